@@ -1,0 +1,106 @@
+//! The error type of `impactcal-core`.
+
+use std::error::Error as StdError;
+
+/// Everything that can go wrong in the shared types: reading files, validating parameter
+/// spaces and histories, and running a [`Model`](crate::Model).
+///
+/// File positions are 1-based: `row` counts lines of the file (the header is row 1) and
+/// `column` counts comma-separated fields.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CoreError {
+    /// A fault at a known position of a CSV file.
+    #[error("{file}: row {row}, column {column}: {message}")]
+    Csv {
+        /// The file (or the name given to text parsed from memory).
+        file: String,
+        /// 1-based line number; the header is row 1.
+        row: usize,
+        /// 1-based field number.
+        column: usize,
+        /// What is wrong there.
+        message: String,
+    },
+    /// A fault that concerns a whole file rather than one cell (for example an empty file).
+    #[error("{file}: {message}")]
+    File {
+        /// The file.
+        file: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The operating system could not read or write a file.
+    #[error("{path}: {source}")]
+    Io {
+        /// The path involved.
+        path: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A parameter definition or value is invalid.
+    #[error("parameter `{name}`: {message}")]
+    Parameter {
+        /// The parameter's name.
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A length or count does not match what the context requires.
+    #[error("{what}: expected {expected}, found {found}")]
+    DimensionMismatch {
+        /// The quantity whose size is wrong.
+        what: String,
+        /// The size required.
+        expected: usize,
+        /// The size given.
+        found: usize,
+    },
+    /// A NaN or infinite value where finite numbers are required.
+    #[error("{what}: non-finite value {value} at {location}")]
+    NonFinite {
+        /// The quantity.
+        what: String,
+        /// Where in it (for example `channel 3, sample 10`).
+        location: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// A channel label that is not present.
+    #[error("no channel labelled `{label}` (available: {available})")]
+    UnknownLabel {
+        /// The label asked for.
+        label: String,
+        /// A short list of the labels that exist.
+        available: String,
+    },
+    /// Input that is structurally invalid in a way not covered above.
+    #[error("{0}")]
+    Invalid(String),
+    /// A model run failed; the source says why.
+    #[error("simulation failed: {0}")]
+    Simulation(#[source] Box<dyn StdError + Send + Sync>),
+}
+
+/// `Result` with [`CoreError`].
+pub type Result<T, E = CoreError> = std::result::Result<T, E>;
+
+impl CoreError {
+    /// Wraps any error raised by a model's own code as [`CoreError::Simulation`].
+    pub fn simulation(err: impl StdError + Send + Sync + 'static) -> Self {
+        CoreError::Simulation(Box::new(err))
+    }
+}
+
+/// Checks that every value is finite, naming `what` and the first offending index.
+pub fn check_finite(what: &str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(CoreError::NonFinite {
+            what: what.to_string(),
+            location: format!("index {i}"),
+            value: values[i],
+        }),
+    }
+}

@@ -1,0 +1,441 @@
+//! Named, bounded parameters and the map between their box and the unit cube.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{CoreError, Result};
+
+/// One uncertain or adjustable model parameter: a name, a closed interval
+/// `[lower, upper]`, a nominal value inside it and a unit string (free text).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Parameter {
+    /// Unique name within a space, for example `belly_panel.t`.
+    pub name: String,
+    /// Lower bound (finite, strictly below `upper`).
+    pub lower: f64,
+    /// Upper bound (finite).
+    pub upper: f64,
+    /// Nominal value, `lower <= nominal <= upper`.
+    pub nominal: f64,
+    /// Unit, for reports only (may be empty).
+    pub unit: String,
+}
+
+impl Parameter {
+    /// A parameter with an empty unit, validated.
+    ///
+    /// # Errors
+    /// [`CoreError::Parameter`] when the name is empty, a value is not finite,
+    /// `lower >= upper`, or the nominal lies outside the bounds.
+    pub fn new(name: impl Into<String>, lower: f64, upper: f64, nominal: f64) -> Result<Self> {
+        let p = Parameter {
+            name: name.into(),
+            lower,
+            upper,
+            nominal,
+            unit: String::new(),
+        };
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// The same parameter with the given unit.
+    #[must_use]
+    pub fn with_unit(mut self, unit: impl Into<String>) -> Self {
+        self.unit = unit.into();
+        self
+    }
+
+    /// Width of the interval, `upper - lower`.
+    pub fn width(&self) -> f64 {
+        self.upper - self.lower
+    }
+
+    /// Checks the invariants stated on [`Parameter::new`].
+    ///
+    /// # Errors
+    /// As [`Parameter::new`].
+    pub fn validate(&self) -> Result<()> {
+        let fail = |message: String| {
+            Err(CoreError::Parameter {
+                name: self.name.clone(),
+                message,
+            })
+        };
+        if self.name.trim().is_empty() {
+            return fail("the name is empty".into());
+        }
+        for (what, v) in [
+            ("lower", self.lower),
+            ("upper", self.upper),
+            ("nominal", self.nominal),
+        ] {
+            if !v.is_finite() {
+                return fail(format!("{what} bound {v} is not finite"));
+            }
+        }
+        if self.lower >= self.upper {
+            return fail(format!(
+                "lower bound {} is not below upper bound {}",
+                self.lower, self.upper
+            ));
+        }
+        if self.nominal < self.lower || self.nominal > self.upper {
+            return fail(format!(
+                "nominal {} lies outside [{}, {}]",
+                self.nominal, self.lower, self.upper
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// An ordered set of named parameters: the design space of a study.
+///
+/// Points are slices of length [`dim`](Self::dim) in the order of the parameters. The unit
+/// cube map is affine per coordinate, `u_i = (x_i - lower_i) / (upper_i - lower_i)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "Vec<Parameter>", into = "Vec<Parameter>")]
+pub struct ParameterSpace {
+    parameters: Vec<Parameter>,
+}
+
+impl TryFrom<Vec<Parameter>> for ParameterSpace {
+    type Error = CoreError;
+    fn try_from(parameters: Vec<Parameter>) -> Result<Self> {
+        ParameterSpace::new(parameters)
+    }
+}
+
+impl From<ParameterSpace> for Vec<Parameter> {
+    fn from(space: ParameterSpace) -> Self {
+        space.parameters
+    }
+}
+
+impl ParameterSpace {
+    /// A space of the given parameters, each validated, names unique.
+    ///
+    /// # Errors
+    /// [`CoreError::Invalid`] for an empty list; [`CoreError::Parameter`] for an invalid
+    /// parameter or a repeated name.
+    pub fn new(parameters: Vec<Parameter>) -> Result<Self> {
+        if parameters.is_empty() {
+            return Err(CoreError::Invalid(
+                "a parameter space needs at least one parameter".into(),
+            ));
+        }
+        for (i, p) in parameters.iter().enumerate() {
+            p.validate()?;
+            if parameters[..i].iter().any(|q| q.name == p.name) {
+                return Err(CoreError::Parameter {
+                    name: p.name.clone(),
+                    message: "the name is used twice".into(),
+                });
+            }
+        }
+        Ok(ParameterSpace { parameters })
+    }
+
+    /// Number of parameters `d`.
+    pub fn dim(&self) -> usize {
+        self.parameters.len()
+    }
+
+    /// The parameters in order.
+    pub fn parameters(&self) -> &[Parameter] {
+        &self.parameters
+    }
+
+    /// The names in order.
+    pub fn names(&self) -> Vec<&str> {
+        self.parameters.iter().map(|p| p.name.as_str()).collect()
+    }
+
+    /// Position of the parameter called `name`.
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.parameters.iter().position(|p| p.name == name)
+    }
+
+    /// The nominal point.
+    pub fn nominal(&self) -> Vec<f64> {
+        self.parameters.iter().map(|p| p.nominal).collect()
+    }
+
+    /// The lower bounds.
+    pub fn lower(&self) -> Vec<f64> {
+        self.parameters.iter().map(|p| p.lower).collect()
+    }
+
+    /// The upper bounds.
+    pub fn upper(&self) -> Vec<f64> {
+        self.parameters.iter().map(|p| p.upper).collect()
+    }
+
+    /// Whether `x` has the right length and lies inside the closed box.
+    pub fn contains(&self, x: &[f64]) -> bool {
+        x.len() == self.dim()
+            && self
+                .parameters
+                .iter()
+                .zip(x)
+                .all(|(p, &v)| v >= p.lower && v <= p.upper)
+    }
+
+    /// Maps a point of the box to the unit cube: `u_i = (x_i - l_i) / (u_i - l_i)`.
+    /// Points outside the box map outside `[0, 1]` (no clamping).
+    ///
+    /// # Errors
+    /// [`CoreError::DimensionMismatch`] for a wrong length, [`CoreError::NonFinite`] for
+    /// NaN or infinite coordinates.
+    pub fn to_unit(&self, x: &[f64]) -> Result<Vec<f64>> {
+        self.check_point("point", x)?;
+        Ok(self
+            .parameters
+            .iter()
+            .zip(x)
+            .map(|(p, &v)| (v - p.lower) / p.width())
+            .collect())
+    }
+
+    /// Maps a point of the unit cube to the box: `x_i = l_i + u_i (u_i - l_i)`.
+    ///
+    /// # Errors
+    /// As [`to_unit`](Self::to_unit).
+    pub fn from_unit(&self, u: &[f64]) -> Result<Vec<f64>> {
+        self.check_point("unit-cube point", u)?;
+        Ok(self
+            .parameters
+            .iter()
+            .zip(u)
+            .map(|(p, &v)| p.lower + v * p.width())
+            .collect())
+    }
+
+    fn check_point(&self, what: &str, x: &[f64]) -> Result<()> {
+        if x.len() != self.dim() {
+            return Err(CoreError::DimensionMismatch {
+                what: format!("{what} length (number of parameters)"),
+                expected: self.dim(),
+                found: x.len(),
+            });
+        }
+        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+            return Err(CoreError::NonFinite {
+                what: what.to_string(),
+                location: format!("parameter `{}`", self.parameters[i].name),
+                value: x[i],
+            });
+        }
+        Ok(())
+    }
+
+    /// Reads a bounds file: a header `name,lower,upper,nominal[,unit]`, then one parameter
+    /// per row.
+    ///
+    /// # Errors
+    /// [`CoreError::Io`] when unreadable; otherwise as [`parse_csv`](Self::parse_csv).
+    pub fn read_csv(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| CoreError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::parse_csv(&text, &path.display().to_string())
+    }
+
+    /// Parses bounds CSV text; see [`read_csv`](Self::read_csv).
+    ///
+    /// # Errors
+    /// [`CoreError::File`] for an empty text or no rows; [`CoreError::Csv`] (file, row,
+    /// column) for a wrong header, a ragged row, a number that does not parse or is not
+    /// finite, `lower >= upper`, a nominal outside the bounds, or a repeated name.
+    pub fn parse_csv(text: &str, source_name: &str) -> Result<Self> {
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let err = |row: usize, column: usize, message: String| CoreError::Csv {
+            file: source_name.to_string(),
+            row,
+            column,
+            message,
+        };
+        let line_index = crate::table::LineIndex::new(text);
+        let mut header_seen = false;
+        let mut parameters: Vec<Parameter> = Vec::new();
+        for record in reader.records() {
+            let record = record.map_err(|e| CoreError::File {
+                file: source_name.to_string(),
+                message: e.to_string(),
+            })?;
+            if record.iter().all(str::is_empty) {
+                continue;
+            }
+            let row = line_index.line_of(&record);
+            if !header_seen {
+                const EXPECTED: [&str; 5] = ["name", "lower", "upper", "nominal", "unit"];
+                if !(4..=5).contains(&record.len()) {
+                    return Err(err(
+                        row,
+                        1,
+                        "expected the header `name,lower,upper,nominal[,unit]`".into(),
+                    ));
+                }
+                for (j, field) in record.iter().enumerate() {
+                    if !field.eq_ignore_ascii_case(EXPECTED[j]) {
+                        return Err(err(
+                            row,
+                            j + 1,
+                            format!("header field `{field}` should be `{}`", EXPECTED[j]),
+                        ));
+                    }
+                }
+                header_seen = true;
+                continue;
+            }
+            if !(4..=5).contains(&record.len()) {
+                return Err(err(
+                    row,
+                    record.len().min(5) + 1,
+                    format!("row has {} fields; expected 4 or 5", record.len()),
+                ));
+            }
+            let name = record.get(0).unwrap_or_default().to_string();
+            if name.is_empty() {
+                return Err(err(row, 1, "empty parameter name".into()));
+            }
+            let mut values = [0.0; 3];
+            for (k, value) in values.iter_mut().enumerate() {
+                let cell = record.get(k + 1).unwrap_or_default();
+                *value = crate::table::parse_cell(cell, crate::table::TableOptions::default())
+                    .map_err(|m| err(row, k + 2, m))?;
+            }
+            let [lower, upper, nominal] = values;
+            let p = Parameter {
+                name,
+                lower,
+                upper,
+                nominal,
+                unit: record.get(4).unwrap_or_default().to_string(),
+            };
+            if let Err(CoreError::Parameter { message, .. }) = p.validate() {
+                let column = if lower >= upper { 3 } else { 4 };
+                return Err(err(row, column, format!("parameter `{}`: {message}", p.name)));
+            }
+            if parameters.iter().any(|q| q.name == p.name) {
+                return Err(err(row, 1, format!("parameter `{}` is listed twice", p.name)));
+            }
+            parameters.push(p);
+        }
+        if !header_seen {
+            return Err(CoreError::File {
+                file: source_name.to_string(),
+                message: "the file is empty (expected a header `name,lower,upper,nominal[,unit]`)"
+                    .into(),
+            });
+        }
+        if parameters.is_empty() {
+            return Err(CoreError::File {
+                file: source_name.to_string(),
+                message: "no parameters after the header".into(),
+            });
+        }
+        ParameterSpace::new(parameters)
+    }
+
+    /// Writes the space as a bounds CSV (with the unit column).
+    pub fn to_csv_string(&self) -> String {
+        let mut s = String::from("name,lower,upper,nominal,unit\n");
+        for p in &self.parameters {
+            s.push_str(&format!(
+                "{},{},{},{},{}\n",
+                p.name, p.lower, p.upper, p.nominal, p.unit
+            ));
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use proptest::prelude::*;
+
+    fn space() -> ParameterSpace {
+        ParameterSpace::new(vec![
+            Parameter::new("a", -1.0, 3.0, 0.0).unwrap(),
+            Parameter::new("b", 10.0, 20.0, 12.0).unwrap().with_unit("psi"),
+        ])
+        .unwrap()
+    }
+
+    #[test]
+    fn unit_map_is_affine() {
+        let s = space();
+        let u = s.to_unit(&[1.0, 15.0]).unwrap();
+        assert_relative_eq!(u[0], 0.5);
+        assert_relative_eq!(u[1], 0.5);
+        assert_eq!(s.from_unit(&[0.0, 1.0]).unwrap(), vec![-1.0, 20.0]);
+        assert!(s.to_unit(&[1.0]).is_err());
+        assert!(s.to_unit(&[f64::NAN, 1.0]).is_err());
+    }
+
+    #[test]
+    fn invalid_parameters_are_rejected() {
+        assert!(Parameter::new("x", 1.0, 1.0, 1.0).is_err());
+        assert!(Parameter::new("x", 0.0, 1.0, 2.0).is_err());
+        assert!(Parameter::new("x", 0.0, f64::INFINITY, 0.5).is_err());
+        assert!(Parameter::new("", 0.0, 1.0, 0.5).is_err());
+        let dup = vec![
+            Parameter::new("x", 0.0, 1.0, 0.5).unwrap(),
+            Parameter::new("x", 0.0, 2.0, 0.5).unwrap(),
+        ];
+        assert!(ParameterSpace::new(dup).is_err());
+        assert!(ParameterSpace::new(vec![]).is_err());
+    }
+
+    #[test]
+    fn bounds_csv_round_trip_and_faults() {
+        let s = space();
+        let back = ParameterSpace::parse_csv(&s.to_csv_string(), "b.csv").unwrap();
+        assert_eq!(back, s);
+        let four = ParameterSpace::parse_csv("name,lower,upper,nominal\nt,1,2,1.5\n", "b.csv");
+        assert_eq!(four.unwrap().dim(), 1);
+        let pos = |text: &str| match ParameterSpace::parse_csv(text, "b.csv").unwrap_err() {
+            CoreError::Csv { row, column, .. } => (row, column),
+            e => panic!("unexpected {e}"),
+        };
+        assert_eq!(pos("name,low,upper,nominal\n"), (1, 2));
+        assert_eq!(pos("name,lower,upper,nominal\nt,1,x,1\n"), (2, 3));
+        assert_eq!(pos("name,lower,upper,nominal\nt,2,1,1.5\n"), (2, 3));
+        assert_eq!(pos("name,lower,upper,nominal\nt,1,2,3\n"), (2, 4));
+        assert_eq!(pos("name,lower,upper,nominal\nt,1,2\n"), (2, 4));
+        assert_eq!(pos("name,lower,upper,nominal\nt,1,2,1\nt,1,2,1\n"), (3, 1));
+        assert!(ParameterSpace::parse_csv("", "b.csv").is_err());
+        assert!(ParameterSpace::parse_csv("name,lower,upper,nominal\n", "b.csv").is_err());
+    }
+
+    #[test]
+    fn serde_round_trip_validates() {
+        let s = space();
+        let json = serde_json::to_string(&s).unwrap();
+        let back: ParameterSpace = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, s);
+        let bad = json.replace("\"upper\":3.0", "\"upper\":-2.0");
+        assert!(serde_json::from_str::<ParameterSpace>(&bad).is_err());
+    }
+
+    proptest! {
+        #[test]
+        fn unit_round_trip(lo in -1e3f64..1e3, w in 1e-3f64..1e3, f in 0.0f64..1.0) {
+            let s = ParameterSpace::new(vec![Parameter::new("p", lo, lo + w, lo).unwrap()]).unwrap();
+            let x = lo + f * w;
+            let back = s.from_unit(&s.to_unit(&[x]).unwrap()).unwrap()[0];
+            prop_assert!((back - x).abs() <= 1e-12 * (1.0 + x.abs()));
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! Impact shapes (work in progress in this commit).
