@@ -99,7 +99,11 @@ fn chain_forward_greedy_from_pivoted_qr() {
         let fwd = place(&c, &PlacementOptions::new(n).method(Method::Forward)).unwrap();
         let bwd = place(&c, &PlacementOptions::new(n)).unwrap();
         assert_eq!(fwd.selected, bwd.selected, "N = {n}");
-        assert_abs_diff_eq!(fwd.determinant_ratio, bwd.determinant_ratio, epsilon = 1e-12);
+        assert_abs_diff_eq!(
+            fwd.determinant_ratio,
+            bwd.determinant_ratio,
+            epsilon = 1e-12
+        );
     }
 }
 
@@ -140,7 +144,11 @@ fn triaxial_backward_node_elimination() {
     assert_eq!(p.selected.len(), 9);
     assert_abs_diff_eq!(p.determinant_ratio, 0.084028, epsilon = 1e-6);
     assert_eq!(
-        (p.counts_by_direction.x, p.counts_by_direction.y, p.counts_by_direction.z),
+        (
+            p.counts_by_direction.x,
+            p.counts_by_direction.y,
+            p.counts_by_direction.z
+        ),
         (3, 3, 3)
     );
 
