@@ -12,6 +12,9 @@ pub enum SensorsError {
     /// Reading or validating shared input failed (a CSV fault names file, row and column).
     #[error(transparent)]
     Core(#[from] CoreError),
+    /// Computing impact shapes from an ensemble of histories failed.
+    #[error(transparent)]
+    Shapes(#[from] impactcal_shapes::ShapesError),
     /// A shape value is NaN or infinite.
     #[error("shape matrix: non-finite value {value} at candidate `{label}`, shape {shape}")]
     NonFinite {

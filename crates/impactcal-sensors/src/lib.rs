@@ -19,6 +19,9 @@
 //! - Options ([`PlacementOptions`]): DOFs to keep, DOFs to exclude, noise per DOF
 //!   (prewhitening), a forward greedy method started by QR with column pivoting, and a swap
 //!   refinement.
+//! - Straight from simulations ([`place_from_histories`]): the runs of an ensemble are
+//!   concatenated in time, their impact shapes computed (`impactcal-shapes`) and the
+//!   placement made on those shapes, as the source paper does.
 //! - The [`Placement`] carries the chosen DOFs, the removal order with each score, the
 //!   retained information `det(A_kept)/det(A_full)`, the condition number, the largest
 //!   off-diagonal of the normalised Gram matrix and the counts per direction.
@@ -46,6 +49,7 @@
 mod candidates;
 mod elimination;
 mod engine;
+mod ensemble;
 mod error;
 mod linalg;
 mod options;
@@ -53,6 +57,7 @@ mod place;
 
 pub use candidates::{CandidateShapes, Direction, split_label};
 pub use elimination::{ESSENTIAL, Elimination};
+pub use ensemble::{EnsemblePlacement, concatenate_runs, place_from_histories};
 pub use error::{Result, SensorsError};
 pub use linalg::leverage_scores;
 pub use options::{Grouping, Method, PlacementOptions};
