@@ -7,6 +7,7 @@ mod compare;
 mod error;
 mod expand;
 mod output;
+mod place;
 mod shapes;
 
 use std::process::ExitCode;
@@ -32,6 +33,9 @@ enum Command {
     Compare(compare::Args),
     /// Expand measured channels to the unmeasured channels of a model through its shapes.
     Expand(expand::Args),
+    /// Sensor placement by effective independence (Kammer) on impact shapes or a shape
+    /// matrix.
+    Place(place::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -39,6 +43,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Shapes(a) => shapes::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
+        Command::Place(a) => place::run(a),
     }
 }
 
