@@ -18,17 +18,41 @@
 //! det(A') = det(A) det(I + sigma G)
 //! ```
 //!
-//! One step costs `O(s k)` (per DOF) and a refresh `O(s k^2)`; the refresh every
-//! `refresh_every` steps removes rounding drift.
+//! Per node, every tracked `E_bb` is updated after each step, `O(s k)`. Per DOF, only `P`
+//! is updated (`O(k^2)`); a DOF's score `w_i P w_i^T` is re-evaluated lazily, only when it
+//! reaches the top of a heap of earlier scores (see [`Engine::best`]), which gives the same
+//! choices as updating every score. A refresh costs `O(s k^2)` and removes rounding drift:
+//! per node every `refresh_every` steps, per DOF after `refresh_every` steps or after half
+//! of the candidates tracked at the last refresh are gone, whichever is later.
+
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
 
 use rayon::prelude::*;
 
 use crate::linalg::{dot, r_factor, small_det, small_spd_inverse, whiten_row};
 
-/// Positions per parallel chunk in the per-DOF update.
-const CHUNK: usize = 2048;
-/// Below this many multiply-adds per step the per-DOF update runs on one thread.
-const PARALLEL_WORK: usize = 1 << 16;
+/// Heap key of a per-DOF position: (score, negated for addition; block id; position),
+/// ordered by score then block id.
+#[derive(Debug, Clone, Copy)]
+struct Key(f64, usize, usize);
+
+impl PartialEq for Key {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Key {}
+impl PartialOrd for Key {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Key {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
+    }
+}
 
 /// Whether steps remove blocks from the set or add blocks to it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -52,9 +76,14 @@ pub(crate) struct Engine {
     /// Tracked block ids, ascending, and whether each is still tracked.
     ids: Vec<usize>,
     alive: Vec<bool>,
-    /// Per-DOF mode: whitened rows, column-major (`ids.len() x k`), and `E_ii`.
+    /// Per-DOF mode: whitened rows, row-major (`ids.len() x k`); `e[pos]` is the score of
+    /// `pos` as last evaluated, at step `stamp[pos]`; `heap` orders positions by that
+    /// (possibly stale) score.
     wc: Vec<f64>,
     e: Vec<f64>,
+    stamp: Vec<u64>,
+    step: u64,
+    heap: BinaryHeap<Reverse<Key>>,
     /// Block mode: whitened rows, row-major, block `pos` at rows `off[pos]..off[pos + 1]`,
     /// and each block's `E_bb` (row-major, up to 3 x 3).
     wr: Vec<f64>,
@@ -64,7 +93,6 @@ pub(crate) struct Engine {
     p: Vec<f64>,
     since_refresh: usize,
     refresh_every: usize,
-    scratch_b: Vec<f64>,
 }
 
 impl Engine {
@@ -97,13 +125,15 @@ impl Engine {
             ids: tracked,
             wc: Vec::new(),
             e: Vec::new(),
+            stamp: Vec::new(),
+            step: 0,
+            heap: BinaryHeap::new(),
             wr: Vec::new(),
             off: Vec::new(),
             gram: Vec::new(),
             p: Vec::new(),
             since_refresh: 0,
             refresh_every,
-            scratch_b: Vec::new(),
         };
         engine.refresh();
         engine
@@ -152,14 +182,10 @@ impl Engine {
                 .par_iter()
                 .map(|&b| whiten(self.blocks[b][0]))
                 .collect();
-            self.wc = vec![0.0; n * k];
-            self.e = vec![0.0; n];
-            for (pos, w) in rows.iter().enumerate() {
-                for (c, v) in w.iter().enumerate() {
-                    self.wc[c * n + pos] = *v;
-                }
-                self.e[pos] = dot(w, w);
-            }
+            self.wc = rows.concat();
+            self.e = rows.iter().map(|w| dot(w, w)).collect();
+            self.stamp = vec![self.step; n];
+            self.heap = (0..n).map(|pos| Reverse(self.key(pos))).collect();
         } else {
             self.wr.clear();
             self.off = vec![0];
@@ -192,7 +218,7 @@ impl Engine {
     fn score(&self, pos: usize) -> f64 {
         if self.per_dof {
             // 1 - (1 - E_ii) when removing, (1 + E_ii) - 1 when adding.
-            return self.e[pos];
+            return self.exact_dof(pos);
         }
         let nb = self.off[pos + 1] - self.off[pos];
         let mut m = [0.0; 9];
@@ -217,9 +243,49 @@ impl Engine {
             .collect()
     }
 
+    /// Heap key of per-DOF position `pos` from its last evaluated score.
+    fn key(&self, pos: usize) -> Key {
+        let v = match self.direction {
+            Direction::Remove => self.e[pos],
+            Direction::Add => -self.e[pos],
+        };
+        Key(v, self.ids[pos], pos)
+    }
+
+    /// `E_ii = w_i P w_i^T` of per-DOF position `pos` under the current `P` (`O(k^2)`).
+    fn exact_dof(&self, pos: usize) -> f64 {
+        let k = self.k;
+        let w = &self.wc[pos * k..(pos + 1) * k];
+        (0..k)
+            .map(|i| w[i] * dot(&self.p[i * k..(i + 1) * k], w))
+            .sum()
+    }
+
     /// The best tracked block (lowest score when removing, highest when adding; ties go to
     /// the lowest block id) as (position, block id, score).
-    pub(crate) fn best(&self) -> Option<(usize, usize, f64)> {
+    ///
+    /// Per DOF this is a lazy search: a score only grows as rows are removed (`A` shrinks,
+    /// so `A^-1` grows) and only falls as rows are added, so a score evaluated at an earlier
+    /// step bounds the current one. The heap is ordered by those bounds; the top is
+    /// re-evaluated until its score is current, and then no other block can beat it. The
+    /// result is the same as re-scoring every block, at `O(k^2)` per re-evaluation.
+    pub(crate) fn best(&mut self) -> Option<(usize, usize, f64)> {
+        if self.per_dof {
+            while let Some(&Reverse(Key(_, id, pos))) = self.heap.peek() {
+                if !self.alive[pos] {
+                    self.heap.pop();
+                } else if self.stamp[pos] == self.step {
+                    return Some((pos, id, self.e[pos]));
+                } else {
+                    self.heap.pop();
+                    self.e[pos] = self.exact_dof(pos);
+                    self.stamp[pos] = self.step;
+                    let key = self.key(pos);
+                    self.heap.push(Reverse(key));
+                }
+            }
+            return None;
+        }
         let mut best: Option<(usize, f64)> = None;
         for pos in 0..self.ids.len() {
             if !self.alive[pos] {
@@ -252,49 +318,34 @@ impl Engine {
         let b = self.ids[pos];
         self.in_set[b] = !self.in_set[b];
         self.since_refresh += 1;
-        if self.refresh_every > 0 && self.since_refresh >= self.refresh_every {
+        // Per DOF a refresh costs far more than a step, so it waits until half of the
+        // blocks tracked at the last refresh are gone as well (a geometric schedule).
+        let due = if self.per_dof {
+            self.refresh_every.max(self.ids.len() / 2)
+        } else {
+            self.refresh_every
+        };
+        if self.refresh_every > 0 && self.since_refresh >= due {
             self.refresh();
         }
         ratio
     }
 
     fn apply_dof(&mut self, pos: usize) -> f64 {
-        let (k, n) = (self.k, self.ids.len());
-        let w: Vec<f64> = (0..k).map(|c| self.wc[c * n + pos]).collect();
+        let k = self.k;
+        let w = &self.wc[pos * k..(pos + 1) * k];
         let z: Vec<f64> = (0..k)
-            .map(|i| dot(&self.p[i * k..(i + 1) * k], &w))
+            .map(|i| dot(&self.p[i * k..(i + 1) * k], w))
             .collect();
-        let g = dot(&w, &z);
+        let g = dot(w, &z);
         let denom = 1.0 + self.sigma * g;
         let f = self.sigma / denom;
-        let wc = &self.wc;
-        let update = |start: usize, e: &mut [f64], b: &mut [f64]| {
-            let len = e.len();
-            b[..len].fill(0.0);
-            for (c, zc) in z.iter().enumerate() {
-                let col = &wc[c * n + start..c * n + start + len];
-                for (bi, wi) in b[..len].iter_mut().zip(col) {
-                    *bi += zc * wi;
-                }
-            }
-            for (ei, bi) in e.iter_mut().zip(&b[..len]) {
-                *ei -= f * bi * bi;
-            }
-        };
-        if n * k >= PARALLEL_WORK {
-            self.e
-                .par_chunks_mut(CHUNK)
-                .enumerate()
-                .for_each_init(|| vec![0.0; CHUNK], |b, (ci, e)| update(ci * CHUNK, e, b));
-        } else {
-            self.scratch_b.resize(n, 0.0);
-            update(0, &mut self.e, &mut self.scratch_b);
-        }
         for i in 0..k {
             for j in 0..k {
                 self.p[i * k + j] -= f * z[i] * z[j];
             }
         }
+        self.step += 1;
         denom
     }
 
