@@ -17,8 +17,8 @@ trap 'rm -rf "$WORK"' EXIT
 if [ ! -x "$VENV/bin/python" ]; then
     python3 -m venv "$VENV"
     "$VENV/bin/pip" install --quiet --upgrade pip
-    "$VENV/bin/pip" install --quiet sdynpy
 fi
+"$VENV/bin/pip" install --quiet sdynpy
 
 cargo build --release --quiet --example place_timing
 OURS="${CARGO_TARGET_DIR:-target}/release/examples/place_timing"
