@@ -1,0 +1,1 @@
+//! LS-DYNA keyword decks (placeholder).
