@@ -189,6 +189,7 @@ pub struct Simulation {
     a: Vec<[f64; 3]>,
     alpha: Vec<[f64; 3]>,
     v_int: Vec<[f64; 3]>,
+    w_int: Vec<[f64; 3]>,
     time: f64,
     cycle: u64,
     dt_half: f64,
@@ -273,6 +274,7 @@ impl Simulation {
             csr,
             x,
             v_int: v.clone(),
+            w_int: w.clone(),
             v,
             w,
             a: vec![[0.0; 3]; nn],
@@ -469,9 +471,23 @@ impl Simulation {
                     vt[1] + vn_new * n[1],
                     vt[2] + vn_new * n[2],
                 ];
-                let ke = |u: [f64; 3]| 0.5 * m * dot(u, u);
-                self.energies.contact += ke(vs) - ke(vnew);
-                self.energies.friction += 0.5 * m * vt_len * vt_len * (1.0 - keep * keep);
+                // Work of the wall impulse with the mean velocity over the kick (the power
+                // of a force in the central-difference energy balance).
+                let vbar = [
+                    0.5 * (vold[0] + vnew[0]),
+                    0.5 * (vold[1] + vnew[1]),
+                    0.5 * (vold[2] + vnew[2]),
+                ];
+                let imp = [
+                    m * (vnew[0] - vs[0]),
+                    m * (vnew[1] - vs[1]),
+                    m * (vnew[2] - vs[2]),
+                ];
+                let work = dot(imp, vbar);
+                let imp_n = dot(imp, n);
+                let work_t = work - imp_n * dot(vbar, n);
+                self.energies.contact -= work;
+                self.energies.friction -= work_t;
                 for k in 0..3 {
                     let f = m * (vnew[k] - vs[k]) / dt_v;
                     force[k] += f;
@@ -504,19 +520,19 @@ impl Simulation {
         self.v
             .par_iter_mut()
             .zip(self.w.par_iter_mut())
-            .zip(self.v_int.par_iter_mut())
+            .zip(self.v_int.par_iter_mut().zip(self.w_int.par_iter_mut()))
             .enumerate()
             .with_min_len(NODE_CHUNK)
-            .for_each(|(i, ((v, w), vi))| {
+            .for_each(|(i, ((v, w), (vi, wi)))| {
                 for d in 0..3 {
                     vi[d] = v[d] + h_prev * a[i][d];
                     v[d] = vi[d] + half * a[i][d];
-                    w[d] += dt_v * al[i][d];
+                    wi[d] = w[d] + h_prev * al[i][d];
+                    w[d] = wi[d] + half * al[i][d];
                 }
             });
         let ke_t = chunked_sum(&self.v_int, &self.c.mass, |v, m| 0.5 * m * dot(*v, *v));
-        // Rotational kinetic energy from the mid-step angular velocities.
-        let ke_r = chunked_sum(&self.w, &self.c.inertia, |w, i| 0.5 * i * dot(*w, *w));
+        let ke_r = chunked_sum(&self.w_int, &self.c.inertia, |w, i| 0.5 * i * dot(*w, *w));
         self.energies.kinetic = ke_t + ke_r;
     }
 
