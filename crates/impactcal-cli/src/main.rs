@@ -3,8 +3,11 @@
 //! Each subcommand lives in its own module with an `Args` struct (clap) and a `run`
 //! function; this file only registers them. Numerical work happens in the library.
 
+mod compare;
 mod error;
+mod expand;
 mod output;
+mod shapes;
 
 use std::process::ExitCode;
 
@@ -21,10 +24,22 @@ struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
-enum Command {}
+enum Command {
+    /// Impact shapes (SVD) of a histories file: singular values, contributions, shapes and
+    /// time functions as JSON.
+    Shapes(shapes::Args),
+    /// Calibration metric M2: orthogonality and pairing of test and analysis impact shapes.
+    Compare(compare::Args),
+    /// Expand measured channels to the unmeasured channels of a model through its shapes.
+    Expand(expand::Args),
+}
 
 fn run(command: Command) -> Result<(), CliError> {
-    match command {}
+    match command {
+        Command::Shapes(a) => shapes::run(a),
+        Command::Compare(a) => compare::run(a),
+        Command::Expand(a) => expand::run(a),
+    }
 }
 
 fn main() -> ExitCode {
