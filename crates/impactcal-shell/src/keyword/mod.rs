@@ -11,7 +11,10 @@
 //! system id, a box, mass scaling) are errors too. The supported keywords and fields are
 //! listed card by card in `docs/shell-solver.md`.
 
+// Deck flags and defaults are exact values (0, 1): compare them exactly.
+#[allow(clippy::float_cmp)]
 mod reader;
+#[allow(clippy::float_cmp)]
 mod writer;
 
 pub use reader::{Deck, IGNORED_KEYWORDS, parse_deck, read_deck};
