@@ -65,15 +65,12 @@ fn simulate_writes_histories_energies_and_a_summary() {
     // Same histories on two threads.
     run("2", "velocity");
     assert_eq!(Histories::read_csv(&h).unwrap(), v1);
-    // Displacement: the strip ends on the floor (z = 0) from 4 mm up.
+    // Displacement: node 21 starts 6 mm up, comes down and never passes the floor.
     run("2", "displacement");
     let u = Histories::read_csv(&h).unwrap();
     let uz = u.channel_by_label("21.z").unwrap();
-    assert!(
-        (uz[uz.len() - 1] + 0.004).abs() < 1e-4,
-        "{}",
-        uz[uz.len() - 1]
-    );
+    let lowest = uz.iter().cloned().fold(f64::INFINITY, f64::min);
+    assert!(lowest >= -0.006 - 1e-12 && lowest < -0.004, "{lowest}");
 }
 
 #[test]

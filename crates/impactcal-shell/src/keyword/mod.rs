@@ -1,6 +1,6 @@
 //! LS-DYNA keyword decks: the subset this solver supports, in and out.
 //!
-//! [`parse_deck`] / [`read_deck`] turn a deck into a [`ShellModel`]; [`write_deck`] writes a
+//! [`parse_deck`] / [`read_deck`] turn a deck into a [`ShellModel`](crate::ShellModel); [`write_deck`] writes a
 //! model back in fixed-width format, and reading what it wrote gives the same model.
 //!
 //! Cards may be fixed-width (the widths of each keyword's manual page: 8/16 for `*NODE`,
