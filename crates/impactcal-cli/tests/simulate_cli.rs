@@ -70,7 +70,7 @@ fn simulate_writes_histories_energies_and_a_summary() {
     let u = Histories::read_csv(&h).unwrap();
     let uz = u.channel_by_label("21.z").unwrap();
     let lowest = uz.iter().cloned().fold(f64::INFINITY, f64::min);
-    assert!(lowest >= -0.006 - 1e-12 && lowest < -0.004, "{lowest}");
+    assert!((-0.006 - 1e-12..-0.004).contains(&lowest), "{lowest}");
 }
 
 #[test]
