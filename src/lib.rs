@@ -7,6 +7,7 @@
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
 //! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
+//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -23,6 +24,7 @@
 pub use impactcal_core as core;
 pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
+pub use impactcal_shell as shell;
 
 /// The types most programs need, in one import.
 pub mod prelude {
@@ -37,4 +39,5 @@ pub mod prelude {
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
     };
+    pub use impactcal_shell::{ShellError, ShellModel, Simulation};
 }

@@ -9,6 +9,7 @@ mod expand;
 mod output;
 mod place;
 mod shapes;
+mod simulate;
 
 use std::process::ExitCode;
 
@@ -36,6 +37,9 @@ enum Command {
     /// Sensor placement by effective independence (Kammer) on impact shapes or a shape
     /// matrix.
     Place(place::Args),
+    /// Run an LS-DYNA keyword deck with the built-in explicit shell solver; write nodal
+    /// histories and energies as CSV.
+    Simulate(simulate::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -44,6 +48,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
         Command::Place(a) => place::run(a),
+        Command::Simulate(a) => simulate::run(a),
     }
 }
 
