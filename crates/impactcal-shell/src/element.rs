@@ -111,7 +111,6 @@ pub struct KernelOptions {
 /// Frame and centre derivatives of an element on its current geometry.
 struct Local<const N: usize> {
     rot: [[f64; 3]; 3],
-    r: [[f64; 3]; N],
     b1: [f64; N],
     b2: [f64; N],
     area: f64,
@@ -169,7 +168,6 @@ fn quad_local(x: &[[f64; 3]; 4]) -> Result<Local<4>, ElementFault> {
     let s = 0.5 / area;
     Ok(Local {
         rot,
-        r,
         b1: [s * (y2 - y4), s * (y3 - y1), s * (y4 - y2), s * (y1 - y3)],
         b2: [s * (x4 - x2), s * (x1 - x3), s * (x2 - x4), s * (x3 - x1)],
         area,
@@ -192,74 +190,10 @@ fn tri_local(x: &[[f64; 3]; 3]) -> Result<Local<3>, ElementFault> {
     let s = 0.5 / area;
     Ok(Local {
         rot,
-        r,
         b1: [s * (y2 - y3), s * (y3 - y1), s * (y1 - y2)],
         b2: [s * (x3 - x2), s * (x1 - x3), s * (x2 - x1)],
         area,
     })
-}
-
-/// Inverse of the rigid-rotation Gram matrix `G = sum_I (|r_I|^2 1 - r_I r_I^T) + n 1`.
-fn rotation_gram_inverse<const N: usize>(r: &[[f64; 3]; N]) -> [[f64; 3]; 3] {
-    let mut g = [[0.0; 3]; 3];
-    for ri in r {
-        let rr = dot(*ri, *ri);
-        for a in 0..3 {
-            for b in 0..3 {
-                g[a][b] -= ri[a] * ri[b];
-            }
-            g[a][a] += rr;
-        }
-    }
-    for a in 0..3 {
-        g[a][a] += N as f64;
-    }
-    let c00 = g[1][1] * g[2][2] - g[1][2] * g[2][1];
-    let c01 = g[1][2] * g[2][0] - g[1][0] * g[2][2];
-    let c02 = g[1][0] * g[2][1] - g[1][1] * g[2][0];
-    let det = g[0][0] * c00 + g[0][1] * c01 + g[0][2] * c02;
-    let inv = 1.0 / det;
-    [
-        [
-            c00 * inv,
-            (g[0][2] * g[2][1] - g[0][1] * g[2][2]) * inv,
-            (g[0][1] * g[1][2] - g[0][2] * g[1][1]) * inv,
-        ],
-        [
-            c01 * inv,
-            (g[0][0] * g[2][2] - g[0][2] * g[2][0]) * inv,
-            (g[0][2] * g[1][0] - g[0][0] * g[1][2]) * inv,
-        ],
-        [
-            c02 * inv,
-            (g[0][1] * g[2][0] - g[0][0] * g[2][1]) * inv,
-            (g[0][0] * g[1][1] - g[0][1] * g[1][0]) * inv,
-        ],
-    ]
-}
-
-/// Removes the rigid-body part of a set of nodal 6-vectors (translations then rotations):
-/// `u <- (1 - T T^T / n - Rm G^-1 Rm^T) u`, with the modes `T` (unit translations) and `Rm`
-/// (rotation `e_k` about the centroid: `e_k x r_I` on translations, `e_k` on rotations).
-fn project_rigid<const N: usize>(r: &[[f64; 3]; N], ginv: &[[f64; 3]; 3], u: &mut [[f64; 6]; N]) {
-    let mut tbar = [0.0; 3];
-    let mut b = [0.0; 3];
-    for i in 0..N {
-        let t = [u[i][0], u[i][1], u[i][2]];
-        let c = cross(r[i], t);
-        for k in 0..3 {
-            tbar[k] += t[k] / N as f64;
-            b[k] += c[k] + u[i][3 + k];
-        }
-    }
-    let w = [dot(ginv[0], b), dot(ginv[1], b), dot(ginv[2], b)];
-    for i in 0..N {
-        let wr = cross(w, r[i]);
-        for k in 0..3 {
-            u[i][k] -= tbar[k] + wr[k];
-            u[i][3 + k] -= w[k];
-        }
-    }
 }
 
 /// Evaluates one quad for one cycle: updates its `state` (length
@@ -280,38 +214,11 @@ pub fn quad(
     dt: f64,
     opts: KernelOptions,
 ) -> Result<ElementOutput, ElementFault> {
-    let loc = quad_local(x)?;
-    let ginv = opts.projection.then(|| rotation_gram_inverse(&loc.r));
-    let mut u = [[0.0; 6]; 4];
-    for i in 0..4 {
-        for k in 0..3 {
-            u[i][k] = dot(loc.rot[k], v[i]);
-            u[i][3 + k] = dot(loc.rot[k], omega[i]);
-        }
+    let slot = crate::kernel::quad_single(x, v, omega, props, state, dt, opts);
+    match slot.fault {
+        Some(f) => Err(f),
+        None => Ok(slot.out),
     }
-    if let Some(ginv) = &ginv {
-        project_rigid(&loc.r, ginv, &mut u);
-    }
-    let (mut f, internal, mut hourglass) = resultant_forces(&loc, &u, props, state, dt);
-    hourglass += hourglass_forces(&loc, &u, props, state, dt, &mut f);
-    if let Some(ginv) = &ginv {
-        project_rigid(&loc.r, ginv, &mut f);
-    }
-    // Characteristic length from sides and diagonals.
-    let d = |i: usize, j: usize| norm(sub(x[i], x[j]));
-    let side = d(0, 1).max(d(1, 2)).max(d(2, 3)).max(d(3, 0));
-    let diag = d(0, 2).max(d(1, 3));
-    let len = if opts.isdo_diagonal {
-        loc.area / diag
-    } else {
-        loc.area / side.max(diag)
-    };
-    Ok(ElementOutput {
-        f: to_global(&loc.rot, &f),
-        dt: len / props.mat.wave_speed,
-        internal,
-        hourglass,
-    })
 }
 
 /// Evaluates one C0 triangle for one cycle (as [`quad`], without hourglass control or
@@ -457,82 +364,6 @@ fn resultant_forces<const N: usize>(
         ];
     }
     (f, internal, 0.0)
-}
-
-/// Quad hourglass forces (added to `f`); returns the hourglass energy increment.
-fn hourglass_forces(
-    loc: &Local<4>,
-    u: &[[f64; 6]; 4],
-    props: &PartProps,
-    state: &mut [f64],
-    dt: f64,
-    f: &mut [[f64; 6]; 4],
-) -> f64 {
-    const H: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
-    let (mut hx, mut hy) = (0.0, 0.0);
-    for i in 0..4 {
-        hx += H[i] * loc.r[i][0];
-        hy += H[i] * loc.r[i][1];
-    }
-    let mut gam = [0.0; 4];
-    for i in 0..4 {
-        gam[i] = H[i] - hx * loc.b1[i] - hy * loc.b2[i];
-    }
-    // Hourglass rates: membrane x, y; out-of-plane w; rotation x, y.
-    let mut q = [0.0; 5];
-    for i in 0..4 {
-        q[0] += gam[i] * u[i][0];
-        q[1] += gam[i] * u[i][1];
-        q[2] += gam[i] * u[i][2];
-        q[3] += gam[i] * u[i][3];
-        q[4] += gam[i] * u[i][4];
-    }
-    let mat = &props.mat;
-    let (t, a) = (props.t, loc.area);
-    let [rm, rw, rb] = props.hg;
-    let mut c = [0.0; 5];
-    match props.hg_form {
-        HourglassForm::Stiffness => {
-            let bb: f64 = (0..4)
-                .map(|i| loc.b1[i] * loc.b1[i] + loc.b2[i] * loc.b2[i])
-                .sum();
-            c[0] = rm * mat.e * t * a * bb / 8.0;
-            c[1] = c[0];
-            c[2] = rw * props.shear_factor * mat.g * t * t * t * bb / 12.0;
-            c[3] = rb * mat.e * t * t * t * a * bb / 192.0;
-            c[4] = c[3];
-        }
-        HourglassForm::Viscous => {
-            let base = 0.25 * mat.rho * mat.wave_speed * t * a.sqrt();
-            c[0] = rm * base;
-            c[1] = c[0];
-            c[2] = rw * base;
-            c[3] = rb * base * t * t / 12.0;
-            c[4] = c[3];
-        }
-    }
-    let hg = &mut state[2..7];
-    let mut energy = 0.0;
-    for k in 0..5 {
-        let old = hg[k];
-        let new = match props.hg_form {
-            HourglassForm::Stiffness => old + c[k] * dt * q[k],
-            HourglassForm::Viscous => c[k] * q[k],
-        };
-        hg[k] = new;
-        energy += match props.hg_form {
-            HourglassForm::Stiffness => 0.5 * (old + new) * dt * q[k],
-            HourglassForm::Viscous => new * dt * q[k],
-        };
-    }
-    for i in 0..4 {
-        f[i][0] += gam[i] * hg[0];
-        f[i][1] += gam[i] * hg[1];
-        f[i][2] += gam[i] * hg[2];
-        f[i][3] += gam[i] * hg[3];
-        f[i][4] += gam[i] * hg[4];
-    }
-    energy
 }
 
 /// Area of the current geometry of a quad or triangle and whether it is usable, for

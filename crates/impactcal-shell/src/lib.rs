@@ -74,6 +74,7 @@
 pub mod element;
 pub mod error;
 mod geometry;
+mod kernel;
 pub mod keyword;
 pub mod material;
 pub mod model;

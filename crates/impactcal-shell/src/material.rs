@@ -95,9 +95,17 @@ impl MaterialProps {
         let sy = sig[1] + c12 * de[0] + self.c11 * de[1];
         let txy = sig[2] + self.g * de[2];
         *sig = [sx, sy, txy];
-        if !self.is_plastic() {
-            return;
+        if self.is_plastic() {
+            *sig = self.plastic_return(*sig, epsp, factor);
         }
+    }
+
+    /// The return of a trial (elastic predictor) stress to the yield surface: returns the
+    /// trial stress itself when it lies within the current yield stress `s_y(p) factor`,
+    /// else the returned stress, adding the plastic strain increment to `epsp`.
+    #[inline]
+    pub fn plastic_return(&self, trial: [f64; 3], epsp: &mut f64, factor: f64) -> [f64; 3] {
+        let [sx, sy, txy] = trial;
         let s = sx + sy;
         let d = sx - sy;
         let a = 0.25 * s * s;
@@ -106,7 +114,7 @@ impl MaterialProps {
         let hf = self.hardening * factor;
         let sy0 = (self.yield0 + self.hardening * *epsp) * factor;
         if vm2 <= sy0 * sy0 {
-            return;
+            return trial;
         }
         let (e, nu) = (self.e, self.nu);
         let f_of = |dp: f64| {
@@ -152,8 +160,8 @@ impl MaterialProps {
         let (_, _, p, q) = f_of(dp);
         let s = p * s;
         let d = q * d;
-        *sig = [0.5 * (s + d), 0.5 * (s - d), q * txy];
         *epsp += dp;
+        [0.5 * (s + d), 0.5 * (s - d), q * txy]
     }
 }
 

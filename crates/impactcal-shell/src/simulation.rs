@@ -21,11 +21,10 @@
 use impactcal_core::Histories;
 use rayon::prelude::*;
 
-use crate::element::{
-    self, ElementFault, ElementOutput, KernelOptions, STATE_HEAD, STATE_PER_POINT,
-};
+use crate::element::{self, ElementOutput, KernelOptions, STATE_HEAD, STATE_PER_POINT};
 use crate::error::{Result, ShellError};
 use crate::geometry::{dot, sub};
+use crate::kernel::{Block, LANES, Slot, quad_block};
 use crate::model::{Curve, ShellModel, WallMethod};
 use crate::setup::{Compiled, Elem, compile};
 
@@ -181,6 +180,7 @@ pub struct Simulation {
     stride: usize,
     state: Vec<f64>,
     slots: Vec<Slot>,
+    chunks: Vec<ChunkSum>,
     csr_start: Vec<u32>,
     csr: Vec<u32>,
     x: Vec<[f64; 3]>,
@@ -203,10 +203,28 @@ pub struct Simulation {
     started: bool,
 }
 
-#[derive(Debug, Clone, Copy, Default)]
-struct Slot {
-    out: ElementOutput,
-    fault: Option<ElementFault>,
+/// Per-chunk reductions of the element loop, combined in chunk order.
+#[derive(Debug, Clone, Copy)]
+struct ChunkSum {
+    internal: f64,
+    hourglass: f64,
+    dt_min: f64,
+    /// Element (global index) of `dt_min`.
+    arg: usize,
+    /// First element of the chunk with a fault or a non-finite step.
+    problem: Option<usize>,
+}
+
+impl Default for ChunkSum {
+    fn default() -> Self {
+        ChunkSum {
+            internal: 0.0,
+            hourglass: 0.0,
+            dt_min: f64::INFINITY,
+            arg: 0,
+            problem: None,
+        }
+    }
 }
 
 impl Simulation {
@@ -270,6 +288,7 @@ impl Simulation {
             stride,
             state: vec![0.0; stride * ne],
             slots: vec![Slot::default(); ne],
+            chunks: vec![ChunkSum::default(); ne.div_ceil(ELEMENT_CHUNK)],
             csr_start: count,
             csr,
             x,
@@ -365,20 +384,75 @@ impl Simulation {
     }
 
     /// Runs the element loop for a step `dt` on the current positions and mid-step
-    /// velocities; fills the slots.
+    /// velocities: fills the slots and the chunk reductions. Each fixed chunk of
+    /// `ELEMENT_CHUNK` elements is one task; inside it, runs of up to `LANES` consecutive
+    /// quads of one part go through the blocked kernel, triangles one by one.
     fn element_loop(&mut self, dt: f64) {
         let (x, v, w) = (&self.x, &self.v, &self.w);
-        let parts = &self.c.parts;
+        let (parts, elems) = (&self.c.parts, &self.c.elems);
         let kernel = self.kernel;
         let stride = self.stride;
-        self.c
-            .elems
-            .par_iter()
-            .zip(self.state.par_chunks_mut(stride))
-            .zip(self.slots.par_iter_mut())
-            .with_min_len(ELEMENT_CHUNK)
-            .for_each(|((e, st), slot)| {
-                *slot = eval_element(e, x, v, w, &parts[e.part as usize], st, dt, kernel);
+        self.state
+            .par_chunks_mut(stride * ELEMENT_CHUNK)
+            .zip(self.slots.par_chunks_mut(ELEMENT_CHUNK))
+            .zip(self.chunks.par_iter_mut())
+            .enumerate()
+            .for_each(|(ci, ((st, sl), sum))| {
+                let first = ci * ELEMENT_CHUNK;
+                let n = sl.len();
+                let mut k = 0;
+                while k < n {
+                    let e = &elems[first + k];
+                    let props = &parts[e.part as usize];
+                    if e.tri {
+                        let g = |a: &[[f64; 3]]| {
+                            [
+                                a[e.nodes[0] as usize],
+                                a[e.nodes[1] as usize],
+                                a[e.nodes[2] as usize],
+                            ]
+                        };
+                        let es = &mut st[k * stride..(k + 1) * stride];
+                        sl[k] = match element::triangle(&g(x), &g(v), &g(w), props, es, dt) {
+                            Ok(out) => Slot { out, fault: None },
+                            Err(f) => Slot {
+                                out: ElementOutput::default(),
+                                fault: Some(f),
+                            },
+                        };
+                        k += 1;
+                        continue;
+                    }
+                    let mut blk = Block {
+                        nodes: [e.nodes; LANES],
+                        slot: [k; LANES],
+                        active: 1,
+                    };
+                    while blk.active < LANES && k + blk.active < n {
+                        let f = &elems[first + k + blk.active];
+                        if f.tri || f.part != e.part {
+                            break;
+                        }
+                        blk.nodes[blk.active] = f.nodes;
+                        blk.slot[blk.active] = k + blk.active;
+                        blk.active += 1;
+                    }
+                    quad_block(&blk, x, v, w, props, st, stride, sl, dt, kernel);
+                    k += blk.active;
+                }
+                let mut cs = ChunkSum::default();
+                for (j, s) in sl.iter().enumerate() {
+                    cs.internal += s.out.internal;
+                    cs.hourglass += s.out.hourglass;
+                    if cs.problem.is_none() && (s.fault.is_some() || !(s.out.dt >= 0.0)) {
+                        cs.problem = Some(first + j);
+                    }
+                    if s.out.dt < cs.dt_min {
+                        cs.dt_min = s.out.dt;
+                        cs.arg = first + j;
+                    }
+                }
+                *sum = cs;
             });
     }
 
@@ -554,16 +628,17 @@ impl Simulation {
     fn next_dt(&self) -> Result<f64> {
         let mut min = f64::INFINITY;
         let mut arg = 0;
-        for (k, s) in self.slots.iter().enumerate() {
-            if let Some(f) = s.fault {
-                return Err(self.unstable(k, f.to_string()));
+        for c in &self.chunks {
+            if let Some(k) = c.problem {
+                let cause = match self.slots[k].fault {
+                    Some(f) => f.to_string(),
+                    None => "non-finite element time step".into(),
+                };
+                return Err(self.unstable(k, cause));
             }
-            if !(s.out.dt >= 0.0) {
-                return Err(self.unstable(k, "non-finite element time step".into()));
-            }
-            if s.out.dt < min {
-                min = s.out.dt;
-                arg = k;
+            if c.dt_min < min {
+                min = c.dt_min;
+                arg = c.arg;
             }
         }
         let dt = match self.control.fixed_dt {
@@ -618,14 +693,9 @@ impl Simulation {
         self.element_loop(dt);
         let dt_next = self.next_dt()?;
         let (mut die, mut dhg) = (0.0, 0.0);
-        for chunk in self.slots.chunks(ELEMENT_CHUNK) {
-            let (mut a, mut b) = (0.0, 0.0);
-            for s in chunk {
-                a += s.out.internal;
-                b += s.out.hourglass;
-            }
-            die += a;
-            dhg += b;
+        for c in &self.chunks {
+            die += c.internal;
+            dhg += c.hourglass;
         }
         self.energies.internal += die;
         self.energies.hourglass += dhg;

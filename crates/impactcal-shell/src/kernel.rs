@@ -1,0 +1,669 @@
+//! The Belytschko-Lin-Tsay quad evaluated on blocks of [`LANES`] elements at once.
+//!
+//! The arithmetic is that of [`crate::element`] (see its module docs for the equations),
+//! written on [`V`], a short vector of one value per element, so that the compiler can issue
+//! packed instructions across the elements of a block (structure of arrays). Every lane is
+//! computed independently with plain IEEE operations (no fused multiply-add), so an
+//! element's result does not depend on the block it sits in, the lane it occupies or the
+//! number of threads. Only the plastic return, needed by few points, runs lane by lane.
+
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
+
+use crate::element::{
+    ElementFault, ElementOutput, KernelOptions, PartProps, STATE_HEAD, STATE_PER_POINT,
+};
+use crate::model::HourglassForm;
+
+/// Elements per block.
+pub(crate) const LANES: usize = 4;
+
+/// One value per element of a block.
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(align(32))]
+pub(crate) struct V(pub [f64; LANES]);
+
+impl V {
+    #[inline(always)]
+    fn splat(a: f64) -> V {
+        V([a; LANES])
+    }
+
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> V {
+        V(self.0.map(f))
+    }
+
+    #[inline(always)]
+    fn zip(self, o: V, f: impl Fn(f64, f64) -> f64) -> V {
+        let mut r = [0.0; LANES];
+        for l in 0..LANES {
+            r[l] = f(self.0[l], o.0[l]);
+        }
+        V(r)
+    }
+
+    #[inline(always)]
+    fn sqrt(self) -> V {
+        self.map(f64::sqrt)
+    }
+
+    #[inline(always)]
+    fn max(self, o: V) -> V {
+        self.zip(o, |a, b| if a >= b { a } else { b })
+    }
+}
+
+macro_rules! binop {
+    ($tr:ident, $f:ident, $op:tt) => {
+        impl $tr for V {
+            type Output = V;
+            #[inline(always)]
+            fn $f(self, o: V) -> V {
+                self.zip(o, |a, b| a $op b)
+            }
+        }
+        impl $tr<f64> for V {
+            type Output = V;
+            #[inline(always)]
+            fn $f(self, o: f64) -> V {
+                self.map(|a| a $op o)
+            }
+        }
+        impl $tr<V> for f64 {
+            type Output = V;
+            #[inline(always)]
+            fn $f(self, o: V) -> V {
+                o.map(|b| self $op b)
+            }
+        }
+    };
+}
+binop!(Add, add, +);
+binop!(Sub, sub, -);
+binop!(Mul, mul, *);
+binop!(Div, div, /);
+
+impl Neg for V {
+    type Output = V;
+    #[inline(always)]
+    fn neg(self) -> V {
+        self.map(|a| -a)
+    }
+}
+
+impl AddAssign for V {
+    #[inline(always)]
+    fn add_assign(&mut self, o: V) {
+        *self = *self + o;
+    }
+}
+
+impl SubAssign for V {
+    #[inline(always)]
+    fn sub_assign(&mut self, o: V) {
+        *self = *self - o;
+    }
+}
+
+type V3 = [V; 3];
+
+#[inline(always)]
+fn sub3(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
+fn dot3(a: V3, b: V3) -> V {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn cross3(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// What one element of a block produced: its output, or the fault that stops the run.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Slot {
+    /// Forces, step and energy increments.
+    pub out: ElementOutput,
+    /// Set when the element could not be evaluated.
+    pub fault: Option<ElementFault>,
+}
+
+/// Where a block's data lives: the element node indices per lane, the lanes in use, and
+/// each lane's element position in `state` / `slots` (unused lanes repeat lane 0).
+pub(crate) struct Block {
+    pub nodes: [[u32; 4]; LANES],
+    pub slot: [usize; LANES],
+    pub active: usize,
+}
+
+/// Evaluates the quads of one block for a step `dt`: reads positions `x`, mid-step
+/// velocities `v` and angular velocities `w` at the nodes, updates the element states
+/// (`stride` values each in `state`, element `slot[l]` at `slot[l] * stride`) and writes
+/// the outputs to `slots[slot[l]]` for the active lanes.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn quad_block(
+    blk: &Block,
+    x: &[[f64; 3]],
+    v: &[[f64; 3]],
+    w: &[[f64; 3]],
+    props: &PartProps,
+    state: &mut [f64],
+    stride: usize,
+    slots: &mut [Slot],
+    dt: f64,
+    opts: KernelOptions,
+) {
+    // Gather.
+    let load = |a: &[[f64; 3]], node: usize| -> V3 {
+        let mut r = [V::default(); 3];
+        for l in 0..LANES {
+            let p = a[blk.nodes[l][node] as usize];
+            for k in 0..3 {
+                r[k].0[l] = p[k];
+            }
+        }
+        r
+    };
+    let xs = [load(x, 0), load(x, 1), load(x, 2), load(x, 3)];
+
+    // Frame.
+    let mut fault = [None; LANES];
+    let d31 = sub3(xs[2], xs[0]);
+    let d42 = sub3(xs[3], xs[1]);
+    let n3 = cross3(d31, d42);
+    let len3 = dot3(n3, n3).sqrt();
+    let mut a = [V::default(); 3];
+    for k in 0..3 {
+        a[k] = xs[1][k] - xs[0][k] + xs[2][k] - xs[3][k];
+    }
+    let inv3 = 1.0 / len3;
+    let e3 = [n3[0] * inv3, n3[1] * inv3, n3[2] * inv3];
+    let an = dot3(a, e3);
+    for k in 0..3 {
+        a[k] -= an * e3[k];
+    }
+    let len1 = dot3(a, a).sqrt();
+    let inv1 = 1.0 / len1;
+    let e1 = [a[0] * inv1, a[1] * inv1, a[2] * inv1];
+    let e2 = cross3(e3, e1);
+    for l in 0..LANES {
+        let ok = |n: f64| n > 0.0 && n.is_finite();
+        if !(ok(len3.0[l]) && ok(len1.0[l])) {
+            fault[l] = Some(ElementFault::Degenerate);
+        }
+    }
+
+    // Local coordinates from the centroid.
+    let mut c = [V::default(); 3];
+    for k in 0..3 {
+        c[k] = 0.25 * (xs[0][k] + xs[1][k] + xs[2][k] + xs[3][k]);
+    }
+    let mut r = [[V::default(); 3]; 4];
+    for i in 0..4 {
+        let d = sub3(xs[i], c);
+        r[i] = [dot3(e1, d), dot3(e2, d), dot3(e3, d)];
+    }
+    let (x1, x2, x3, x4) = (r[0][0], r[1][0], r[2][0], r[3][0]);
+    let (y1, y2, y3, y4) = (r[0][1], r[1][1], r[2][1], r[3][1]);
+    let area = 0.5 * ((x3 - x1) * (y4 - y2) + (x2 - x4) * (y3 - y1));
+    // Corner Jacobians in the element plane: all positive for a convex, non-inverted quad.
+    let corner: [V; 4] = std::array::from_fn(|i| {
+        let (p, n, q) = (r[(i + 3) % 4], r[(i + 1) % 4], r[i]);
+        (n[0] - q[0]) * (p[1] - q[1]) - (n[1] - q[1]) * (p[0] - q[0])
+    });
+    for l in 0..LANES {
+        if fault[l].is_none() {
+            if !(area.0[l].abs() > 0.0) {
+                fault[l] = Some(ElementFault::Degenerate);
+            } else if !corner.iter().all(|j| j.0[l] > 0.0) {
+                fault[l] = Some(ElementFault::Inverted);
+            }
+        }
+    }
+    let s = 0.5 / area;
+    let b1 = [s * (y2 - y4), s * (y3 - y1), s * (y4 - y2), s * (y1 - y3)];
+    let b2 = [s * (x4 - x2), s * (x1 - x3), s * (x2 - x4), s * (x3 - x1)];
+
+    // Local velocities and angular velocities.
+    let mut u = [[V::default(); 3]; 4];
+    let mut th = [[V::default(); 3]; 4];
+    for i in 0..4 {
+        let vi = load(v, i);
+        let wi = load(w, i);
+        u[i] = [dot3(e1, vi), dot3(e2, vi), dot3(e3, vi)];
+        th[i] = [dot3(e1, wi), dot3(e2, wi), dot3(e3, wi)];
+    }
+    let ginv = opts.projection.then(|| gram_inverse(&r));
+    if let Some(g) = &ginv {
+        project(&r, g, &mut u, &mut th);
+    }
+
+    // Rates.
+    let (mut dxx, mut dyy, mut gxy) = (V::default(), V::default(), V::default());
+    let (mut kxx, mut kyy, mut kxy) = (V::default(), V::default(), V::default());
+    let (mut gxz, mut gyz) = (V::default(), V::default());
+    let (mut thx, mut thy) = (V::default(), V::default());
+    for i in 0..4 {
+        let [vx, vy, vz] = u[i];
+        let [tx, ty, _] = th[i];
+        dxx += b1[i] * vx;
+        dyy += b2[i] * vy;
+        gxy += b2[i] * vx + b1[i] * vy;
+        kxx += b1[i] * ty;
+        kyy -= b2[i] * tx;
+        kxy += b2[i] * ty - b1[i] * tx;
+        gxz += b1[i] * vz;
+        gyz += b2[i] * vz;
+        thx += tx;
+        thy += ty;
+    }
+    gxz += thy * 0.25;
+    gyz -= thx * 0.25;
+
+    let mat = &props.mat;
+    let t = props.t;
+    let factor = if mat.rate.0 > 0.0 {
+        let m = dxx * dxx + dyy * dyy + dxx * dyy + 0.25 * gxy * gxy;
+        let b = kxx * kxx + kyy * kyy + kxx * kyy + 0.25 * kxy * kxy;
+        let eff = (4.0 / 3.0 * m + t * t / 9.0 * b).map(|q| q.max(0.0).sqrt());
+        eff.map(|q| mat.rate_factor(q))
+    } else {
+        V::splat(1.0)
+    };
+
+    // Through the thickness.
+    let base = blk.slot.map(|e| e * stride);
+    let (c11, c12, g) = (mat.c11, mat.nu * mat.c11, mat.g);
+    let plastic = mat.is_plastic();
+    let (mut nxx, mut nyy, mut nxy) = (V::default(), V::default(), V::default());
+    let (mut mxx, mut myy, mut mxy) = (V::default(), V::default(), V::default());
+    let mut work = V::default();
+    for (k, (&zk, &wk)) in props.z.iter().zip(&props.w).enumerate() {
+        let off = STATE_HEAD + STATE_PER_POINT * k;
+        let mut old = [V::default(); 4];
+        for l in 0..LANES {
+            let st = &state[base[l] + off..base[l] + off + STATE_PER_POINT];
+            for q in 0..4 {
+                old[q].0[l] = st[q];
+            }
+        }
+        let de0 = dt * (dxx + zk * kxx);
+        let de1 = dt * (dyy + zk * kyy);
+        let de2 = dt * (gxy + zk * kxy);
+        // Elastic predictor, as in `MaterialProps::update`.
+        let mut sx = old[0] + c11 * de0 + c12 * de1;
+        let mut sy = old[1] + c12 * de0 + c11 * de1;
+        let mut txy = old[2] + g * de2;
+        let mut p = old[3];
+        if plastic {
+            let ss = sx + sy;
+            let dd = sx - sy;
+            let vm2 = 0.25 * ss * ss + (0.75 * dd * dd + 3.0 * txy * txy);
+            let sy0 = (mat.yield0 + mat.hardening * p) * factor;
+            for l in 0..LANES {
+                if vm2.0[l] > sy0.0[l] * sy0.0[l] {
+                    let mut e = p.0[l];
+                    let sig = mat.plastic_return([sx.0[l], sy.0[l], txy.0[l]], &mut e, factor.0[l]);
+                    sx.0[l] = sig[0];
+                    sy.0[l] = sig[1];
+                    txy.0[l] = sig[2];
+                    p.0[l] = e;
+                }
+            }
+        }
+        for l in 0..blk.active {
+            let st = &mut state[base[l] + off..base[l] + off + STATE_PER_POINT];
+            st[0] = sx.0[l];
+            st[1] = sy.0[l];
+            st[2] = txy.0[l];
+            st[3] = p.0[l];
+        }
+        work += wk * ((old[0] + sx) * de0 + (old[1] + sy) * de1 + (old[2] + txy) * de2);
+        let wz = wk * zk;
+        nxx += wk * sx;
+        nyy += wk * sy;
+        nxy += wk * txy;
+        mxx += wz * sx;
+        myy += wz * sy;
+        mxy += wz * txy;
+    }
+    let mut internal = 0.5 * work * t * area;
+
+    // Transverse shear, elastic, as resultants; hourglass generalised forces.
+    let mut head = [V::default(); STATE_HEAD];
+    for l in 0..LANES {
+        let st = &state[base[l]..base[l] + STATE_HEAD];
+        for q in 0..STATE_HEAD {
+            head[q].0[l] = st[q];
+        }
+    }
+    let ks = props.shear_factor * g * t * dt;
+    let (qx0, qy0) = (head[0], head[1]);
+    let qx = qx0 + ks * gxz;
+    let qy = qy0 + ks * gyz;
+    internal += 0.5 * area * dt * ((qx0 + qx) * gxz + (qy0 + qy) * gyz);
+
+    let ta = t * area;
+    let (nxx, nyy, nxy) = (ta * nxx, ta * nyy, ta * nxy);
+    let (mxx, myy, mxy) = (ta * mxx, ta * myy, ta * mxy);
+    let (qxa, qya) = (area * qx * 0.25, area * qy * 0.25);
+    let mut f = [[V::default(); 6]; 4];
+    for i in 0..4 {
+        f[i] = [
+            b1[i] * nxx + b2[i] * nxy,
+            b2[i] * nyy + b1[i] * nxy,
+            area * (b1[i] * qx + b2[i] * qy),
+            -b2[i] * myy - b1[i] * mxy - qya,
+            b1[i] * mxx + b2[i] * mxy + qxa,
+            V::default(),
+        ];
+    }
+
+    // Hourglass (Flanagan-Belytschko vector), membrane x, y; out-of-plane w; rotation x, y.
+    let hx = x1 - x2 + x3 - x4;
+    let hy = y1 - y2 + y3 - y4;
+    const H: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
+    let gam: [V; 4] = std::array::from_fn(|i| H[i] - hx * b1[i] - hy * b2[i]);
+    let mut q = [V::default(); 5];
+    for i in 0..4 {
+        q[0] += gam[i] * u[i][0];
+        q[1] += gam[i] * u[i][1];
+        q[2] += gam[i] * u[i][2];
+        q[3] += gam[i] * th[i][0];
+        q[4] += gam[i] * th[i][1];
+    }
+    let [rm, rw, rb] = props.hg;
+    let mut cc = [V::default(); 5];
+    match props.hg_form {
+        HourglassForm::Stiffness => {
+            let mut bb = V::default();
+            for i in 0..4 {
+                bb += b1[i] * b1[i] + b2[i] * b2[i];
+            }
+            let t3 = t * t * t;
+            cc[0] = (rm * mat.e * t / 8.0) * area * bb;
+            cc[1] = cc[0];
+            cc[2] = (rw * props.shear_factor * g * t3 / 12.0) * bb;
+            cc[3] = (rb * mat.e * t3 / 192.0) * area * bb;
+            cc[4] = cc[3];
+        }
+        HourglassForm::Viscous => {
+            let base = 0.25 * mat.rho * mat.wave_speed * t * area.sqrt();
+            cc[0] = rm * base;
+            cc[1] = cc[0];
+            cc[2] = rw * base;
+            cc[3] = (rb * t * t / 12.0) * base;
+            cc[4] = cc[3];
+        }
+    }
+    let mut hourglass = V::default();
+    let mut hg = [V::default(); 5];
+    for k in 0..5 {
+        let old = head[2 + k];
+        hg[k] = match props.hg_form {
+            HourglassForm::Stiffness => old + cc[k] * dt * q[k],
+            HourglassForm::Viscous => cc[k] * q[k],
+        };
+        hourglass += match props.hg_form {
+            HourglassForm::Stiffness => 0.5 * (old + hg[k]) * dt * q[k],
+            HourglassForm::Viscous => hg[k] * dt * q[k],
+        };
+    }
+    for l in 0..blk.active {
+        let st = &mut state[base[l]..base[l] + STATE_HEAD];
+        st[0] = qx.0[l];
+        st[1] = qy.0[l];
+        for k in 0..5 {
+            st[2 + k] = hg[k].0[l];
+        }
+    }
+    for i in 0..4 {
+        for k in 0..5 {
+            f[i][k] += gam[i] * hg[k];
+        }
+    }
+    if let Some(gi) = &ginv {
+        let (mut ft, mut fm) = ([[V::default(); 3]; 4], [[V::default(); 3]; 4]);
+        for i in 0..4 {
+            ft[i] = [f[i][0], f[i][1], f[i][2]];
+            fm[i] = [f[i][3], f[i][4], f[i][5]];
+        }
+        project(&r, gi, &mut ft, &mut fm);
+        for i in 0..4 {
+            f[i] = [ft[i][0], ft[i][1], ft[i][2], fm[i][0], fm[i][1], fm[i][2]];
+        }
+    }
+
+    // Characteristic length: sqrt is monotonic, so the longest length is the root of the
+    // largest square.
+    let sq = |a: V3| dot3(a, a);
+    let diag2 = sq(d31).max(sq(d42));
+    let len2 = if opts.isdo_diagonal {
+        diag2
+    } else {
+        sq(sub3(xs[1], xs[0]))
+            .max(sq(sub3(xs[2], xs[1])))
+            .max(sq(sub3(xs[3], xs[2])))
+            .max(sq(sub3(xs[0], xs[3])))
+            .max(diag2)
+    };
+    let dt_e = area / len2.sqrt() / mat.wave_speed;
+
+    // Back to the global frame, into the slots.
+    let rot = [e1, e2, e3];
+    for l in 0..blk.active {
+        let slot = &mut slots[blk.slot[l]];
+        for i in 0..4 {
+            for k in 0..3 {
+                slot.out.f[i][k] = rot[0][k].0[l] * f[i][0].0[l]
+                    + rot[1][k].0[l] * f[i][1].0[l]
+                    + rot[2][k].0[l] * f[i][2].0[l];
+                slot.out.f[i][3 + k] = rot[0][k].0[l] * f[i][3].0[l]
+                    + rot[1][k].0[l] * f[i][4].0[l]
+                    + rot[2][k].0[l] * f[i][5].0[l];
+            }
+        }
+        slot.out.dt = dt_e.0[l];
+        slot.out.internal = internal.0[l];
+        slot.out.hourglass = hourglass.0[l];
+        slot.fault = fault[l];
+    }
+}
+
+/// Inverse of the rigid-rotation Gram matrix `G = sum_I (|r_I|^2 1 - r_I r_I^T) + 4 1`
+/// (symmetric; rows returned in full).
+#[inline(always)]
+fn gram_inverse(r: &[V3; 4]) -> [V3; 3] {
+    let (mut g00, mut g11, mut g22) = (V::splat(4.0), V::splat(4.0), V::splat(4.0));
+    let (mut g01, mut g02, mut g12) = (V::default(), V::default(), V::default());
+    for ri in r {
+        let (x2, y2, z2) = (ri[0] * ri[0], ri[1] * ri[1], ri[2] * ri[2]);
+        g00 += y2 + z2;
+        g11 += x2 + z2;
+        g22 += x2 + y2;
+        g01 -= ri[0] * ri[1];
+        g02 -= ri[0] * ri[2];
+        g12 -= ri[1] * ri[2];
+    }
+    let c00 = g11 * g22 - g12 * g12;
+    let c01 = g12 * g02 - g01 * g22;
+    let c02 = g01 * g12 - g11 * g02;
+    let c11 = g00 * g22 - g02 * g02;
+    let c12 = g02 * g01 - g00 * g12;
+    let c22 = g00 * g11 - g01 * g01;
+    let inv = 1.0 / (g00 * c00 + g01 * c01 + g02 * c02);
+    let (c00, c01, c02) = (c00 * inv, c01 * inv, c02 * inv);
+    let (c11, c12, c22) = (c11 * inv, c12 * inv, c22 * inv);
+    [[c00, c01, c02], [c01, c11, c12], [c02, c12, c22]]
+}
+
+/// Removes the rigid-body part of nodal (translation `t`, rotation `m`) vectors:
+/// `u <- (1 - T T^T / 4 - Rm G^-1 Rm^T) u` (see [`crate::element`]).
+#[inline(always)]
+fn project(r: &[V3; 4], ginv: &[V3; 3], t: &mut [V3; 4], m: &mut [V3; 4]) {
+    let mut tbar = [V::default(); 3];
+    let mut b = [V::default(); 3];
+    for i in 0..4 {
+        let c = cross3(r[i], t[i]);
+        for k in 0..3 {
+            tbar[k] += t[i][k];
+            b[k] += c[k] + m[i][k];
+        }
+    }
+    for k in 0..3 {
+        tbar[k] = 0.25 * tbar[k];
+    }
+    let w = [dot3(ginv[0], b), dot3(ginv[1], b), dot3(ginv[2], b)];
+    for i in 0..4 {
+        let wr = cross3(w, r[i]);
+        for k in 0..3 {
+            t[i][k] -= tbar[k] + wr[k];
+            m[i][k] -= w[k];
+        }
+    }
+}
+
+/// One quad on its own (all lanes of a block on the same element): the public
+/// [`crate::element::quad`] and build-time paths.
+pub(crate) fn quad_single(
+    x: &[[f64; 3]; 4],
+    v: &[[f64; 3]; 4],
+    omega: &[[f64; 3]; 4],
+    props: &PartProps,
+    state: &mut [f64],
+    dt: f64,
+    opts: KernelOptions,
+) -> Slot {
+    let nodes = [[0, 1, 2, 3]; LANES];
+    let blk = Block {
+        nodes,
+        slot: [0; LANES],
+        active: 1,
+    };
+    let mut slots = [Slot::default()];
+    let stride = state.len();
+    quad_block(
+        &blk, x, v, omega, props, state, stride, &mut slots, dt, opts,
+    );
+    slots[0]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::MaterialProps;
+    use crate::model::{Material, MaterialLaw};
+
+    fn props() -> PartProps {
+        let t = 0.002;
+        PartProps {
+            t,
+            z: vec![-0.45 * t, -0.25 * t, 0.0, 0.25 * t, 0.45 * t],
+            w: vec![0.1, 0.2, 0.4, 0.2, 0.1],
+            shear_factor: 5.0 / 6.0,
+            mat: MaterialProps::new(&Material {
+                id: 1,
+                density: 2700.0,
+                youngs: 70e9,
+                poisson: 0.3,
+                law: MaterialLaw::Plastic {
+                    yield_stress: 200e6,
+                    tangent_modulus: 1e9,
+                    rate: None,
+                },
+            }),
+            hg_form: HourglassForm::Stiffness,
+            hg: [0.05, 0.05, 0.05],
+        }
+    }
+
+    /// A pseudo-random number in [-1, 1) from an index (golden-ratio sequence).
+    fn h(i: usize) -> f64 {
+        2.0 * ((i as f64 * 0.618_033_988_749_895).fract() - 0.5)
+    }
+
+    /// Every lane of a block, full or partial, gives bit for bit the result of the same
+    /// element evaluated alone, plastic points included.
+    #[test]
+    fn a_block_lane_matches_the_element_alone() {
+        let props = props();
+        let stride = STATE_HEAD + STATE_PER_POINT * 5;
+        let ne = 7;
+        let mut x = Vec::new();
+        let mut v = Vec::new();
+        let mut w = Vec::new();
+        for e in 0..ne {
+            let corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+            for (c, p) in corners.iter().enumerate() {
+                let i = 4 * e + c;
+                x.push([
+                    0.01 * (p[0] + 0.1 * h(3 * i)),
+                    0.01 * (p[1] + 0.1 * h(3 * i + 1)),
+                    0.001 * h(3 * i + 2),
+                ]);
+                v.push([50.0 * h(7 * i), 50.0 * h(7 * i + 1), 80.0 * h(7 * i + 2)]);
+                w.push([3e3 * h(11 * i), 3e3 * h(11 * i + 1), 1e3 * h(11 * i + 2)]);
+            }
+        }
+        let mut state0 = vec![0.0; stride * ne];
+        for (i, s) in state0.iter_mut().enumerate() {
+            let j = i % stride;
+            let plastic_strain = j >= STATE_HEAD && (j - STATE_HEAD) % STATE_PER_POINT == 3;
+            *s = if plastic_strain {
+                0.0
+            } else {
+                2.5e8 * h(13 * i)
+            };
+        }
+        let opts = KernelOptions {
+            projection: true,
+            isdo_diagonal: false,
+        };
+        let dt = 2e-6;
+        // Blocks of 4 then 3 elements, in reverse lane order.
+        let mut state = state0.clone();
+        let mut slots = vec![Slot::default(); ne];
+        for (start, len) in [(0usize, 4usize), (4, 3)] {
+            let mut blk = Block {
+                nodes: [[0; 4]; LANES],
+                slot: [start + len - 1; LANES],
+                active: len,
+            };
+            for l in 0..len {
+                let e = start + len - 1 - l;
+                blk.nodes[l] = std::array::from_fn(|c| (4 * e + c) as u32);
+                blk.slot[l] = e;
+            }
+            for l in len..LANES {
+                blk.nodes[l] = blk.nodes[0];
+            }
+            quad_block(
+                &blk, &x, &v, &w, &props, &mut state, stride, &mut slots, dt, opts,
+            );
+        }
+        let mut yielded = 0;
+        for e in 0..ne {
+            let g = |a: &[[f64; 3]]| -> [[f64; 3]; 4] { std::array::from_fn(|c| a[4 * e + c]) };
+            let mut st = state0[e * stride..(e + 1) * stride].to_vec();
+            let alone = quad_single(&g(&x), &g(&v), &g(&w), &props, &mut st, dt, opts);
+            assert_eq!(alone.fault, None);
+            assert_eq!(alone.out, slots[e].out, "element {e}");
+            assert_eq!(st, &state[e * stride..(e + 1) * stride], "element {e}");
+            for k in 0..5 {
+                let off = e * stride + STATE_HEAD + STATE_PER_POINT * k + 3;
+                if state[off] > 0.0 {
+                    yielded += 1;
+                }
+            }
+        }
+        assert!(yielded > 0, "no point yielded");
+    }
+}

@@ -1,0 +1,61 @@
+//! Times whole explicit cycles of the shell solver on the benchmark plate
+//! (`benches/common/shell_plate.rs`, 21,000 elastic-plastic quads, 5 thickness points) and
+//! prints microseconds per element-cycle, plus a checksum of the final state so that runs on
+//! different thread counts can be compared bit for bit.
+//!
+//! `cargo run --release --example shell_timing -- THREADS CYCLES REPEATS`
+//! (after 20 warm-up cycles; prints the median over the repeats).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::time::Instant;
+
+use impactcal::shell::Simulation;
+
+#[path = "../benches/common/shell_plate.rs"]
+mod shell_plate;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let arg = |k: usize, d: usize| args.get(k).map_or(Ok(d), |s| s.parse::<usize>());
+    let threads = arg(1, 1)?;
+    let cycles = arg(2, 50)?;
+    let repeats = arg(3, 5)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
+    let m = shell_plate::plate();
+    let ne = m.shells.len();
+    let (times, checksum) = pool.install(|| -> Result<_, impactcal::shell::ShellError> {
+        let mut sim = Simulation::new(&m)?;
+        for _ in 0..20 {
+            sim.step()?;
+        }
+        let mut times = Vec::with_capacity(repeats);
+        for _ in 0..repeats.max(1) {
+            let start = Instant::now();
+            for _ in 0..cycles {
+                sim.step()?;
+            }
+            times.push(start.elapsed().as_secs_f64());
+        }
+        let mut h: u64 = 0;
+        for p in sim.positions().iter().chain(sim.velocities()) {
+            for c in p {
+                h = h.rotate_left(5) ^ c.to_bits();
+            }
+        }
+        let e = sim.energies();
+        h = h.rotate_left(5) ^ e.internal.to_bits() ^ e.kinetic.to_bits();
+        Ok((times, h))
+    })?;
+    let mut times = times;
+    times.sort_by(f64::total_cmp);
+    let med = times[times.len() / 2];
+    println!(
+        "shell_timing: {ne} shells, {threads} thread(s), {cycles} cycles x {}: median {:.3} ms/cycle, {:.4} us/element-cycle, checksum {checksum:016x}",
+        times.len(),
+        1e3 * med / cycles as f64,
+        1e6 * med / (cycles as f64 * ne as f64)
+    );
+    Ok(())
+}
