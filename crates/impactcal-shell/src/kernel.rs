@@ -15,11 +15,11 @@ use crate::element::{
 use crate::model::HourglassForm;
 
 /// Elements per block.
-pub(crate) const LANES: usize = 4;
+pub(crate) const LANES: usize = 2;
 
 /// One value per element of a block.
 #[derive(Debug, Clone, Copy, Default)]
-#[repr(align(32))]
+#[repr(align(16))]
 pub(crate) struct V(pub [f64; LANES]);
 
 impl V {
@@ -458,17 +458,18 @@ pub(crate) fn quad_block(
     let dt_e = area / len2.sqrt() / mat.wave_speed;
 
     // Back to the global frame, into the slots.
-    let rot = [e1, e2, e3];
+    let mut gf = [[V::default(); 6]; 4];
+    for i in 0..4 {
+        for k in 0..3 {
+            gf[i][k] = e1[k] * f[i][0] + e2[k] * f[i][1] + e3[k] * f[i][2];
+            gf[i][3 + k] = e1[k] * f[i][3] + e2[k] * f[i][4] + e3[k] * f[i][5];
+        }
+    }
     for l in 0..blk.active {
         let slot = &mut slots[blk.slot[l]];
         for i in 0..4 {
-            for k in 0..3 {
-                slot.out.f[i][k] = rot[0][k].0[l] * f[i][0].0[l]
-                    + rot[1][k].0[l] * f[i][1].0[l]
-                    + rot[2][k].0[l] * f[i][2].0[l];
-                slot.out.f[i][3 + k] = rot[0][k].0[l] * f[i][3].0[l]
-                    + rot[1][k].0[l] * f[i][4].0[l]
-                    + rot[2][k].0[l] * f[i][5].0[l];
+            for k in 0..6 {
+                slot.out.f[i][k] = gf[i][k].0[l];
             }
         }
         slot.out.dt = dt_e.0[l];
@@ -628,10 +629,22 @@ mod tests {
             isdo_diagonal: false,
         };
         let dt = 2e-6;
-        // Blocks of 4 then 3 elements, in reverse lane order.
+        // Full and partial blocks in turn, elements in reverse lane order.
+        let mut blocks = Vec::new();
+        let mut start = 0;
+        while start < ne {
+            let want = if blocks.len() % 2 == 0 {
+                LANES
+            } else {
+                LANES - 1
+            };
+            let len = want.max(1).min(ne - start);
+            blocks.push((start, len));
+            start += len;
+        }
         let mut state = state0.clone();
         let mut slots = vec![Slot::default(); ne];
-        for (start, len) in [(0usize, 4usize), (4, 3)] {
+        for (start, len) in blocks {
             let mut blk = Block {
                 nodes: [[0; 4]; LANES],
                 slot: [start + len - 1; LANES],

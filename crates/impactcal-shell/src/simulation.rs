@@ -181,6 +181,10 @@ pub struct Simulation {
     state: Vec<f64>,
     slots: Vec<Slot>,
     chunks: Vec<ChunkSum>,
+    /// `1 / m` per node, 0 where the node has no mass.
+    inv_mass: Vec<f64>,
+    /// `1 / I` per node, 0 where the node has no rotary inertia.
+    inv_inertia: Vec<f64>,
     csr_start: Vec<u32>,
     csr: Vec<u32>,
     x: Vec<[f64; 3]>,
@@ -289,6 +293,16 @@ impl Simulation {
             state: vec![0.0; stride * ne],
             slots: vec![Slot::default(); ne],
             chunks: vec![ChunkSum::default(); ne.div_ceil(ELEMENT_CHUNK)],
+            inv_mass: c
+                .mass
+                .iter()
+                .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
+                .collect(),
+            inv_inertia: c
+                .inertia
+                .iter()
+                .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
+                .collect(),
             csr_start: count,
             csr,
             x,
@@ -460,7 +474,7 @@ impl Simulation {
     fn gather(&mut self, t: f64) {
         let g = self.body_accel(t);
         let (slots, csr, start) = (&self.slots, &self.csr, &self.csr_start);
-        let (mass, inertia) = (&self.c.mass, &self.c.inertia);
+        let (inv_mass, inv_inertia) = (&self.inv_mass, &self.inv_inertia);
         let damping = self.damping;
         let v = &self.v;
         self.a
@@ -476,21 +490,17 @@ impl Simulation {
                         f[d] += s[d];
                     }
                 }
-                let m = mass[i];
-                if m > 0.0 {
+                let im = inv_mass[i];
+                if im > 0.0 {
                     for d in 0..3 {
-                        a[d] = -f[d] / m - damping * v[i][d];
+                        a[d] = -f[d] * im - damping * v[i][d];
                     }
                     a[2] += g;
                 } else {
                     *a = [0.0; 3];
                 }
-                let inr = inertia[i];
-                *al = if inr > 0.0 {
-                    [-f[3] / inr, -f[4] / inr, -f[5] / inr]
-                } else {
-                    [0.0; 3]
-                };
+                let ii = inv_inertia[i];
+                *al = [-f[3] * ii, -f[4] * ii, -f[5] * ii];
             });
     }
 
