@@ -1,60 +1,64 @@
-//! Shell solver: whole explicit cycles on a 21,000-shell elastic-plastic plate (5 thickness
-//! points), on 1 and 2 threads; divide the time per cycle by the element count for
-//! microseconds per element-cycle.
+//! Shell solver on a 21,000-shell elastic-plastic plate (5 thickness points,
+//! `benches/common/shell_plate.rs`): the element kernel alone (all quads evaluated for one
+//! step with the blocked kernel, one thread) and whole explicit cycles on 1 and 2 threads.
+//! Divide the time per iteration by the element count for microseconds per element-cycle.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use impactcal::shell::{
-    InitialVelocity, Material, MaterialLaw, Section, ShellModel, Simulation, VelocityTarget,
+use impactcal::shell::element::{
+    ElementOutput, KernelOptions, PartProps, STATE_HEAD, STATE_PER_POINT, quad_batch,
 };
+use impactcal::shell::{Hourglass, Simulation};
 
-const NX: u64 = 150;
-const NY: u64 = 140;
+#[path = "common/shell_plate.rs"]
+mod shell_plate;
 
-fn model() -> ShellModel {
-    let mut m = ShellModel::new("bench plate");
-    let h = 0.01;
-    for j in 0..=NY {
-        for i in 0..=NX {
-            let z = 0.002 * ((i as f64 * 0.3).sin() * (j as f64 * 0.2).cos());
-            m.add_node(1 + i + j * (NX + 1), [h * i as f64, h * j as f64, z]);
-        }
+/// The element kernel alone: every quad of the plate, one step of the cycle's size, on one
+/// thread (no gather, no time integration). The state carries over between iterations, so
+/// after the warm-up the strain keeps growing and most points are on the yield surface.
+fn kernel(c: &mut Criterion) {
+    let m = shell_plate::plate();
+    let n = m.shells.len();
+    let props = PartProps::new(&m.sections[0], &m.materials[0], &Hourglass::default());
+    let index = |id: u64| (id - 1) as u32;
+    let elems: Vec<[u32; 4]> = m.shells.iter().map(|s| s.nodes.map(index)).collect();
+    let x: Vec<[f64; 3]> = m.nodes.iter().map(|p| p.x).collect();
+    let v: Vec<[f64; 3]> = m
+        .initial_velocities
+        .iter()
+        .map(|iv| iv.translation)
+        .collect();
+    let w = vec![[0.0; 3]; x.len()];
+    let stride = STATE_HEAD + STATE_PER_POINT * props.z.len();
+    let mut state = vec![0.0; stride * n];
+    let mut out = vec![ElementOutput::default(); n];
+    let opts = KernelOptions {
+        projection: true,
+        isdo_diagonal: false,
+    };
+    let dt = Simulation::new(&m).unwrap().dt();
+    for _ in 0..20 {
+        quad_batch(
+            &elems, &x, &v, &w, &props, &mut state, stride, &mut out, dt, opts,
+        )
+        .unwrap();
     }
-    for j in 0..NY {
-        for i in 0..NX {
-            let n = 1 + i + j * (NX + 1);
-            m.add_shell(1 + i + j * NX, 1, [n, n + 1, n + NX + 2, n + NX + 1]);
-        }
-    }
-    m.add_part(1, 1, 1);
-    m.sections.push(Section::new(1, 0.0015));
-    m.materials.push(Material {
-        id: 1,
-        density: 2780.0,
-        youngs: 73.1e9,
-        poisson: 0.33,
-        law: MaterialLaw::Plastic {
-            yield_stress: 345e6,
-            tangent_modulus: 1e9,
-            rate: None,
-        },
+    let mut g = c.benchmark_group(format!("shell_element_kernel_{n}_quads"));
+    g.sample_size(20);
+    g.bench_function("1_thread", |b| {
+        b.iter(|| {
+            quad_batch(
+                &elems, &x, &v, &w, &props, &mut state, stride, &mut out, dt, opts,
+            )
+            .unwrap()
+        })
     });
-    // A velocity field that bends and stretches the plate, so points yield.
-    for p in m.nodes.clone() {
-        let v = [
-            20.0 * (p.x[1] * 7.0).sin(),
-            0.0,
-            -30.0 * (p.x[0] * 5.0).sin(),
-        ];
-        m.initial_velocities
-            .push(InitialVelocity::translation(VelocityTarget::Node(p.id), v));
-    }
-    m.control.end_time = 1.0;
-    m
+    g.finish();
 }
 
+/// Whole cycles (element loop, gather, walls and constraints, velocity update, energies).
 fn cycles(c: &mut Criterion) {
-    let m = model();
+    let m = shell_plate::plate();
     let n = m.shells.len();
     assert!(n >= 20_000);
     let mut g = c.benchmark_group(format!("shell_cycle_{n}_shells"));
@@ -79,5 +83,5 @@ fn cycles(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, cycles);
+criterion_group!(benches, kernel, cycles);
 criterion_main!(benches);

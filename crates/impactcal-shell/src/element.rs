@@ -37,9 +37,9 @@
 //!
 //! The returned forces are internal forces: the nodal equation is `m a = f_ext - f_int`.
 
-use crate::geometry::{cross, dot, norm, sub};
+use crate::geometry::{cross, dot, norm, sub, thickness_rule};
 use crate::material::MaterialProps;
-use crate::model::HourglassForm;
+use crate::model::{Hourglass, HourglassForm, Material, Section, ThicknessRule};
 
 /// Number of state values ahead of the thickness points: transverse shear resultants
 /// `Q_x, Q_y`, then the five hourglass generalised forces (membrane x, y, out-of-plane w,
@@ -65,6 +65,24 @@ pub struct PartProps {
     pub hg_form: HourglassForm,
     /// Hourglass coefficients (membrane, out-of-plane, rotation).
     pub hg: [f64; 3],
+}
+
+impl PartProps {
+    /// Prepares the constants of a part from its section, material and the hourglass
+    /// control (the values are assumed validated, as [`crate::Simulation::new`] does:
+    /// positive thickness, 1 to 10 points, Lobatto with at least 2).
+    pub fn new(section: &Section, material: &Material, hourglass: &Hourglass) -> Self {
+        let (zeta, w) = thickness_rule(section.nip, section.rule == ThicknessRule::Lobatto);
+        PartProps {
+            t: section.thickness,
+            z: zeta.iter().map(|z| 0.5 * z * section.thickness).collect(),
+            w,
+            shear_factor: section.shear_factor,
+            mat: MaterialProps::new(material),
+            hg_form: hourglass.form,
+            hg: [hourglass.membrane, hourglass.transverse, hourglass.rotation],
+        }
+    }
 }
 
 /// What one element returns for one cycle.
@@ -214,10 +232,52 @@ pub fn quad(
     dt: f64,
     opts: KernelOptions,
 ) -> Result<ElementOutput, ElementFault> {
-    let slot = crate::kernel::quad_single(x, v, omega, props, state, dt, opts);
-    match slot.fault {
-        Some(f) => Err(f),
-        None => Ok(slot.out),
+    crate::kernel::quad_single(x, v, omega, props, state, dt, opts)
+}
+
+/// Evaluates many quads of one part for one cycle, as [`quad`] does one by one, with the
+/// blocked kernel of the solver (several elements per instruction): element `e` has the
+/// node indices `elems[e]` into the nodal arrays `x`, `v` (mid-step velocities) and
+/// `omega` (mid-step angular velocities), its state at `state[e * stride..][..stride]`
+/// (`stride >= STATE_HEAD + STATE_PER_POINT * nip`) and its output in `out[e]`.
+///
+/// # Errors
+/// The index and the fault of the first degenerate or inverted element; the outputs and
+/// states of the others are written all the same.
+///
+/// # Panics
+/// When a node index is out of range of the nodal arrays, or `state` / `out` hold fewer
+/// than `elems.len()` elements.
+#[allow(clippy::too_many_arguments)]
+pub fn quad_batch(
+    elems: &[[u32; 4]],
+    x: &[[f64; 3]],
+    v: &[[f64; 3]],
+    omega: &[[f64; 3]],
+    props: &PartProps,
+    state: &mut [f64],
+    stride: usize,
+    out: &mut [ElementOutput],
+    dt: f64,
+    opts: KernelOptions,
+) -> Result<(), (usize, ElementFault)> {
+    let mut faults = vec![None; elems.len()];
+    crate::kernel::quad_run(
+        elems,
+        x,
+        v,
+        omega,
+        props,
+        state,
+        stride,
+        out,
+        &mut faults,
+        dt,
+        opts,
+    );
+    match faults.iter().position(Option::is_some) {
+        Some(e) => Err((e, faults[e].unwrap_or(ElementFault::Degenerate))),
+        None => Ok(()),
     }
 }
 

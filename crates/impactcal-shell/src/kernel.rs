@@ -126,17 +126,8 @@ fn cross3(a: V3, b: V3) -> V3 {
     ]
 }
 
-/// What one element of a block produced: its output, or the fault that stops the run.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Slot {
-    /// Forces, step and energy increments.
-    pub out: ElementOutput,
-    /// Set when the element could not be evaluated.
-    pub fault: Option<ElementFault>,
-}
-
 /// Where a block's data lives: the element node indices per lane, the lanes in use, and
-/// each lane's element position in `state` / `slots` (unused lanes repeat lane 0).
+/// each lane's element position in `state` / `out` (unused lanes repeat lane 0).
 pub(crate) struct Block {
     pub nodes: [[u32; 4]; LANES],
     pub slot: [usize; LANES],
@@ -146,7 +137,7 @@ pub(crate) struct Block {
 /// Evaluates the quads of one block for a step `dt`: reads positions `x`, mid-step
 /// velocities `v` and angular velocities `w` at the nodes, updates the element states
 /// (`stride` values each in `state`, element `slot[l]` at `slot[l] * stride`) and writes
-/// the outputs to `slots[slot[l]]` for the active lanes.
+/// the outputs to `out[slot[l]]` and `fault[slot[l]]` for the active lanes.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub(crate) fn quad_block(
@@ -157,7 +148,8 @@ pub(crate) fn quad_block(
     props: &PartProps,
     state: &mut [f64],
     stride: usize,
-    slots: &mut [Slot],
+    out: &mut [ElementOutput],
+    faults: &mut [Option<ElementFault>],
     dt: f64,
     opts: KernelOptions,
 ) {
@@ -466,16 +458,16 @@ pub(crate) fn quad_block(
         }
     }
     for l in 0..blk.active {
-        let slot = &mut slots[blk.slot[l]];
+        let o = &mut out[blk.slot[l]];
         for i in 0..4 {
             for k in 0..6 {
-                slot.out.f[i][k] = gf[i][k].0[l];
+                o.f[i][k] = gf[i][k].0[l];
             }
         }
-        slot.out.dt = dt_e.0[l];
-        slot.out.internal = internal.0[l];
-        slot.out.hourglass = hourglass.0[l];
-        slot.fault = fault[l];
+        o.dt = dt_e.0[l];
+        o.internal = internal.0[l];
+        o.hourglass = hourglass.0[l];
+        faults[blk.slot[l]] = fault[l];
     }
 }
 
@@ -533,7 +525,7 @@ fn project(r: &[V3; 4], ginv: &[V3; 3], t: &mut [V3; 4], m: &mut [V3; 4]) {
 }
 
 /// One quad on its own (all lanes of a block on the same element): the public
-/// [`crate::element::quad`] and build-time paths.
+/// [`crate::element::quad`] path.
 pub(crate) fn quad_single(
     x: &[[f64; 3]; 4],
     v: &[[f64; 3]; 4],
@@ -542,19 +534,53 @@ pub(crate) fn quad_single(
     state: &mut [f64],
     dt: f64,
     opts: KernelOptions,
-) -> Slot {
-    let nodes = [[0, 1, 2, 3]; LANES];
+) -> Result<ElementOutput, ElementFault> {
     let blk = Block {
-        nodes,
+        nodes: [[0, 1, 2, 3]; LANES],
         slot: [0; LANES],
         active: 1,
     };
-    let mut slots = [Slot::default()];
+    let mut out = [ElementOutput::default()];
+    let mut fault = [None];
     let stride = state.len();
     quad_block(
-        &blk, x, v, omega, props, state, stride, &mut slots, dt, opts,
+        &blk, x, v, omega, props, state, stride, &mut out, &mut fault, dt, opts,
     );
-    slots[0]
+    match fault[0] {
+        Some(f) => Err(f),
+        None => Ok(out[0]),
+    }
+}
+
+/// Quads of one part in element order, in blocks of [`LANES`] (the batch path of
+/// [`crate::element::quad_batch`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn quad_run(
+    elems: &[[u32; 4]],
+    x: &[[f64; 3]],
+    v: &[[f64; 3]],
+    w: &[[f64; 3]],
+    props: &PartProps,
+    state: &mut [f64],
+    stride: usize,
+    out: &mut [ElementOutput],
+    faults: &mut [Option<ElementFault>],
+    dt: f64,
+    opts: KernelOptions,
+) {
+    for (b, chunk) in elems.chunks(LANES).enumerate() {
+        let first = b * LANES;
+        let mut blk = Block {
+            nodes: [chunk[0]; LANES],
+            slot: [first; LANES],
+            active: chunk.len(),
+        };
+        for (l, e) in chunk.iter().enumerate() {
+            blk.nodes[l] = *e;
+            blk.slot[l] = first + l;
+        }
+        quad_block(&blk, x, v, w, props, state, stride, out, faults, dt, opts);
+    }
 }
 
 #[cfg(test)]
@@ -643,7 +669,8 @@ mod tests {
             start += len;
         }
         let mut state = state0.clone();
-        let mut slots = vec![Slot::default(); ne];
+        let mut out = vec![ElementOutput::default(); ne];
+        let mut faults = vec![None; ne];
         for (start, len) in blocks {
             let mut blk = Block {
                 nodes: [[0; 4]; LANES],
@@ -659,7 +686,17 @@ mod tests {
                 blk.nodes[l] = blk.nodes[0];
             }
             quad_block(
-                &blk, &x, &v, &w, &props, &mut state, stride, &mut slots, dt, opts,
+                &blk,
+                &x,
+                &v,
+                &w,
+                &props,
+                &mut state,
+                stride,
+                &mut out,
+                &mut faults,
+                dt,
+                opts,
             );
         }
         let mut yielded = 0;
@@ -667,8 +704,8 @@ mod tests {
             let g = |a: &[[f64; 3]]| -> [[f64; 3]; 4] { std::array::from_fn(|c| a[4 * e + c]) };
             let mut st = state0[e * stride..(e + 1) * stride].to_vec();
             let alone = quad_single(&g(&x), &g(&v), &g(&w), &props, &mut st, dt, opts);
-            assert_eq!(alone.fault, None);
-            assert_eq!(alone.out, slots[e].out, "element {e}");
+            assert_eq!(faults[e], None);
+            assert_eq!(alone.unwrap(), out[e], "element {e}");
             assert_eq!(st, &state[e * stride..(e + 1) * stride], "element {e}");
             for k in 0..5 {
                 let off = e * stride + STATE_HEAD + STATE_PER_POINT * k + 3;

@@ -4,8 +4,7 @@ use std::collections::HashMap;
 
 use crate::element::{self, ElementFault, PartProps};
 use crate::error::{Result, ShellError};
-use crate::geometry::{dot, norm, sub, thickness_rule};
-use crate::material::MaterialProps;
+use crate::geometry::{dot, norm, sub};
 use crate::model::{
     MaterialLaw, NodeTarget, ShellModel, ThicknessRule, VelocityTarget, WallMethod,
 };
@@ -176,16 +175,7 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         let by = format!("part {}", p.id);
         let sec = &model.sections[lookup(&sec_map, p.section, "section", &by)?];
         let mat = &model.materials[lookup(&mat_map, p.material, "material", &by)?];
-        let (zeta, w) = thickness_rule(sec.nip, sec.rule == ThicknessRule::Lobatto);
-        parts.push(PartProps {
-            t: sec.thickness,
-            z: zeta.iter().map(|z| 0.5 * z * sec.thickness).collect(),
-            w,
-            shear_factor: sec.shear_factor,
-            mat: MaterialProps::new(mat),
-            hg_form: hg.form,
-            hg: [hg.membrane, hg.transverse, hg.rotation],
-        });
+        parts.push(PartProps::new(sec, mat, hg));
     }
 
     // Elements, masses, inertias.

@@ -6,7 +6,7 @@
 //! 1. `x^{n+1} = x^n + dt^{n+1/2} v^{n+1/2}`, `t^{n+1} = t^n + dt^{n+1/2}`.
 //! 2. Element loop (rayon, one force slot per element) on `x^{n+1}` with the mid-step
 //!    velocities: stresses, internal forces, element steps, energy increments.
-//! 3. Gather of the slots at each node in a fixed order (node-to-element lists sorted by
+//! 3. Gather of the element outputs at each node in a fixed order (node-to-element lists sorted by
 //!    element), so results are bit-identical for any thread count.
 //! 4. `a = (f_ext - f_int) / m - D v^{n+1/2}`, `alpha = -m_int / I`.
 //! 5. Next step `dt^{n+3/2} = TSSFAC min_e dt_e` and the velocity step
@@ -21,10 +21,12 @@
 use impactcal_core::Histories;
 use rayon::prelude::*;
 
-use crate::element::{self, ElementOutput, KernelOptions, STATE_HEAD, STATE_PER_POINT};
+use crate::element::{
+    self, ElementFault, ElementOutput, KernelOptions, STATE_HEAD, STATE_PER_POINT,
+};
 use crate::error::{Result, ShellError};
 use crate::geometry::{dot, sub};
-use crate::kernel::{Block, LANES, Slot, quad_block};
+use crate::kernel::{Block, LANES, quad_block};
 use crate::model::{Curve, ShellModel, WallMethod};
 use crate::setup::{Compiled, Elem, compile};
 
@@ -179,7 +181,10 @@ pub struct Simulation {
     interval: f64,
     stride: usize,
     state: Vec<f64>,
-    slots: Vec<Slot>,
+    /// Per-element outputs of the last element pass (forces, step, energies).
+    out: Vec<ElementOutput>,
+    /// Per-element faults of the last element pass.
+    faults: Vec<Option<ElementFault>>,
     chunks: Vec<ChunkSum>,
     /// `1 / m` per node, 0 where the node has no mass.
     inv_mass: Vec<f64>,
@@ -291,7 +296,8 @@ impl Simulation {
             interval,
             stride,
             state: vec![0.0; stride * ne],
-            slots: vec![Slot::default(); ne],
+            out: vec![ElementOutput::default(); ne],
+            faults: vec![None; ne],
             chunks: vec![ChunkSum::default(); ne.div_ceil(ELEMENT_CHUNK)],
             inv_mass: c
                 .mass
@@ -398,7 +404,7 @@ impl Simulation {
     }
 
     /// Runs the element loop for a step `dt` on the current positions and mid-step
-    /// velocities: fills the slots and the chunk reductions. Each fixed chunk of
+    /// velocities: fills the element outputs and the chunk reductions. Each fixed chunk of
     /// `ELEMENT_CHUNK` elements is one task; inside it, runs of up to `LANES` consecutive
     /// quads of one part go through the blocked kernel, triangles one by one.
     fn element_loop(&mut self, dt: f64) {
@@ -408,12 +414,13 @@ impl Simulation {
         let stride = self.stride;
         self.state
             .par_chunks_mut(stride * ELEMENT_CHUNK)
-            .zip(self.slots.par_chunks_mut(ELEMENT_CHUNK))
+            .zip(self.out.par_chunks_mut(ELEMENT_CHUNK))
+            .zip(self.faults.par_chunks_mut(ELEMENT_CHUNK))
             .zip(self.chunks.par_iter_mut())
             .enumerate()
-            .for_each(|(ci, ((st, sl), sum))| {
+            .for_each(|(ci, (((st, out), faults), sum))| {
                 let first = ci * ELEMENT_CHUNK;
-                let n = sl.len();
+                let n = out.len();
                 let mut k = 0;
                 while k < n {
                     let e = &elems[first + k];
@@ -427,13 +434,11 @@ impl Simulation {
                             ]
                         };
                         let es = &mut st[k * stride..(k + 1) * stride];
-                        sl[k] = match element::triangle(&g(x), &g(v), &g(w), props, es, dt) {
-                            Ok(out) => Slot { out, fault: None },
-                            Err(f) => Slot {
-                                out: ElementOutput::default(),
-                                fault: Some(f),
-                            },
-                        };
+                        (out[k], faults[k]) =
+                            match element::triangle(&g(x), &g(v), &g(w), props, es, dt) {
+                                Ok(o) => (o, None),
+                                Err(f) => (ElementOutput::default(), Some(f)),
+                            };
                         k += 1;
                         continue;
                     }
@@ -451,18 +456,18 @@ impl Simulation {
                         blk.slot[blk.active] = k + blk.active;
                         blk.active += 1;
                     }
-                    quad_block(&blk, x, v, w, props, st, stride, sl, dt, kernel);
+                    quad_block(&blk, x, v, w, props, st, stride, out, faults, dt, kernel);
                     k += blk.active;
                 }
                 let mut cs = ChunkSum::default();
-                for (j, s) in sl.iter().enumerate() {
-                    cs.internal += s.out.internal;
-                    cs.hourglass += s.out.hourglass;
-                    if cs.problem.is_none() && (s.fault.is_some() || !(s.out.dt >= 0.0)) {
+                for (j, (o, f)) in out.iter().zip(faults.iter()).enumerate() {
+                    cs.internal += o.internal;
+                    cs.hourglass += o.hourglass;
+                    if cs.problem.is_none() && (f.is_some() || !(o.dt >= 0.0)) {
                         cs.problem = Some(first + j);
                     }
-                    if s.out.dt < cs.dt_min {
-                        cs.dt_min = s.out.dt;
+                    if o.dt < cs.dt_min {
+                        cs.dt_min = o.dt;
                         cs.arg = first + j;
                     }
                 }
@@ -473,7 +478,7 @@ impl Simulation {
     /// Gathers slot forces into accelerations (before walls and constraints).
     fn gather(&mut self, t: f64) {
         let g = self.body_accel(t);
-        let (slots, csr, start) = (&self.slots, &self.csr, &self.csr_start);
+        let (out, csr, start) = (&self.out, &self.csr, &self.csr_start);
         let (inv_mass, inv_inertia) = (&self.inv_mass, &self.inv_inertia);
         let damping = self.damping;
         let v = &self.v;
@@ -485,7 +490,7 @@ impl Simulation {
             .for_each(|(i, (a, al))| {
                 let mut f = [0.0; 6];
                 for &k in &csr[start[i] as usize..start[i + 1] as usize] {
-                    let s = &slots[k as usize / 4].out.f[k as usize % 4];
+                    let s = &out[k as usize / 4].f[k as usize % 4];
                     for d in 0..6 {
                         f[d] += s[d];
                     }
@@ -633,14 +638,14 @@ impl Simulation {
         Ok(())
     }
 
-    /// The next stable step from the slots (`TSSFAC min dt_e`, or the fixed step), checking
+    /// The next stable step from the element outputs (`TSSFAC min dt_e`, or the fixed step), checking
     /// for faults.
     fn next_dt(&self) -> Result<f64> {
         let mut min = f64::INFINITY;
         let mut arg = 0;
         for c in &self.chunks {
             if let Some(k) = c.problem {
-                let cause = match self.slots[k].fault {
+                let cause = match self.faults[k] {
                     Some(f) => f.to_string(),
                     None => "non-finite element time step".into(),
                 };
@@ -724,10 +729,10 @@ impl Simulation {
         let total = e.total();
         if !(total.is_finite() && die.is_finite() && dhg.is_finite()) {
             let k = self
-                .slots
+                .out
                 .iter()
-                .position(|s| {
-                    s.out.f.iter().flatten().any(|f| !f.is_finite()) || !s.out.internal.is_finite()
+                .position(|o| {
+                    o.f.iter().flatten().any(|f| !f.is_finite()) || !o.internal.is_finite()
                 })
                 .unwrap_or(0);
             return Err(self.unstable(k, "non-finite force or energy".into()));
@@ -743,12 +748,12 @@ impl Simulation {
         let reference = e.initial + e.external_work;
         if reference > 0.0 && total > self.control.energy_ratio_bound * reference {
             let k = self
-                .slots
+                .out
                 .iter()
                 .enumerate()
                 .max_by(|a, b| {
-                    let ea = (a.1.out.internal + a.1.out.hourglass).abs();
-                    let eb = (b.1.out.internal + b.1.out.hourglass).abs();
+                    let ea = (a.1.internal + a.1.hourglass).abs();
+                    let eb = (b.1.internal + b.1.hourglass).abs();
                     ea.total_cmp(&eb)
                 })
                 .map_or(0, |(k, _)| k);
@@ -963,7 +968,7 @@ impl Simulation {
             let mut f = vec![[0.0; 6]; nn];
             for e in &self.c.elems {
                 let mut st = vec![0.0; self.stride];
-                let slot = eval_element(
+                let out = eval_element(
                     e,
                     &self.c.x0,
                     &vel,
@@ -975,7 +980,7 @@ impl Simulation {
                 );
                 for (s, &n) in e.nodes[..if e.tri { 3 } else { 4 }].iter().enumerate() {
                     for d in 0..6 {
-                        f[n as usize][d] += slot.out.f[s][d];
+                        f[n as usize][d] += out.f[s][d];
                     }
                 }
             }
@@ -1018,7 +1023,7 @@ fn eval_element(
     st: &mut [f64],
     dt: f64,
     kernel: KernelOptions,
-) -> Slot {
+) -> ElementOutput {
     let n = e.nodes.map(|i| i as usize);
     let res = if e.tri {
         let g = |a: &[[f64; 3]]| [a[n[0]], a[n[1]], a[n[2]]];
@@ -1027,13 +1032,7 @@ fn eval_element(
         let g = |a: &[[f64; 3]]| [a[n[0]], a[n[1]], a[n[2]], a[n[3]]];
         element::quad(&g(x), &g(v), &g(w), props, st, dt, kernel)
     };
-    match res {
-        Ok(out) => Slot { out, fault: None },
-        Err(f) => Slot {
-            out: ElementOutput::default(),
-            fault: Some(f),
-        },
-    }
+    res.unwrap_or_default()
 }
 
 /// `sum_i f(a_i, b_i)` in fixed chunks, so the rounding does not depend on threads.
