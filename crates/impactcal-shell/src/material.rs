@@ -12,7 +12,8 @@
 //! `s = s*/(1 + E dp/(2 s_y (1-nu)))`, `d = d*/(1 + 3 E dp/(2 s_y (1+nu)))` and the same
 //! factor as `d` on `s_xy`, and `dp` is the root of
 //! `F(dp) = s*^2/4 P^2 + (3 d*^2/4 + 3 s_xy*^2) Q^2 - s_y(p + dp)^2 = 0`
-//! found by safeguarded Newton iteration to a relative tolerance of 1e-12.
+//! found by Newton iteration from the radial-return estimate `(s_vm* - s_y) / (3 G + H)`,
+//! safeguarded by bisection, to a relative tolerance of 1e-12 on `F`.
 
 use crate::model::{Material, MaterialLaw};
 
@@ -116,32 +117,27 @@ impl MaterialProps {
         if vm2 <= sy0 * sy0 {
             return trial;
         }
-        let (e, nu) = (self.e, self.nu);
+        let (e, c1, c3) = (self.e, 1.0 / (1.0 - self.nu), 3.0 / (1.0 + self.nu));
         let f_of = |dp: f64| {
             let syn = sy0 + hf * dp;
-            let dr = e * dp / (2.0 * syn);
-            let p = 1.0 / (1.0 + dr / (1.0 - nu));
-            let q = 1.0 / (1.0 + 3.0 * dr / (1.0 + nu));
-            let f = a * p * p + b * q * q - syn * syn;
-            let df = -(a * p * p * p / (1.0 - nu) + 3.0 * b * q * q * q / (1.0 + nu))
-                * (e - 2.0 * dr * hf)
-                / syn
-                - 2.0 * hf * syn;
+            let inv_syn = 1.0 / syn;
+            let dr = 0.5 * e * dp * inv_syn;
+            let p = 1.0 / (1.0 + c1 * dr);
+            let q = 1.0 / (1.0 + c3 * dr);
+            let (ap2, bq2) = (a * p * p, b * q * q);
+            let f = ap2 + bq2 - syn * syn;
+            let df =
+                -(c1 * ap2 * p + c3 * bq2 * q) * (e - 2.0 * dr * hf) * inv_syn - 2.0 * hf * syn;
             (f, df, p, q)
         };
-        // Bracket: F(0) > 0; find hi with F(hi) < 0.
-        let mut lo = 0.0;
-        let mut hi = (vm2.sqrt() - sy0) / (3.0 * self.g + hf);
-        let mut guard = 0;
-        while f_of(hi).0 > 0.0 && guard < 200 {
-            lo = hi;
-            hi *= 2.0;
-            guard += 1;
-        }
-        let mut dp = 0.5 * (lo + hi);
+        // Safeguarded Newton from the radial-return estimate (exact in pure shear); F(0) > 0
+        // and F decreases, so every evaluation narrows the bracket [lo, hi] of the root.
         let tol = 1e-12 * sy0 * sy0;
-        for _ in 0..60 {
-            let (f, df, _, _) = f_of(dp);
+        let (mut lo, mut hi) = (0.0, f64::INFINITY);
+        let mut dp = (vm2.sqrt() - sy0) / (3.0 * self.g + hf);
+        let mut fv = f_of(dp);
+        for _ in 0..100 {
+            let (f, df, _, _) = fv;
             if f.abs() <= tol {
                 break;
             }
@@ -153,11 +149,14 @@ impl MaterialProps {
             let next = dp - f / df;
             dp = if next > lo && next < hi {
                 next
-            } else {
+            } else if hi.is_finite() {
                 0.5 * (lo + hi)
+            } else {
+                (2.0 * dp).max(f64::MIN_POSITIVE)
             };
+            fv = f_of(dp);
         }
-        let (_, _, p, q) = f_of(dp);
+        let (_, _, p, q) = fv;
         let s = p * s;
         let d = q * d;
         *epsp += dp;
