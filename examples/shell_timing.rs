@@ -25,37 +25,43 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .build()?;
     let m = shell_plate::plate();
     let ne = m.shells.len();
-    let (times, checksum) = pool.install(|| -> Result<_, impactcal::shell::ShellError> {
-        let mut sim = Simulation::new(&m)?;
-        for _ in 0..20 {
-            sim.step()?;
-        }
-        let mut times = Vec::with_capacity(repeats);
-        for _ in 0..repeats.max(1) {
-            let start = Instant::now();
-            for _ in 0..cycles {
+    let (times, checksum, yielded) =
+        pool.install(|| -> Result<_, impactcal::shell::ShellError> {
+            let mut sim = Simulation::new(&m)?;
+            for _ in 0..20 {
                 sim.step()?;
             }
-            times.push(start.elapsed().as_secs_f64());
-        }
-        let mut h: u64 = 0;
-        for p in sim.positions().iter().chain(sim.velocities()) {
-            for c in p {
-                h = h.rotate_left(5) ^ c.to_bits();
+            let mut times = Vec::with_capacity(repeats);
+            for _ in 0..repeats.max(1) {
+                let start = Instant::now();
+                for _ in 0..cycles {
+                    sim.step()?;
+                }
+                times.push(start.elapsed().as_secs_f64());
             }
-        }
-        let e = sim.energies();
-        h = h.rotate_left(5) ^ e.internal.to_bits() ^ e.kinetic.to_bits();
-        Ok((times, h))
-    })?;
+            let mut h: u64 = 0;
+            for p in sim.positions().iter().chain(sim.velocities()) {
+                for c in p {
+                    h = h.rotate_left(5) ^ c.to_bits();
+                }
+            }
+            let e = sim.energies();
+            h = h.rotate_left(5) ^ e.internal.to_bits() ^ e.kinetic.to_bits();
+            let yielded = (0..ne)
+                .flat_map(|k| (0..5).map(move |p| (k, p)))
+                .filter(|&(k, p)| sim.point_state(k, p).is_some_and(|s| s[3] > 0.0))
+                .count();
+            Ok((times, h, yielded as f64 / (5 * ne) as f64))
+        })?;
     let mut times = times;
     times.sort_by(f64::total_cmp);
     let med = times[times.len() / 2];
     println!(
-        "shell_timing: {ne} shells, {threads} thread(s), {cycles} cycles x {}: median {:.3} ms/cycle, {:.4} us/element-cycle, checksum {checksum:016x}",
+        "shell_timing: {ne} shells, {threads} thread(s), {cycles} cycles x {}: median {:.3} ms/cycle, {:.4} us/element-cycle, {:.0} % of the points have yielded, checksum {checksum:016x}",
         times.len(),
         1e3 * med / cycles as f64,
-        1e6 * med / (cycles as f64 * ne as f64)
+        1e6 * med / (cycles as f64 * ne as f64),
+        100.0 * yielded
     );
     Ok(())
 }

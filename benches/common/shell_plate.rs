@@ -44,9 +44,9 @@ pub fn plate() -> ShellModel {
     // A velocity field that bends and stretches the plate, so points yield.
     for p in m.nodes.clone() {
         let v = [
-            20.0 * (p.x[1] * 7.0).sin(),
+            80.0 * (p.x[1] * 7.0).sin(),
             0.0,
-            -30.0 * (p.x[0] * 5.0).sin(),
+            -120.0 * (p.x[0] * 5.0).sin(),
         ];
         m.initial_velocities
             .push(InitialVelocity::translation(VelocityTarget::Node(p.id), v));

@@ -233,10 +233,34 @@ pub(crate) fn quad_block(
         u[i] = [dot3(e1, vi), dot3(e2, vi), dot3(e3, vi)];
         th[i] = [dot3(e1, wi), dot3(e2, wi), dot3(e3, wi)];
     }
-    let ginv = opts.projection.then(|| gram_inverse(&r));
-    if let Some(g) = &ginv {
-        project(&r, g, &mut u, &mut th);
-    }
+    // Flanagan-Belytschko hourglass vector.
+    let hx = x1 - x2 + x3 - x4;
+    let hy = y1 - y2 + y3 - y4;
+    const H: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
+    let gam: [V; 4] = std::array::from_fn(|i| H[i] - hx * b1[i] - hy * b2[i]);
+
+    // Warping projection, applied through its effect. Strain and hourglass rates vanish on
+    // rigid translations and, but for terms in the warp heights z_I, on rigid rotations.
+    // In this frame both diagonals are normal to e3, so z = w (1, -1, 1, -1): B1.z = B2.z = 0
+    // and the warp only reaches the membrane hourglass rates, through Zg = gamma.z. Removing
+    // the rigid part of the velocities (rotation w = G^-1 (sum r_I x v_I + theta_I)) thus
+    // shifts q_0 by -w_y Zg and q_1 by w_x Zg; on the forces, P f only removes the rotation
+    // of the mode powers rho = (-hg_1 Zg, hg_0 Zg, 0).
+    let warp = opts.projection.then(|| {
+        let gi = gram_inverse(&r);
+        let mut bs = [V::default(); 3];
+        for i in 0..4 {
+            let c = cross3(r[i], u[i]);
+            for k in 0..3 {
+                bs[k] += c[k] + th[i][k];
+            }
+        }
+        let mut zg = V::default();
+        for i in 0..4 {
+            zg += gam[i] * r[i][2];
+        }
+        (gi, dot3(gi[0], bs), dot3(gi[1], bs), zg)
+    });
 
     // Rates.
     let (mut dxx, mut dyy, mut gxy) = (V::default(), V::default(), V::default());
@@ -359,11 +383,7 @@ pub(crate) fn quad_block(
         ];
     }
 
-    // Hourglass (Flanagan-Belytschko vector), membrane x, y; out-of-plane w; rotation x, y.
-    let hx = x1 - x2 + x3 - x4;
-    let hy = y1 - y2 + y3 - y4;
-    const H: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
-    let gam: [V; 4] = std::array::from_fn(|i| H[i] - hx * b1[i] - hy * b2[i]);
+    // Hourglass rates: membrane x, y; out-of-plane w; rotation x, y.
     let mut q = [V::default(); 5];
     for i in 0..4 {
         q[0] += gam[i] * u[i][0];
@@ -371,6 +391,10 @@ pub(crate) fn quad_block(
         q[2] += gam[i] * u[i][2];
         q[3] += gam[i] * th[i][0];
         q[4] += gam[i] * th[i][1];
+    }
+    if let Some((_, wx, wy, zg)) = warp {
+        q[0] -= wy * zg;
+        q[1] += wx * zg;
     }
     let [rm, rw, rb] = props.hg;
     let mut cc = [V::default(); 5];
@@ -422,15 +446,20 @@ pub(crate) fn quad_block(
             f[i][k] += gam[i] * hg[k];
         }
     }
-    if let Some(gi) = &ginv {
-        let (mut ft, mut fm) = ([[V::default(); 3]; 4], [[V::default(); 3]; 4]);
+    if let Some((gi, _, _, zg)) = warp {
+        let rx = -(hg[1] * zg);
+        let ry = hg[0] * zg;
+        let wf = [
+            gi[0][0] * rx + gi[0][1] * ry,
+            gi[1][0] * rx + gi[1][1] * ry,
+            gi[2][0] * rx + gi[2][1] * ry,
+        ];
         for i in 0..4 {
-            ft[i] = [f[i][0], f[i][1], f[i][2]];
-            fm[i] = [f[i][3], f[i][4], f[i][5]];
-        }
-        project(&r, gi, &mut ft, &mut fm);
-        for i in 0..4 {
-            f[i] = [ft[i][0], ft[i][1], ft[i][2], fm[i][0], fm[i][1], fm[i][2]];
+            let c = cross3(wf, r[i]);
+            for k in 0..3 {
+                f[i][k] -= c[k];
+                f[i][3 + k] -= wf[k];
+            }
         }
     }
 
@@ -472,7 +501,7 @@ pub(crate) fn quad_block(
 }
 
 /// Inverse of the rigid-rotation Gram matrix `G = sum_I (|r_I|^2 1 - r_I r_I^T) + 4 1`
-/// (symmetric; rows returned in full).
+/// (symmetric), without its (z, z) entry (returned as 0).
 #[inline(always)]
 fn gram_inverse(r: &[V3; 4]) -> [V3; 3] {
     let (mut g00, mut g11, mut g22) = (V::splat(4.0), V::splat(4.0), V::splat(4.0));
@@ -491,37 +520,12 @@ fn gram_inverse(r: &[V3; 4]) -> [V3; 3] {
     let c02 = g01 * g12 - g11 * g02;
     let c11 = g00 * g22 - g02 * g02;
     let c12 = g02 * g01 - g00 * g12;
-    let c22 = g00 * g11 - g01 * g01;
     let inv = 1.0 / (g00 * c00 + g01 * c01 + g02 * c02);
     let (c00, c01, c02) = (c00 * inv, c01 * inv, c02 * inv);
-    let (c11, c12, c22) = (c11 * inv, c12 * inv, c22 * inv);
-    [[c00, c01, c02], [c01, c11, c12], [c02, c12, c22]]
-}
-
-/// Removes the rigid-body part of nodal (translation `t`, rotation `m`) vectors:
-/// `u <- (1 - T T^T / 4 - Rm G^-1 Rm^T) u` (see [`crate::element`]).
-#[inline(always)]
-fn project(r: &[V3; 4], ginv: &[V3; 3], t: &mut [V3; 4], m: &mut [V3; 4]) {
-    let mut tbar = [V::default(); 3];
-    let mut b = [V::default(); 3];
-    for i in 0..4 {
-        let c = cross3(r[i], t[i]);
-        for k in 0..3 {
-            tbar[k] += t[i][k];
-            b[k] += c[k] + m[i][k];
-        }
-    }
-    for k in 0..3 {
-        tbar[k] = 0.25 * tbar[k];
-    }
-    let w = [dot3(ginv[0], b), dot3(ginv[1], b), dot3(ginv[2], b)];
-    for i in 0..4 {
-        let wr = cross3(w, r[i]);
-        for k in 0..3 {
-            t[i][k] -= tbar[k] + wr[k];
-            m[i][k] -= w[k];
-        }
-    }
+    let (c11, c12) = (c11 * inv, c12 * inv);
+    // The (z, z) entry is never needed: only rotations about the in-plane axes carry
+    // strain on a warped element.
+    [[c00, c01, c02], [c01, c11, c12], [c02, c12, V::default()]]
 }
 
 /// One quad on its own (all lanes of a block on the same element): the public
@@ -715,5 +719,146 @@ mod tests {
             }
         }
         assert!(yielded > 0, "no point yielded");
+    }
+    /// Rigid-body projection `u - vbar - w x r`, `theta - w` with
+    /// `w = G^-1 (sum r x u + sum theta)`, in the global frame (r from the centroid).
+    fn project_global(x: &[[f64; 3]; 4], t: &mut [[f64; 3]; 4], m: &mut [[f64; 3]; 4]) {
+        let c: [f64; 3] = std::array::from_fn(|k| 0.25 * (x[0][k] + x[1][k] + x[2][k] + x[3][k]));
+        let r: [[f64; 3]; 4] = std::array::from_fn(|i| std::array::from_fn(|k| x[i][k] - c[k]));
+        let mut g = [[0.0; 3]; 3];
+        let mut b = [0.0; 3];
+        let mut tbar = [0.0; 3];
+        for i in 0..4 {
+            let rr: f64 = r[i].iter().map(|a| a * a).sum();
+            for a in 0..3 {
+                for bb in 0..3 {
+                    g[a][bb] -= r[i][a] * r[i][bb];
+                }
+                g[a][a] += rr + 1.0;
+            }
+            let cr = [
+                r[i][1] * t[i][2] - r[i][2] * t[i][1],
+                r[i][2] * t[i][0] - r[i][0] * t[i][2],
+                r[i][0] * t[i][1] - r[i][1] * t[i][0],
+            ];
+            for k in 0..3 {
+                b[k] += cr[k] + m[i][k];
+                tbar[k] += 0.25 * t[i][k];
+            }
+        }
+        // Solve G w = b by Cramer's rule.
+        let det = |a: [[f64; 3]; 3]| {
+            a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+                - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+                + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+        };
+        let d = det(g);
+        let w: [f64; 3] = std::array::from_fn(|k| {
+            let mut a = g;
+            for row in 0..3 {
+                a[row][k] = b[row];
+            }
+            det(a) / d
+        });
+        for i in 0..4 {
+            let wr = [
+                w[1] * r[i][2] - w[2] * r[i][1],
+                w[2] * r[i][0] - w[0] * r[i][2],
+                w[0] * r[i][1] - w[1] * r[i][0],
+            ];
+            for k in 0..3 {
+                t[i][k] -= tbar[k] + wr[k];
+                m[i][k] -= w[k];
+            }
+        }
+    }
+
+    /// The projection applied through its effect on the rates and forces equals the
+    /// explicit projection of the velocities before, and of the forces after, an
+    /// unprojected evaluation (up to rounding), on a strongly warped quad.
+    #[test]
+    fn the_warping_projection_by_its_effect_equals_the_explicit_projection() {
+        let props = props();
+        let stride = STATE_HEAD + STATE_PER_POINT * 5;
+        for case in 0..20 {
+            let h0 = 100 * case;
+            let corners = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+            let x: [[f64; 3]; 4] = std::array::from_fn(|c| {
+                let i = h0 + 3 * c;
+                [
+                    0.01 * (corners[c][0] + 0.15 * h(i)),
+                    0.01 * (corners[c][1] + 0.15 * h(i + 1)),
+                    0.003 * h(i + 2),
+                ]
+            });
+            // A deformation plus a large rigid rotation about an in-plane axis.
+            let spin = [30000.0, -20000.0, 5000.0];
+            let v: [[f64; 3]; 4] = std::array::from_fn(|c| {
+                let p = x[c];
+                let rot = [
+                    spin[1] * p[2] - spin[2] * p[1],
+                    spin[2] * p[0] - spin[0] * p[2],
+                    spin[0] * p[1] - spin[1] * p[0],
+                ];
+                std::array::from_fn(|k| 5.0 * h(h0 + 31 + 3 * c + k) + rot[k])
+            });
+            let w: [[f64; 3]; 4] = std::array::from_fn(|c| {
+                std::array::from_fn(|k| 300.0 * h(h0 + 61 + 3 * c + k) + spin[k])
+            });
+            let on = KernelOptions {
+                projection: true,
+                isdo_diagonal: false,
+            };
+            let off = KernelOptions {
+                projection: false,
+                ..on
+            };
+            let dt = 1e-7;
+            let mut st_on = vec![0.0; stride];
+            let f_on = quad_single(&x, &v, &w, &props, &mut st_on, dt, on).unwrap();
+            let (mut vp, mut wp) = (v, w);
+            project_global(&x, &mut vp, &mut wp);
+            let mut st_off = vec![0.0; stride];
+            let f_off = quad_single(&x, &vp, &wp, &props, &mut st_off, dt, off).unwrap();
+            let smax = st_on.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            for (a, b) in st_on.iter().zip(&st_off) {
+                assert!(
+                    (a - b).abs() <= 1e-9 * smax,
+                    "case {case}: state {a} vs {b}"
+                );
+            }
+            let mut ft: [[f64; 3]; 4] =
+                std::array::from_fn(|i| [f_off.f[i][0], f_off.f[i][1], f_off.f[i][2]]);
+            let mut fm: [[f64; 3]; 4] =
+                std::array::from_fn(|i| [f_off.f[i][3], f_off.f[i][4], f_off.f[i][5]]);
+            project_global(&x, &mut ft, &mut fm);
+            let fmax = f_on.f.iter().flatten().fold(0.0f64, |a, b| a.max(b.abs()));
+            for i in 0..4 {
+                for k in 0..3 {
+                    let (a, b) = (f_on.f[i][k], ft[i][k]);
+                    assert!(
+                        (a - b).abs() <= 1e-9 * fmax,
+                        "case {case}: force {a} vs {b}"
+                    );
+                    let (a, b) = (f_on.f[i][3 + k], fm[i][k]);
+                    assert!(
+                        (a - b).abs() <= 1e-9 * fmax,
+                        "case {case}: moment {a} vs {b}"
+                    );
+                }
+            }
+            // The projection matters here: without it, the rotation of the warped quad
+            // loads its membrane hourglass modes (state values 2 and 3).
+            let mut st_raw = vec![0.0; stride];
+            quad_single(&x, &v, &w, &props, &mut st_raw, dt, off).unwrap();
+            let hg_on = st_on[2].abs().max(st_on[3].abs());
+            let diff = (st_on[2] - st_raw[2])
+                .abs()
+                .max((st_on[3] - st_raw[3]).abs());
+            assert!(
+                diff > hg_on,
+                "case {case}: projection changes little ({diff} vs {hg_on})"
+            );
+        }
     }
 }
