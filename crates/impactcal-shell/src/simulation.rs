@@ -186,6 +186,8 @@ pub struct Simulation {
     /// Per-element faults of the last element pass.
     faults: Vec<Option<ElementFault>>,
     chunks: Vec<ChunkSum>,
+    /// Per-chunk partial sums of the node loops.
+    node_sums: Vec<f64>,
     /// `1 / m` per node, 0 where the node has no mass.
     inv_mass: Vec<f64>,
     /// `1 / I` per node, 0 where the node has no rotary inertia.
@@ -299,6 +301,7 @@ impl Simulation {
             out: vec![ElementOutput::default(); ne],
             faults: vec![None; ne],
             chunks: vec![ChunkSum::default(); ne.div_ceil(ELEMENT_CHUNK)],
+            node_sums: vec![0.0; nn.div_ceil(NODE_CHUNK)],
             inv_mass: c
                 .mass
                 .iter()
@@ -696,13 +699,25 @@ impl Simulation {
     pub fn step(&mut self) -> Result<()> {
         let dt = self.dt_half;
         let g0 = self.body_accel(self.time);
-        let mut mdz = 0.0;
-        for (x, (v, m)) in self.x.iter_mut().zip(self.v.iter().zip(&self.c.mass)) {
-            for d in 0..3 {
-                x[d] += dt * v[d];
-            }
-            mdz += m * dt * v[2];
-        }
+        // Positions, and the vertical momentum for the work of the body load, in fixed
+        // chunks summed in order.
+        let mass = &self.c.mass;
+        self.x
+            .par_chunks_mut(NODE_CHUNK)
+            .zip(self.v.par_chunks(NODE_CHUNK))
+            .zip(mass.par_chunks(NODE_CHUNK))
+            .zip(self.node_sums.par_iter_mut())
+            .for_each(|(((xs, vs), ms), sum)| {
+                let mut mdz = 0.0;
+                for ((x, v), m) in xs.iter_mut().zip(vs).zip(ms) {
+                    for d in 0..3 {
+                        x[d] += dt * v[d];
+                    }
+                    mdz += m * dt * v[2];
+                }
+                *sum = mdz;
+            });
+        let mdz: f64 = self.node_sums.iter().sum();
         self.time += dt;
         self.cycle += 1;
         self.element_loop(dt);
@@ -737,7 +752,10 @@ impl Simulation {
                 .unwrap_or(0);
             return Err(self.unstable(k, "non-finite force or energy".into()));
         }
-        if let Some(i) = self.v.iter().position(|v| v.iter().any(|c| !c.is_finite())) {
+        let bad = |v: &[f64; 3]| v.iter().any(|c| !c.is_finite());
+        if self.v.par_iter().with_min_len(NODE_CHUNK).any(bad)
+            && let Some(i) = self.v.iter().position(bad)
+        {
             return Err(ShellError::Unstable {
                 time: self.time,
                 cycle: self.cycle,
