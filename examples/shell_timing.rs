@@ -3,8 +3,10 @@
 //! prints microseconds per element-cycle, plus a checksum of the final state so that runs on
 //! different thread counts can be compared bit for bit.
 //!
-//! `cargo run --release --example shell_timing -- THREADS CYCLES REPEATS`
-//! (after 20 warm-up cycles; prints the median over the repeats).
+//! `cargo run --release --example shell_timing -- THREADS CYCLES REPEATS [VARIANT]`
+//! (after 20 warm-up cycles; prints the median over the repeats). VARIANT, for profiling
+//! by ablation: `full` (default), `noproj` (warping projection off), `elastic` (elastic
+//! material), `nip1` (one thickness point).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::time::Instant;
@@ -23,7 +25,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()?;
-    let m = shell_plate::plate();
+    let mut m = shell_plate::plate();
+    match args.get(4).map_or("full", String::as_str) {
+        "full" => {}
+        "noproj" => m.control.warping_projection = false,
+        "elastic" => m.materials[0].law = impactcal::shell::MaterialLaw::Elastic,
+        "nip1" => m.sections[0].nip = 1,
+        other => return Err(format!("unknown variant {other}").into()),
+    }
+    let nip = m.sections[0].nip;
     let ne = m.shells.len();
     let (times, checksum, yielded) =
         pool.install(|| -> Result<_, impactcal::shell::ShellError> {
@@ -48,10 +58,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let e = sim.energies();
             h = h.rotate_left(5) ^ e.internal.to_bits() ^ e.kinetic.to_bits();
             let yielded = (0..ne)
-                .flat_map(|k| (0..5).map(move |p| (k, p)))
+                .flat_map(|k| (0..nip).map(move |p| (k, p)))
                 .filter(|&(k, p)| sim.point_state(k, p).is_some_and(|s| s[3] > 0.0))
                 .count();
-            Ok((times, h, yielded as f64 / (5 * ne) as f64))
+            Ok((times, h, yielded as f64 / (nip * ne) as f64))
         })?;
     let mut times = times;
     times.sort_by(f64::total_cmp);
