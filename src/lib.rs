@@ -6,9 +6,11 @@
 //! |---|---|---|
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
+//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
 //!
 
 pub use impactcal_core as core;
+pub use impactcal_erbf as erbf;
 pub use impactcal_shapes as shapes;
 
 /// The types most programs need, in one import.
@@ -16,5 +18,8 @@ pub mod prelude {
     pub use impactcal_core::{
         BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
         TableOptions,
+    };
+    pub use impactcal_erbf::{
+        Accuracy, ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions,
     };
 }
