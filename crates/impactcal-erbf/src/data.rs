@@ -168,7 +168,6 @@ pub(crate) fn find_duplicate(points: MatRef<'_, f64>, tol: f64) -> Option<(usize
 }
 
 /// Errors with [`ErbfError::DuplicateSamples`] when two rows are closer than `tol`.
-#[allow(dead_code)]
 pub(crate) fn reject_duplicates(points: MatRef<'_, f64>, tol: f64) -> Result<()> {
     match find_duplicate(points, tol) {
         None => Ok(()),

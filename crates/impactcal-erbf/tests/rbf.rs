@@ -1,5 +1,7 @@
 //! Classic RBF interpolants against analytic truths and invariants.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use approx::assert_relative_eq;
 use faer::{Mat, MatRef};
 use impactcal_erbf::{ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions};
