@@ -5,6 +5,7 @@
 
 mod error;
 mod output;
+mod surrogate;
 
 use std::process::ExitCode;
 
@@ -21,10 +22,15 @@ struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
-enum Command {}
+enum Command {
+    /// ERBF and RBF surrogates of sampled responses (whole time histories).
+    Surrogate(surrogate::Args),
+}
 
 fn run(command: Command) -> Result<(), CliError> {
-    match command {}
+    match command {
+        Command::Surrogate(args) => surrogate::run(args),
+    }
 }
 
 fn main() -> ExitCode {

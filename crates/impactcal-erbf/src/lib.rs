@@ -63,6 +63,7 @@ pub mod loo;
 pub mod metrics;
 pub mod nrbf;
 pub mod rbf;
+pub mod surrogate;
 
 pub use data::StoredMat;
 pub use erbf::{Erbf, ErbfOptions, FamilyWeights};
@@ -71,3 +72,4 @@ pub use kernel::{Kernel, PolyDegree};
 pub use loo::{ErrorSummary, LooMethod};
 pub use metrics::Accuracy;
 pub use rbf::{RbfInterpolant, RbfOptions};
+pub use surrogate::{Surrogate, SurrogateKind, SurrogateModel};
