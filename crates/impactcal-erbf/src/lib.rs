@@ -8,7 +8,8 @@
 //!   radial functions plus, per sample and input, the non-radial functions of [`nrbf`]),
 //!   inputs scaled by the bounds of a parameter space, minimum-norm coefficients through a
 //!   QR factorisation of `A^T`. Predicts whole time histories at the cost of one solve.
-//! - [`metrics`]: RAAE, RMAE and R^2.
+//! - [`metrics`]: RAAE, RMAE and R^2; [`testfns`]: Branin, Goldstein-Price, Hartmann-3/6,
+//!   Dixon-Price and a Latin hypercube design for accuracy studies.
 //!
 //! Both models offer batch prediction (parallel, thread-count independent), gradients with
 //! respect to the inputs, leave-one-out errors, a conditioning diagnostic, a flag for
@@ -64,6 +65,7 @@ pub mod metrics;
 pub mod nrbf;
 pub mod rbf;
 pub mod surrogate;
+pub mod testfns;
 
 pub use data::StoredMat;
 pub use erbf::{Erbf, ErbfOptions, FamilyWeights};
