@@ -37,7 +37,7 @@ use serde::{Deserialize, Serialize};
 use crate::data::{StoredMat, check_queries, check_training, reject_duplicates, without_row};
 use crate::error::{ErbfError, Result};
 use crate::loo::LooMethod;
-use crate::nrbf::{dphi_l, dphi_r, phi_l, phi_r};
+use crate::nrbf::{LeftRight, dphi_l, dphi_r};
 use crate::rbf::{condition_number, relative_max_error};
 
 /// Multipliers of the three basis families. The minimum-norm solution is not invariant
@@ -518,25 +518,41 @@ impl Factor {
 fn basis_matrix_t(u: MatRef<'_, f64>, centres: MatRef<'_, f64>, o: &ErbfOptions) -> Mat<f64> {
     let n = centres.nrows();
     let m = centres.ncols();
-    let mut bt = Mat::<f64>::zeros(n * (3 * m + 1), u.nrows());
-    let order = o.order as i32;
+    // Centres row-major, so that the inner loop reads contiguous memory.
+    let c: Vec<f64> = (0..n)
+        .flat_map(|i| (0..m).map(move |j| centres[(i, j)]))
+        .collect();
+    let lr = LeftRight::new(o.order as i32, o.gamma);
     let inv2rc2 = 0.5 / (o.rc * o.rc);
     let w = o.weights;
-    bt.par_col_chunks_mut(1).enumerate().for_each(|(q, col)| {
-        let mut col = col.col_mut(0);
-        for i in 0..n {
-            let mut d2 = 0.0;
-            for j in 0..m {
-                let xi = u[(q, j)] - centres[(i, j)];
-                d2 += xi * xi;
-                let base = n + 3 * (i * m + j);
-                col[base] = w.left_right * phi_l(xi, order, o.gamma);
-                col[base + 1] = w.left_right * phi_r(xi, order, o.gamma);
-                col[base + 2] = w.beta * xi;
+    let mut bt = Mat::<f64>::zeros(n * (3 * m + 1), u.nrows());
+    bt.par_col_chunks_mut(1)
+        .enumerate()
+        .for_each(|(q, mut col)| {
+            let x: Vec<f64> = (0..m).map(|j| u[(q, j)]).collect();
+            let Some(col) = col.as_mut().col_mut(0).try_as_col_major_mut() else {
+                return;
+            };
+            let col = col.as_slice_mut();
+            let (radial, rest) = col.split_at_mut(n);
+            for (i, (r, out)) in radial
+                .iter_mut()
+                .zip(rest.chunks_exact_mut(3 * m))
+                .enumerate()
+            {
+                let ci = &c[i * m..(i + 1) * m];
+                let mut d2 = 0.0;
+                for ((&xj, &cj), o3) in x.iter().zip(ci).zip(out.chunks_exact_mut(3)) {
+                    let xi = xj - cj;
+                    d2 += xi * xi;
+                    let (l, rr) = lr.values(xi);
+                    o3[0] = w.left_right * l;
+                    o3[1] = w.left_right * rr;
+                    o3[2] = w.beta * xi;
+                }
+                *r = w.radial * (-d2 * inv2rc2).exp();
             }
-            col[i] = w.radial * (-d2 * inv2rc2).exp();
-        }
-    });
+        });
     bt
 }
 
