@@ -6,11 +6,24 @@
 //! |---|---|---|
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
+//! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
 //! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
+//!
+//! ```
+//! use impactcal::prelude::*;
+//!
+//! let h = Histories::parse_csv("time,1.z,2.z\n0,0,0\n1,1,2\n2,2,4\n", "inline")?;
+//! let shapes = ImpactShapes::from_histories(&h, &ShapeOptions::default())?;
+//! // Two proportional channels: one shape carries everything.
+//! assert_eq!(shapes.len(), 1);
+//! assert!((shapes.contributions()[0] - 1.0).abs() < 1e-12);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 //!
 
 pub use impactcal_core as core;
 pub use impactcal_erbf as erbf;
+pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
 
 /// The types most programs need, in one import.
@@ -21,5 +34,12 @@ pub mod prelude {
     };
     pub use impactcal_erbf::{
         Accuracy, ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions,
+    };
+    pub use impactcal_sensors::{
+        CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,
+        place_from_histories,
+    };
+    pub use impactcal_shapes::{
+        Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
     };
 }

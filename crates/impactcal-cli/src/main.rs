@@ -3,8 +3,12 @@
 //! Each subcommand lives in its own module with an `Args` struct (clap) and a `run`
 //! function; this file only registers them. Numerical work happens in the library.
 
+mod compare;
 mod error;
+mod expand;
 mod output;
+mod place;
+mod shapes;
 mod surrogate;
 
 use std::process::ExitCode;
@@ -25,11 +29,25 @@ struct Cli {
 enum Command {
     /// ERBF and RBF surrogates of sampled responses (whole time histories).
     Surrogate(surrogate::Args),
+    /// Impact shapes (SVD) of a histories file: singular values, contributions, shapes and
+    /// time functions as JSON.
+    Shapes(shapes::Args),
+    /// Calibration metric M2: orthogonality and pairing of test and analysis impact shapes.
+    Compare(compare::Args),
+    /// Expand measured channels to the unmeasured channels of a model through its shapes.
+    Expand(expand::Args),
+    /// Sensor placement by effective independence (Kammer) on impact shapes or a shape
+    /// matrix.
+    Place(place::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
     match command {
         Command::Surrogate(args) => surrogate::run(args),
+        Command::Shapes(a) => shapes::run(a),
+        Command::Compare(a) => compare::run(a),
+        Command::Expand(a) => expand::run(a),
+        Command::Place(a) => place::run(a),
     }
 }
 
