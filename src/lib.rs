@@ -8,6 +8,7 @@
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
 //! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
+//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -22,6 +23,7 @@
 //!
 
 pub use impactcal_core as core;
+pub use impactcal_erbf as erbf;
 pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
 pub use impactcal_shell as shell;
@@ -31,6 +33,9 @@ pub mod prelude {
     pub use impactcal_core::{
         BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
         TableOptions,
+    };
+    pub use impactcal_erbf::{
+        Accuracy, ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions,
     };
     pub use impactcal_sensors::{
         CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,

@@ -10,6 +10,7 @@ mod output;
 mod place;
 mod shapes;
 mod simulate;
+mod surrogate;
 
 use std::process::ExitCode;
 
@@ -27,6 +28,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// ERBF and RBF surrogates of sampled responses (whole time histories).
+    Surrogate(surrogate::Args),
     /// Impact shapes (SVD) of a histories file: singular values, contributions, shapes and
     /// time functions as JSON.
     Shapes(shapes::Args),
@@ -44,6 +47,7 @@ enum Command {
 
 fn run(command: Command) -> Result<(), CliError> {
     match command {
+        Command::Surrogate(args) => surrogate::run(args),
         Command::Shapes(a) => shapes::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
