@@ -6,6 +6,7 @@
 //! |---|---|---|
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
+//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -20,6 +21,7 @@
 //!
 
 pub use impactcal_core as core;
+pub use impactcal_erbf as erbf;
 pub use impactcal_shapes as shapes;
 
 /// The types most programs need, in one import.
@@ -27,6 +29,9 @@ pub mod prelude {
     pub use impactcal_core::{
         BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
         TableOptions,
+    };
+    pub use impactcal_erbf::{
+        Accuracy, ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions,
     };
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
