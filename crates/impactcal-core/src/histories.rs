@@ -44,10 +44,14 @@ impl Histories {
         data: Vec<f64>,
     ) -> Result<Self> {
         if labels.is_empty() {
-            return Err(CoreError::Invalid("histories need at least one channel".into()));
+            return Err(CoreError::Invalid(
+                "histories need at least one channel".into(),
+            ));
         }
         if samples == 0 {
-            return Err(CoreError::Invalid("histories need at least one sample".into()));
+            return Err(CoreError::Invalid(
+                "histories need at least one sample".into(),
+            ));
         }
         check_labels(&labels)?;
         if !(dt.is_finite() && dt > 0.0) {
@@ -270,7 +274,10 @@ impl Histories {
             column,
             message,
         };
-        let header_row = table.lines.first().map_or(1, |&l| l.saturating_sub(1).max(1));
+        let header_row = table
+            .lines
+            .first()
+            .map_or(1, |&l| l.saturating_sub(1).max(1));
         if !table.header[0].eq_ignore_ascii_case("time") {
             return Err(err(
                 header_row,
@@ -371,7 +378,9 @@ impl Histories {
 fn check_labels(labels: &[String]) -> Result<()> {
     for (i, l) in labels.iter().enumerate() {
         if l.trim().is_empty() {
-            return Err(CoreError::Invalid(format!("channel {i} has an empty label")));
+            return Err(CoreError::Invalid(format!(
+                "channel {i} has an empty label"
+            )));
         }
         if let Some(j) = labels[..i].iter().position(|m| m == l) {
             return Err(CoreError::Invalid(format!(
@@ -390,7 +399,11 @@ mod tests {
     fn sample() -> Histories {
         Histories::from_channels(
             vec!["1.x".into(), "1.z".into(), "force".into()],
-            vec![vec![0.0, 1.0, 2.0], vec![3.0, 4.0, 5.0], vec![-1.0, 0.5, 1e-9]],
+            vec![
+                vec![0.0, 1.0, 2.0],
+                vec![3.0, 4.0, 5.0],
+                vec![-1.0, 0.5, 1e-9],
+            ],
             1e-4,
             0.002,
             "in/s",

@@ -113,7 +113,9 @@ mod tests {
             if p[0] < 0.0 {
                 return Err(CoreError::Invalid("negative amplitude".into()));
             }
-            let y = (0..50).map(|k| p[0] * (p[1] * k as f64 * 0.01).sin()).collect();
+            let y = (0..50)
+                .map(|k| p[0] * (p[1] * k as f64 * 0.01).sin())
+                .collect();
             Histories::from_channels(vec!["y".into()], vec![y], 0.01, 0.0, "")
         }
     }

@@ -323,10 +323,18 @@ impl ParameterSpace {
             };
             if let Err(CoreError::Parameter { message, .. }) = p.validate() {
                 let column = if lower >= upper { 3 } else { 4 };
-                return Err(err(row, column, format!("parameter `{}`: {message}", p.name)));
+                return Err(err(
+                    row,
+                    column,
+                    format!("parameter `{}`: {message}", p.name),
+                ));
             }
             if parameters.iter().any(|q| q.name == p.name) {
-                return Err(err(row, 1, format!("parameter `{}` is listed twice", p.name)));
+                return Err(err(
+                    row,
+                    1,
+                    format!("parameter `{}` is listed twice", p.name),
+                ));
             }
             parameters.push(p);
         }
@@ -368,7 +376,9 @@ mod tests {
     fn space() -> ParameterSpace {
         ParameterSpace::new(vec![
             Parameter::new("a", -1.0, 3.0, 0.0).unwrap(),
-            Parameter::new("b", 10.0, 20.0, 12.0).unwrap().with_unit("psi"),
+            Parameter::new("b", 10.0, 20.0, 12.0)
+                .unwrap()
+                .with_unit("psi"),
         ])
         .unwrap()
     }

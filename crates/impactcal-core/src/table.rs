@@ -277,7 +277,10 @@ mod tests {
         assert_eq!(position(parse("a,b\n1,inf\n").unwrap_err()), (2, 2));
         assert_eq!(position(parse("a,b\n1,\n").unwrap_err()), (2, 2));
         assert!(matches!(parse("").unwrap_err(), CoreError::File { .. }));
-        assert!(matches!(parse("a,b\n").unwrap_err(), CoreError::File { .. }));
+        assert!(matches!(
+            parse("a,b\n").unwrap_err(),
+            CoreError::File { .. }
+        ));
     }
 
     #[test]
