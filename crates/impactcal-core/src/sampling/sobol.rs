@@ -190,8 +190,8 @@ fn mix64(mut z: u64) -> u64 {
 fn direction_numbers(dim: usize) -> Result<Vec<u32>> {
     let mut v = vec![0u32; dim * BITS];
     // Dimension 1: m_k = 1 for every k.
-    for k in 0..BITS {
-        v[k] = 1 << (BITS - 1 - k);
+    for (k, vk) in v.iter_mut().enumerate().take(BITS) {
+        *vk = 1 << (BITS - 1 - k);
     }
     let lines = JOE_KUO_D6
         .lines()
