@@ -7,6 +7,7 @@
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
 //! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
+//! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -21,6 +22,7 @@
 //!
 
 pub use impactcal_core as core;
+pub use impactcal_cors as cors;
 pub use impactcal_erbf as erbf;
 pub use impactcal_shapes as shapes;
 
@@ -29,6 +31,9 @@ pub mod prelude {
     pub use impactcal_core::{
         BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
         TableOptions,
+    };
+    pub use impactcal_cors::{
+        Cors, CorsError, CorsOptions, InitialDesign, Outcome, StopReason, Suggestion, Transform,
     };
     pub use impactcal_erbf::{
         Accuracy, ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions,

@@ -6,6 +6,7 @@
 mod compare;
 mod error;
 mod expand;
+mod optimize;
 mod output;
 mod shapes;
 
@@ -32,6 +33,8 @@ enum Command {
     Compare(compare::Args),
     /// Expand measured channels to the unmeasured channels of a model through its shapes.
     Expand(expand::Args),
+    /// CORS-RBF optimisation of an expensive model driven from the shell.
+    Optimize(optimize::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -39,6 +42,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Shapes(a) => shapes::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
+        Command::Optimize(a) => optimize::run(a),
     }
 }
 
