@@ -2,13 +2,14 @@
 //! spent choosing each point, one JSON line per (function, seed).
 //!
 //! `cargo run --release --example cors_dixon_szego -- [--seeds 30] [--budget 300]
-//! [--functions branin,hartmann3] [--transform identity|log|shifted-log|median-cap]`
+//! [--functions branin,hartmann3] [--transform identity|log|shifted-log|median-cap]
+//! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]`
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::time::Instant;
 
-use impactcal::cors::{Cors, CorsOptions, Transform, test_functions};
+use impactcal::cors::{Cors, CorsOptions, SurrogateKernel, Transform, test_functions};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -27,6 +28,13 @@ fn main() {
         Some("median-cap") => Transform::MedianCap,
         Some(t) => panic!("unknown transform {t}"),
     };
+    let kernel = match get("--kernel").as_deref() {
+        None | Some("cubic") => SurrogateKernel::Cubic,
+        Some("thin-plate") => SurrogateKernel::ThinPlate,
+        Some(k) => panic!("unknown kernel {k}"),
+    };
+    let pattern: Option<Vec<f64>> =
+        get("--pattern").map(|s| s.split(',').map(|b| b.parse().unwrap()).collect());
     let names: Vec<String> = get("--functions").map_or_else(
         || {
             test_functions::dixon_szego()
@@ -39,10 +47,20 @@ fn main() {
     for name in &names {
         let f = test_functions::by_name(name).expect("a Dixon-Szego function");
         for seed in first_seed..first_seed + seeds {
-            let options = CorsOptions {
+            let mut options = CorsOptions {
                 transform,
+                kernel,
                 ..CorsOptions::with_seed(seed)
             };
+            if let Some(c) = get("--candidates") {
+                options.candidates_per_dim = c.parse().unwrap();
+            }
+            if let Some(c) = get("--local-candidates") {
+                options.local_candidates_per_dim = c.parse().unwrap();
+            }
+            if let Some(p) = &pattern {
+                options.pattern.clone_from(p);
+            }
             let mut study = Cors::new(f.space().unwrap(), options).unwrap();
             let mut hit: Option<usize> = None;
             let mut best = f64::INFINITY;

@@ -123,7 +123,7 @@ pub struct CorsOptions {
     pub design_size: Option<usize>,
     /// Transform of the objective values for the surrogate.
     pub transform: Transform,
-    /// Quasi-random (scrambled Sobol') candidates per dimension for the auxiliary problem
+    /// Quasi-random (randomly shifted Sobol') candidates per dimension for the auxiliary problem
     /// and the maximin distance.
     pub candidates_per_dim: usize,
     /// Candidates per dimension drawn around the best point (Gaussian perturbations of
@@ -154,8 +154,8 @@ impl Default for CorsOptions {
             initial: InitialDesign::Auto,
             design_size: None,
             transform: Transform::Identity,
-            candidates_per_dim: 500,
-            local_candidates_per_dim: 200,
+            candidates_per_dim: 300,
+            local_candidates_per_dim: 100,
             polish_starts: 5,
             min_distance: 1e-3,
             failure_radius: 0.05,

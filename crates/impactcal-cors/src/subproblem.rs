@@ -11,7 +11,7 @@
 //! point) and `Delta = max_x min_j |x - x_j|` is the maximin distance, the radius of the
 //! largest empty ball centred in the box.
 //!
-//! The solver is a multistart: scrambled Sobol' candidates (which also estimate `Delta`,
+//! The solver is a multistart: randomly shifted Sobol' candidates (which also estimate `Delta`,
 //! refined by a compass search on the maximin point) and Gaussian perturbations of the best
 //! point are screened; the `K` feasible candidates with the lowest `s` and the maximin point
 //! start a projected-gradient descent (steps along `-grad s`, projection onto the box and
@@ -26,6 +26,9 @@ use rayon::prelude::*;
 
 use crate::geometry::{clip_unit, distance};
 use crate::surrogate::Surrogate;
+
+/// Candidates per parallel task: small batches cost more in scheduling than they save.
+const PAR_CHUNK: usize = 1024;
 
 /// Points that a new point must keep away from, in the unit box.
 #[derive(Debug, Clone, Default)]
@@ -116,13 +119,28 @@ pub struct Choice {
     pub predicted: f64,
 }
 
-/// Scrambled Sobol' candidates of the unit box (the stream's Owen scrambling seed first).
+/// Sobol' candidates of the unit box with a random digital shift (every coordinate's bits
+/// XORed with a random word, which keeps the net structure and is far cheaper than Owen
+/// scrambling), drawn from the stream.
 fn global_candidates(dim: usize, n: usize, rng: &mut impl Rng) -> Vec<f64> {
-    let seed: u64 = rng.random();
-    match Sobol::owen_scrambled(dim, seed).and_then(|s| s.points(0, n)) {
-        Ok(p) => p.into_vec(),
+    const SCALE: f64 = 1.0 / 4_294_967_296.0;
+    let shift: Vec<u32> = (0..dim).map(|_| rng.random()).collect();
+    match (Sobol::new(dim), u32::try_from(n)) {
+        (Ok(sobol), Ok(n)) => {
+            let mut out = Vec::with_capacity(n as usize * dim);
+            let mut bits = vec![0u32; dim];
+            for i in 0..n {
+                sobol.point_bits(i, &mut bits);
+                out.extend(
+                    bits.iter()
+                        .zip(&shift)
+                        .map(|(b, s)| (f64::from(b ^ s) + 0.5) * SCALE),
+                );
+            }
+            out
+        }
         // Beyond the Sobol' dimensions (thousands): independent uniform points.
-        Err(_) => (0..n * dim).map(|_| rng.random::<f64>()).collect(),
+        _ => (0..n * dim).map(|_| rng.random::<f64>()).collect(),
     }
 }
 
@@ -171,12 +189,13 @@ fn refine_maximin(blockers: &Blockers, mut x: Vec<f64>, mut h: f64) -> (Vec<f64>
 }
 
 /// The maximin point of the box with respect to `blockers` and its distance `Delta`,
-/// estimated from `n` scrambled Sobol' candidates and refined by a compass search.
+/// estimated from `n` shifted Sobol' candidates and refined by a compass search.
 pub fn maximin(blockers: &Blockers, n: usize, rng: &mut impl Rng) -> (Vec<f64>, f64) {
     let dim = blockers.dim;
     let cands = global_candidates(dim, n.max(1), rng);
     let dists: Vec<f64> = cands
         .par_chunks_exact(dim)
+        .with_min_len(PAR_CHUNK)
         .map(|c| blockers.min_distance(c))
         .collect();
     let i = argmax(&dists);
@@ -210,6 +229,7 @@ pub fn cors_step(
     cands.extend(local_candidates(best, settings.local_candidates, rng));
     let screened: Vec<((f64, f64), f64)> = cands
         .par_chunks_exact(dim)
+        .with_min_len(PAR_CHUNK)
         .map(|c| (blockers.min_distances(c), surrogate.value(c)))
         .collect();
     // Delta from the global candidates, refined around the best of them.
@@ -240,8 +260,9 @@ pub fn cors_step(
     if maximin_ok {
         starts.push(maximin_x.clone());
     }
+    // A handful of short descents: cheaper in sequence than through the thread pool.
     let polished: Vec<(Vec<f64>, f64)> = starts
-        .into_par_iter()
+        .into_iter()
         .map(|x0| polish(surrogate, blockers, radii, x0))
         .collect();
     let mut chosen: Option<(Vec<f64>, f64)> = None;
