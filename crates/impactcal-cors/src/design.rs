@@ -10,7 +10,7 @@ use crate::geometry::distance;
 const DESIGN_TRIES: usize = 100;
 
 /// A symmetric Latin hypercube design of `n` points in `(0, 1)^dim` that holds `dim + 1`
-/// affinely independent points: among [`DESIGN_TRIES`] designs drawn from `seed`, the
+/// affinely independent points: among 100 designs drawn from `seed`, the
 /// affinely spanning one with the largest minimum pairwise distance (the first in draw order
 /// on ties). When none spans (only for `n < dim + 1`, which the options forbid, or in
 /// degenerate tiny cases) the best by distance is returned.
