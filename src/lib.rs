@@ -8,6 +8,8 @@
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
 //! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
 //! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) |
+//! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
+//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -24,7 +26,9 @@
 pub use impactcal_core as core;
 pub use impactcal_cors as cors;
 pub use impactcal_erbf as erbf;
+pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
+pub use impactcal_shell as shell;
 
 /// The types most programs need, in one import.
 pub mod prelude {
@@ -38,7 +42,12 @@ pub mod prelude {
     pub use impactcal_erbf::{
         Accuracy, ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions,
     };
+    pub use impactcal_sensors::{
+        CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,
+        place_from_histories,
+    };
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
     };
+    pub use impactcal_shell::{ShellError, ShellModel, Simulation};
 }

@@ -8,7 +8,9 @@ mod error;
 mod expand;
 mod optimize;
 mod output;
+mod place;
 mod shapes;
+mod simulate;
 
 use std::process::ExitCode;
 
@@ -35,6 +37,12 @@ enum Command {
     Expand(expand::Args),
     /// CORS-RBF optimisation of an expensive model driven from the shell.
     Optimize(optimize::Args),
+    /// Sensor placement by effective independence (Kammer) on impact shapes or a shape
+    /// matrix.
+    Place(place::Args),
+    /// Run an LS-DYNA keyword deck with the built-in explicit shell solver; write nodal
+    /// histories and energies as CSV.
+    Simulate(simulate::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -43,6 +51,8 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
         Command::Optimize(a) => optimize::run(a),
+        Command::Place(a) => place::run(a),
+        Command::Simulate(a) => simulate::run(a),
     }
 }
 

@@ -7,7 +7,12 @@
 use impactcal_cors::{Cors, CorsOptions, Stopping, Transform, test_functions};
 
 /// Evaluations until the best value is within 1% of the minimum, or `None` within `budget`.
-fn evaluations_to_1pct(name: &str, seed: u64, transform: Transform, budget: usize) -> Option<usize> {
+fn evaluations_to_1pct(
+    name: &str,
+    seed: u64,
+    transform: Transform,
+    budget: usize,
+) -> Option<usize> {
     let f = test_functions::by_name(name).unwrap();
     let options = CorsOptions {
         transform,
@@ -73,5 +78,8 @@ fn shekel10() {
 #[test]
 fn a_hard_budget_is_not_met_by_chance() {
     // The check can fail: Hartmann6 is not solved in its own design plus 6 steps.
-    assert_eq!(evaluations_to_1pct("hartmann6", 0, Transform::Identity, 20), None);
+    assert_eq!(
+        evaluations_to_1pct("hartmann6", 0, Transform::Identity, 20),
+        None
+    );
 }
