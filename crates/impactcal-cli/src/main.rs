@@ -6,6 +6,7 @@
 mod compare;
 mod error;
 mod expand;
+mod optimize;
 mod output;
 mod place;
 mod shapes;
@@ -37,6 +38,8 @@ enum Command {
     Compare(compare::Args),
     /// Expand measured channels to the unmeasured channels of a model through its shapes.
     Expand(expand::Args),
+    /// CORS-RBF optimisation of an expensive model driven from the shell.
+    Optimize(optimize::Args),
     /// Sensor placement by effective independence (Kammer) on impact shapes or a shape
     /// matrix.
     Place(place::Args),
@@ -51,6 +54,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Shapes(a) => shapes::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
+        Command::Optimize(a) => optimize::run(a),
         Command::Place(a) => place::run(a),
         Command::Simulate(a) => simulate::run(a),
     }
