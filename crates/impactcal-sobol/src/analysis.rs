@@ -504,22 +504,29 @@ fn assemble(plan: &Plan, options: &SobolOptions, e: &Estimates, cols: usize) -> 
     let first_order = per_column(&|t, i| e.first(0, t, i));
     let total = per_column(&|t, i| e.total(0, t, i));
 
-    let ci = |f: &(dyn Fn(usize, usize, usize) -> f64 + Sync)| -> (Vec<Vec<[f64; 2]>>, Vec<Vec<f64>>) {
-        let cells: Vec<([f64; 2], f64)> = (0..cols * d)
-            .into_par_iter()
-            .map(|c| {
-                let (t, i) = (c / d, c % d);
-                if low[t] {
-                    return ([f64::NAN, f64::NAN], f64::NAN);
-                }
-                let mut v: Vec<f64> = (1..=resamples).map(|g| f(g, t, i)).collect();
-                interval(&mut v, options.confidence)
-            })
-            .collect();
-        let lo_hi = cells.chunks(d).map(|r| r.iter().map(|c| c.0).collect()).collect();
-        let se = cells.chunks(d).map(|r| r.iter().map(|c| c.1).collect()).collect();
-        (lo_hi, se)
-    };
+    let ci =
+        |f: &(dyn Fn(usize, usize, usize) -> f64 + Sync)| -> (Vec<Vec<[f64; 2]>>, Vec<Vec<f64>>) {
+            let cells: Vec<([f64; 2], f64)> = (0..cols * d)
+                .into_par_iter()
+                .map(|c| {
+                    let (t, i) = (c / d, c % d);
+                    if low[t] {
+                        return ([f64::NAN, f64::NAN], f64::NAN);
+                    }
+                    let mut v: Vec<f64> = (1..=resamples).map(|g| f(g, t, i)).collect();
+                    interval(&mut v, options.confidence)
+                })
+                .collect();
+            let lo_hi = cells
+                .chunks(d)
+                .map(|r| r.iter().map(|c| c.0).collect())
+                .collect();
+            let se = cells
+                .chunks(d)
+                .map(|r| r.iter().map(|c| c.1).collect())
+                .collect();
+            (lo_hi, se)
+        };
     let (first_order_ci, first_order_se, total_ci, total_se) = if resamples > 0 {
         let (fc, fs) = ci(&|g, t, i| e.first(g, t, i));
         let (tc, ts) = ci(&|g, t, i| e.total(g, t, i));
@@ -638,7 +645,7 @@ fn assemble(plan: &Plan, options: &SobolOptions, e: &Estimates, cols: usize) -> 
             first_order_ci: agg_first_ci,
             total_ci: agg_total_ci,
         },
-        bootstrap: (resamples > 0).then(|| BootstrapInfo {
+        bootstrap: (resamples > 0).then_some(BootstrapInfo {
             resamples,
             confidence: options.confidence,
             seed: options.seed,

@@ -52,11 +52,7 @@ impl DesignLayout {
                 has: format!("{d}"),
             });
         }
-        Ok(DesignLayout {
-            n,
-            d,
-            second_order,
-        })
+        Ok(DesignLayout { n, d, second_order })
     }
 
     /// The layout that `rows` model runs of `d` parameters must have.
@@ -77,7 +73,11 @@ impl DesignLayout {
             let hint = if rows > 0 && rows % other == 0 {
                 format!(
                     "; it fits {} second order ({} base rows of {other})",
-                    if second_order { "a design without" } else { "a design with" },
+                    if second_order {
+                        "a design without"
+                    } else {
+                        "a design with"
+                    },
                     rows / other
                 )
             } else {
@@ -89,7 +89,11 @@ impl DesignLayout {
                 detail: format!(
                     "expected a multiple of {stride} (N x ({}){}){hint}",
                     if second_order { "2d + 2" } else { "d + 2" },
-                    if second_order { ", with second order" } else { "" },
+                    if second_order {
+                        ", with second order"
+                    } else {
+                        ""
+                    },
                 ),
             });
         }
@@ -165,11 +169,19 @@ impl DesignLayout {
             let (ra, rb) = (a.row(j), b.row(j));
             data.extend_from_slice(ra);
             for i in 0..d {
-                data.extend(ra.iter().enumerate().map(|(k, &x)| if k == i { rb[k] } else { x }));
+                data.extend(
+                    ra.iter()
+                        .enumerate()
+                        .map(|(k, &x)| if k == i { rb[k] } else { x }),
+                );
             }
             if self.second_order {
                 for i in 0..d {
-                    data.extend(rb.iter().enumerate().map(|(k, &x)| if k == i { ra[k] } else { x }));
+                    data.extend(
+                        rb.iter()
+                            .enumerate()
+                            .map(|(k, &x)| if k == i { ra[k] } else { x }),
+                    );
                 }
             }
             data.extend_from_slice(rb);
@@ -223,10 +235,18 @@ impl DesignLayout {
                                 detail: format!(
                                     "a {name}_{i} row should copy {source} row {} here ({expected}) but holds {}; \
                                      the rows are not in the Saltelli/SALib order for {} parameters{}",
-                                    if source == "A" { self.a_row(j) } else { self.b_row(j) },
+                                    if source == "A" {
+                                        self.a_row(j)
+                                    } else {
+                                        self.b_row(j)
+                                    },
                                     r[k],
                                     self.d,
-                                    if self.second_order { " with second order" } else { "" }
+                                    if self.second_order {
+                                        " with second order"
+                                    } else {
+                                        ""
+                                    }
                                 ),
                             });
                         }

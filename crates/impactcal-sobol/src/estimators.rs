@@ -100,7 +100,9 @@ pub(crate) fn first_order(
         }
         FirstOrderEstimator::Martinez2011 => {
             let cov = 0.5 * (s.qb + p.qx - p.e3) - s.mb * p.mx;
-            let sd = ((s.qb - s.mb * s.mb) * (p.qx - p.mx * p.mx)).max(0.0).sqrt();
+            let sd = ((s.qb - s.mb * s.mb) * (p.qx - p.mx * p.mx))
+                .max(0.0)
+                .sqrt();
             (cov, sd)
         }
     }
@@ -118,7 +120,9 @@ pub(crate) fn total(est: TotalEstimator, s: &SharedMoments, p: &ParamMoments) ->
         }
         TotalEstimator::Martinez2011 => {
             let cov = 0.5 * (s.qa + p.qx - p.e2) - s.ma * p.mx;
-            let sd = ((s.qa - s.ma * s.ma) * (p.qx - p.mx * p.mx)).max(0.0).sqrt();
+            let sd = ((s.qa - s.ma * s.ma) * (p.qx - p.mx * p.mx))
+                .max(0.0)
+                .sqrt();
             (sd - cov, sd)
         }
     }

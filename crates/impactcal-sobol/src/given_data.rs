@@ -115,16 +115,14 @@ pub fn given_data_first_order(
             k % d
         )));
     }
-    let names = |given: &Option<Vec<String>>, prefix: &str, count: usize, what: &str| {
-        match given {
-            Some(v) if v.len() != count => Err(SobolError::Mismatch {
-                what: format!("number of {what} names"),
-                expected: count,
-                found: v.len(),
-            }),
-            Some(v) => Ok(v.clone()),
-            None => Ok((1..=count).map(|k| format!("{prefix}{k}")).collect()),
-        }
+    let names = |given: &Option<Vec<String>>, prefix: &str, count: usize, what: &str| match given {
+        Some(v) if v.len() != count => Err(SobolError::Mismatch {
+            what: format!("number of {what} names"),
+            expected: count,
+            found: v.len(),
+        }),
+        Some(v) => Ok(v.clone()),
+        None => Ok((1..=count).map(|k| format!("{prefix}{k}")).collect()),
     };
     let parameters = names(&options.parameter_names, "x", d, "parameter")?;
     let output_names = names(&options.output_names, "y", cols, "output")?;

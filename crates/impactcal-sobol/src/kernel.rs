@@ -62,7 +62,11 @@ pub(crate) struct ItemSums {
 
 /// Splits the resamples into blocks whose accumulators fit [`ACC_BYTES`], and into enough
 /// blocks to keep every thread busy when there are few tiles.
-pub(crate) fn group_blocks(plan: &Plan, groups: usize, tiles: usize) -> Vec<std::ops::Range<usize>> {
+pub(crate) fn group_blocks(
+    plan: &Plan,
+    groups: usize,
+    tiles: usize,
+) -> Vec<std::ops::Range<usize>> {
     let per_group = plan.terms() * TILE * 8;
     let by_cache = (ACC_BYTES / per_group).max(1);
     let threads = rayon::current_num_threads().max(1);
@@ -120,7 +124,8 @@ fn accumulate_item(
     let mu = &centre[t0..t0 + w];
     let row = |r: usize| &data[r * cols + t0..r * cols + t0 + w];
     for j in 0..layout.n() {
-        let wrow = &weights.data[j * weights.groups + groups.start..j * weights.groups + groups.end];
+        let wrow =
+            &weights.data[j * weights.groups + groups.start..j * weights.groups + groups.end];
         if wrow.iter().all(|&x| x == 0.0) {
             continue;
         }

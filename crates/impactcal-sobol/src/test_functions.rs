@@ -51,7 +51,10 @@ pub fn g_function(x: &[f64], a: &[f64]) -> f64 {
 /// Exact indices of [`g_function`]: `V_i = 1 / (3 (1 + a_i)^2)`, `V = prod (1 + V_i) - 1`,
 /// `S_i = V_i / V`, `ST_i = V_i prod_(k != i) (1 + V_k) / V`, `S_ik = V_i V_k / V`.
 pub fn g_function_indices(a: &[f64]) -> ExactIndices {
-    let vi: Vec<f64> = a.iter().map(|ai| 1.0 / (3.0 * (1.0 + ai).powi(2))).collect();
+    let vi: Vec<f64> = a
+        .iter()
+        .map(|ai| 1.0 / (3.0 * (1.0 + ai).powi(2)))
+        .collect();
     let prod: f64 = vi.iter().map(|v| 1.0 + v).product();
     let v = prod - 1.0;
     let d = a.len();
@@ -74,7 +77,11 @@ pub fn g_function_indices(a: &[f64]) -> ExactIndices {
 /// Exact indices of the linear model `y = sum_i c_i x_i` with `x_i ~ U(l_i, u_i)`:
 /// `S_i = ST_i = c_i^2 w_i^2 / sum_k c_k^2 w_k^2`, `w_i = u_i - l_i`.
 pub fn linear_indices(c: &[f64], widths: &[f64]) -> ExactIndices {
-    let parts: Vec<f64> = c.iter().zip(widths).map(|(c, w)| c * c * w * w / 12.0).collect();
+    let parts: Vec<f64> = c
+        .iter()
+        .zip(widths)
+        .map(|(c, w)| c * c * w * w / 12.0)
+        .collect();
     let v: f64 = parts.iter().sum();
     let s: Vec<f64> = parts.iter().map(|p| p / v).collect();
     ExactIndices {

@@ -1,5 +1,10 @@
 //! Indices against exact values of analytic test functions (sobol.md §3).
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::float_cmp,
+    clippy::needless_range_loop
+)]
 
 use std::f64::consts::PI;
 
@@ -9,8 +14,8 @@ use impactcal_sobol::test_functions::{
     g_function, g_function_indices, ishigami, ishigami_indices, linear_indices,
 };
 use impactcal_sobol::{
-    FirstOrderEstimator, GivenDataOptions, OutputView, SaltelliDesign, SobolIndices,
-    SobolOptions, TotalEstimator, analyze, given_data_first_order, replicate_spread,
+    FirstOrderEstimator, GivenDataOptions, OutputView, SaltelliDesign, SobolIndices, SobolOptions,
+    TotalEstimator, analyze, given_data_first_order, replicate_spread,
 };
 
 fn space(bounds: &[(f64, f64)]) -> ParameterSpace {
@@ -48,7 +53,10 @@ fn run(
 
 fn assert_close(what: &str, got: &[f64], exact: &[f64], tol: f64) {
     for (i, (g, e)) in got.iter().zip(exact).enumerate() {
-        assert!((g - e).abs() < tol, "{what}[{i}] = {g}, exact {e} (tol {tol})");
+        assert!(
+            (g - e).abs() < tol,
+            "{what}[{i}] = {g}, exact {e} (tol {tol})"
+        );
     }
 }
 
@@ -58,9 +66,15 @@ fn assert_close(what: &str, got: &[f64], exact: &[f64], tol: f64) {
 fn ishigami_within_001_at_n_8192() {
     let exact = ishigami_indices(7.0, 0.1);
     for seed in [1, 2, 3] {
-        let d = SaltelliDesign::generate(&ishigami_space(), 8192, Method::ScrambledSobol, false, seed)
-            .unwrap();
-        let s = run(&d, 1, |x, y| y[0] = ishigami(x, 7.0, 0.1), &SobolOptions::default());
+        let d =
+            SaltelliDesign::generate(&ishigami_space(), 8192, Method::ScrambledSobol, false, seed)
+                .unwrap();
+        let s = run(
+            &d,
+            1,
+            |x, y| y[0] = ishigami(x, 7.0, 0.1),
+            &SobolOptions::default(),
+        );
         assert_close("S1", &s.first_order[0], &exact.first_order, 0.01);
         assert_close("ST", &s.total[0], &exact.total, 0.01);
         assert!((s.variance[0] - exact.variance).abs() < 0.01 * exact.variance);
@@ -93,7 +107,12 @@ fn ishigami_second_order_and_other_estimators() {
             ..SobolOptions::default()
         };
         let s = run(&d, 1, |x, y| y[0] = ishigami(x, 7.0, 0.1), &o);
-        assert_close(&format!("S1 {first:?}"), &s.first_order[0], &exact.first_order, 0.015);
+        assert_close(
+            &format!("S1 {first:?}"),
+            &s.first_order[0],
+            &exact.first_order,
+            0.015,
+        );
         assert_close(&format!("ST {total:?}"), &s.total[0], &exact.total, 0.015);
         let s2 = s.second_order.as_ref().unwrap();
         for i in 0..3 {
@@ -115,9 +134,20 @@ fn g_function_within_001() {
     let exact = g_function_indices(&a);
     assert!((exact.variance - 0.568_071).abs() < 1e-6);
     assert!((exact.first_order[0] - 0.58678).abs() < 1e-5);
-    let d = SaltelliDesign::generate(&space(&[(0.0, 1.0); 6]), 8192, Method::ScrambledSobol, false, 3)
-        .unwrap();
-    let s = run(&d, 1, |x, y| y[0] = g_function(x, &a), &SobolOptions::default());
+    let d = SaltelliDesign::generate(
+        &space(&[(0.0, 1.0); 6]),
+        8192,
+        Method::ScrambledSobol,
+        false,
+        3,
+    )
+    .unwrap();
+    let s = run(
+        &d,
+        1,
+        |x, y| y[0] = g_function(x, &a),
+        &SobolOptions::default(),
+    );
     assert_close("S1", &s.first_order[0], &exact.first_order, 0.01);
     assert_close("ST", &s.total[0], &exact.total, 0.01);
 }
@@ -149,8 +179,8 @@ fn linear_model_sums_to_one() {
         .unwrap()
         .points;
     let y: Vec<f64> = lhs.rows().map(f).collect();
-    let g = given_data_first_order(&lhs, OutputView::column(&y), &GivenDataOptions::default())
-        .unwrap();
+    let g =
+        given_data_first_order(&lhs, OutputView::column(&y), &GivenDataOptions::default()).unwrap();
     assert_eq!(g.bins, 16);
     assert_close("given-data S1", &g.first_order[0], &exact.first_order, 0.02);
     let sum: f64 = g.normalised_first_order_share[0].iter().sum();
@@ -166,8 +196,8 @@ fn given_data_on_ishigami() {
         .unwrap()
         .points;
     let y: Vec<f64> = x.rows().map(|x| ishigami(x, 7.0, 0.1)).collect();
-    let g = given_data_first_order(&x, OutputView::column(&y), &GivenDataOptions::default())
-        .unwrap();
+    let g =
+        given_data_first_order(&x, OutputView::column(&y), &GivenDataOptions::default()).unwrap();
     assert_close("S1", &g.first_order[0], &exact.first_order, 0.03);
     assert!(g.first_order[0][2].abs() < 0.005);
     assert!(g.first_order_uncorrected[0][2] > g.first_order[0][2]);
@@ -206,7 +236,12 @@ fn time_dependent_ishigami() {
     for k in 0..steps {
         let (a, b) = ab(k);
         let exact = ishigami_indices(a, b);
-        assert_close(&format!("S1(t{k})"), &s.first_order[k], &exact.first_order, 0.012);
+        assert_close(
+            &format!("S1(t{k})"),
+            &s.first_order[k],
+            &exact.first_order,
+            0.012,
+        );
         assert_close(&format!("ST(t{k})"), &s.total[k], &exact.total, 0.012);
         for i in 0..3 {
             num_first[i] += exact.first_order[i] * exact.variance;
@@ -253,7 +288,10 @@ fn bootstrap_intervals_are_coherent_and_reproducible() {
             let d = SaltelliDesign::generate(&ishigami_space(), n, Method::Random, false, seed)
                 .unwrap();
             let s = run(&d, 1, |x, y| y[0] = ishigami(x, 7.0, 0.1), &options);
-            let (c1, ct) = (s.first_order_ci.as_ref().unwrap(), s.total_ci.as_ref().unwrap());
+            let (c1, ct) = (
+                s.first_order_ci.as_ref().unwrap(),
+                s.total_ci.as_ref().unwrap(),
+            );
             for i in 0..3 {
                 for (ci, e) in [(c1[0][i], exact.first_order[i]), (ct[0][i], exact.total[i])] {
                     covered += u32::from(ci[0] < e && e < ci[1]);
@@ -264,16 +302,28 @@ fn bootstrap_intervals_are_coherent_and_reproducible() {
         }
     }
     let coverage = f64::from(covered) / f64::from(total);
-    assert!((0.85..=1.0).contains(&coverage), "coverage {coverage} of nominal 0.95");
+    assert!(
+        (0.85..=1.0).contains(&coverage),
+        "coverage {coverage} of nominal 0.95"
+    );
     // 16 times the rows: intervals 4 times narrower (mean widths over the first 4 seeds
     // at N = 256 are estimated from 40 seeds, so scale).
     let ratio = (widths[0] / 40.0) / (widths[1] / 4.0);
-    assert!((3.0..5.5).contains(&ratio), "width ratio {ratio} (expect 4)");
+    assert!(
+        (3.0..5.5).contains(&ratio),
+        "width ratio {ratio} (expect 4)"
+    );
 
-    let d = SaltelliDesign::generate(&ishigami_space(), 256, Method::ScrambledSobol, true, 3)
+    let d =
+        SaltelliDesign::generate(&ishigami_space(), 256, Method::ScrambledSobol, true, 3).unwrap();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
         .unwrap();
-    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-    let four = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
+    let four = rayon::ThreadPoolBuilder::new()
+        .num_threads(4)
+        .build()
+        .unwrap();
     let f = |x: &[f64], y: &mut [f64]| {
         y[0] = ishigami(x, 7.0, 0.1);
         y[1] = x[0] * x[1];
@@ -291,16 +341,33 @@ fn replicates_over_scramblings() {
     let exact = ishigami_indices(7.0, 0.1);
     let reps: Vec<SobolIndices> = (0..8)
         .map(|seed| {
-            let d = SaltelliDesign::generate(&ishigami_space(), 1024, Method::ScrambledSobol, false, seed)
-                .unwrap();
-            run(&d, 1, |x, y| y[0] = ishigami(x, 7.0, 0.1), &SobolOptions::default())
+            let d = SaltelliDesign::generate(
+                &ishigami_space(),
+                1024,
+                Method::ScrambledSobol,
+                false,
+                seed,
+            )
+            .unwrap();
+            run(
+                &d,
+                1,
+                |x, y| y[0] = ishigami(x, 7.0, 0.1),
+                &SobolOptions::default(),
+            )
         })
         .collect();
     let spread = replicate_spread(&reps, 0.99).unwrap();
     for i in 0..3 {
         let (c, t) = (spread.first_order_ci[0][i], spread.total_ci[0][i]);
-        assert!(c[0] < exact.first_order[i] && exact.first_order[i] < c[1], "S{i}: {c:?}");
-        assert!(t[0] < exact.total[i] && exact.total[i] < t[1], "ST{i}: {t:?}");
+        assert!(
+            c[0] < exact.first_order[i] && exact.first_order[i] < c[1],
+            "S{i}: {c:?}"
+        );
+        assert!(
+            t[0] < exact.total[i] && exact.total[i] < t[1],
+            "ST{i}: {t:?}"
+        );
         assert!(spread.first_order_se[0][i] < 0.01);
     }
     assert!(replicate_spread(&reps[..1], 0.9).is_err());
