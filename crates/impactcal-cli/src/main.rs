@@ -5,6 +5,8 @@
 
 mod error;
 mod output;
+mod sample;
+mod sobol;
 
 use std::process::ExitCode;
 
@@ -21,10 +23,18 @@ struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
-enum Command {}
+enum Command {
+    /// Space-filling samples (Halton, Sobol', Latin hypercubes) and Saltelli designs.
+    Sample(sample::Args),
+    /// Sobol' sensitivity indices of every output column.
+    Sobol(sobol::Args),
+}
 
 fn run(command: Command) -> Result<(), CliError> {
-    match command {}
+    match command {
+        Command::Sample(args) => sample::run(args),
+        Command::Sobol(args) => sobol::run(args),
+    }
 }
 
 fn main() -> ExitCode {
