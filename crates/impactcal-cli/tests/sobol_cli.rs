@@ -1,5 +1,5 @@
 //! `impactcal sample` and `impactcal sobol` end to end on files.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::needless_range_loop)]
 
 use std::path::Path;
 use std::process::Command;
