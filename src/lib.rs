@@ -8,6 +8,17 @@
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
 //! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals |
 //!
+//! ```
+//! use impactcal::prelude::*;
+//!
+//! let h = Histories::parse_csv("time,1.z,2.z\n0,0,0\n1,1,2\n2,2,4\n", "inline")?;
+//! let shapes = ImpactShapes::from_histories(&h, &ShapeOptions::default())?;
+//! // Two proportional channels: one shape carries everything.
+//! assert_eq!(shapes.len(), 1);
+//! assert!((shapes.contributions()[0] - 1.0).abs() < 1e-12);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 
 pub use impactcal_core as core;
 pub use impactcal_shapes as shapes;
@@ -18,6 +29,9 @@ pub mod prelude {
     pub use impactcal_core::{
         BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
         TableOptions,
+    };
+    pub use impactcal_shapes::{
+        Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
     };
     pub use impactcal_sobol::{
         DesignLayout, OutputView, SaltelliDesign, SobolError, SobolIndices, SobolOptions,

@@ -3,9 +3,12 @@
 //! Each subcommand lives in its own module with an `Args` struct (clap) and a `run`
 //! function; this file only registers them. Numerical work happens in the library.
 
+mod compare;
 mod error;
+mod expand;
 mod output;
 mod sample;
+mod shapes;
 mod sobol;
 
 use std::process::ExitCode;
@@ -24,6 +27,13 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Impact shapes (SVD) of a histories file: singular values, contributions, shapes and
+    /// time functions as JSON.
+    Shapes(shapes::Args),
+    /// Calibration metric M2: orthogonality and pairing of test and analysis impact shapes.
+    Compare(compare::Args),
+    /// Expand measured channels to the unmeasured channels of a model through its shapes.
+    Expand(expand::Args),
     /// Space-filling samples (Halton, Sobol', Latin hypercubes) and Saltelli designs.
     Sample(sample::Args),
     /// Sobol' sensitivity indices of every output column.
@@ -32,8 +42,11 @@ enum Command {
 
 fn run(command: Command) -> Result<(), CliError> {
     match command {
-        Command::Sample(args) => sample::run(args),
-        Command::Sobol(args) => sobol::run(args),
+        Command::Shapes(a) => shapes::run(a),
+        Command::Compare(a) => compare::run(a),
+        Command::Expand(a) => expand::run(a),
+        Command::Sample(a) => sample::run(a),
+        Command::Sobol(a) => sobol::run(a),
     }
 }
 

@@ -38,4 +38,4 @@ pub use histories::Histories;
 pub use model::{BatchResults, Model, RunFailure};
 pub use sampling::{Method as SamplingMethod, Points};
 pub use space::{Parameter, ParameterSpace};
-pub use table::{Table, TableOptions};
+pub use table::{Table, TableOptions, read_text};
