@@ -183,7 +183,8 @@ pub struct SobolIndices {
     pub variance: Vec<f64>,
     /// `normalised_first_order_share[t][i] = max(S_i, 0) / sum_j max(S_j, 0)`: each
     /// parameter's share of the sum of first-order effects, which sums to 1 by construction
-    /// (the quantity the source paper plots). It equals `S_i` only for additive outputs.
+    /// (the quantity the source paper plots). It equals `S_i` only for additive outputs; NaN
+    /// where no parameter has a positive first-order index.
     pub normalised_first_order_share: Vec<Vec<f64>>,
     /// `interaction_share[t] = 1 - sum_i S_i(t)`: the variance share of interactions.
     pub interaction_share: Vec<f64>,
