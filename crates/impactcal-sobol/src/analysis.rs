@@ -319,23 +319,24 @@ fn column_means(outputs: &OutputView<'_>) -> Result<Vec<f64>> {
 /// stream, so each resample is fixed by the seed alone.
 fn resample_weights(n: usize, resamples: usize, seed: u64) -> Weights {
     let groups = resamples + 1;
-    let counts: Vec<Vec<u32>> = (0..resamples)
+    let counts: Vec<Vec<u16>> = (0..resamples)
         .into_par_iter()
         .map(|g| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             rng.set_stream(g as u64 + 1);
-            let mut c = vec![0u32; n];
+            let mut c = vec![0u16; n];
             for _ in 0..n {
-                c[rng.random_range(0..n)] += 1;
+                let k = rng.random_range(0..n);
+                c[k] = c[k].saturating_add(1);
             }
             c
         })
         .collect();
-    let mut data = vec![0.0; n * groups];
+    let mut data = vec![0u16; n * groups];
     for j in 0..n {
-        data[j * groups] = 1.0;
+        data[j * groups] = 1;
         for (g, c) in counts.iter().enumerate() {
-            data[j * groups + g + 1] = f64::from(c[j]);
+            data[j * groups + g + 1] = c[j];
         }
     }
     Weights { groups, data }

@@ -46,10 +46,11 @@ impl Plan {
 }
 
 /// Resampling weights: `weights[j * groups + g]` is how many times resample `g` drew base
-/// row `j` (`g = 0` is the point estimate, weight 1 everywhere).
+/// row `j` (`g = 0` is the point estimate, weight 1 everywhere). Stored as `u16`: a count
+/// is Binomial(N, 1/N), about Poisson(1), so it never comes near 65 535.
 pub(crate) struct Weights {
     pub groups: usize,
-    pub data: Vec<f64>,
+    pub data: Vec<u16>,
 }
 
 /// The sums of one work item: `acc[(g - g0) * terms * width + k * width + t]`.
@@ -126,7 +127,7 @@ fn accumulate_item(
     for j in 0..layout.n() {
         let wrow =
             &weights.data[j * weights.groups + groups.start..j * weights.groups + groups.end];
-        if wrow.iter().all(|&x| x == 0.0) {
+        if wrow.iter().all(|&x| x == 0) {
             continue;
         }
         let (ra, rb) = (row(layout.a_row(j)), row(layout.b_row(j)));
@@ -185,9 +186,10 @@ fn accumulate_item(
             }
         }
         for (g, &weight) in wrow.iter().enumerate() {
-            if weight == 0.0 {
+            if weight == 0 {
                 continue;
             }
+            let weight = f64::from(weight);
             let target = &mut acc[g * k_terms * w..(g + 1) * k_terms * w];
             for (s, &v) in target.iter_mut().zip(&scratch) {
                 *s += weight * v;
