@@ -6,6 +6,8 @@
 //! |---|---|---|
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
+//! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
+//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
 //! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals |
 //!
 //! ```
@@ -21,7 +23,9 @@
 //!
 
 pub use impactcal_core as core;
+pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
+pub use impactcal_shell as shell;
 pub use impactcal_sobol as sobol;
 
 /// The types most programs need, in one import.
@@ -30,9 +34,14 @@ pub mod prelude {
         BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
         TableOptions,
     };
+    pub use impactcal_sensors::{
+        CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,
+        place_from_histories,
+    };
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
     };
+    pub use impactcal_shell::{ShellError, ShellModel, Simulation};
     pub use impactcal_sobol::{
         DesignLayout, OutputView, SaltelliDesign, SobolError, SobolIndices, SobolOptions,
     };

@@ -7,8 +7,10 @@ mod compare;
 mod error;
 mod expand;
 mod output;
+mod place;
 mod sample;
 mod shapes;
+mod simulate;
 mod sobol;
 
 use std::process::ExitCode;
@@ -34,6 +36,12 @@ enum Command {
     Compare(compare::Args),
     /// Expand measured channels to the unmeasured channels of a model through its shapes.
     Expand(expand::Args),
+    /// Sensor placement by effective independence (Kammer) on impact shapes or a shape
+    /// matrix.
+    Place(place::Args),
+    /// Run an LS-DYNA keyword deck with the built-in explicit shell solver; write nodal
+    /// histories and energies as CSV.
+    Simulate(simulate::Args),
     /// Space-filling samples (Halton, Sobol', Latin hypercubes) and Saltelli designs.
     Sample(sample::Args),
     /// Sobol' sensitivity indices of every output column.
@@ -45,6 +53,8 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Shapes(a) => shapes::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
+        Command::Place(a) => place::run(a),
+        Command::Simulate(a) => simulate::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Sobol(a) => sobol::run(a),
     }

@@ -1,0 +1,351 @@
+//! Writing keyword decks.
+
+use std::path::Path;
+
+use crate::error::{Result, ShellError};
+use crate::model::{
+    HourglassForm, MaterialLaw, NodeTarget, ShellModel, ThicknessRule, VelocityTarget, WallMethod,
+};
+
+/// Formats `v` right-aligned in `w` characters with as many digits as fit; the shortest
+/// exact representation when it fits.
+fn real(v: f64, w: usize) -> String {
+    let exact = format!("{v}");
+    let exact = if exact.contains('.') || exact.contains('e') || exact.contains("inf") {
+        exact
+    } else {
+        format!("{exact}.")
+    };
+    if exact.len() <= w {
+        return format!("{exact:>w$}");
+    }
+    for p in (0..w).rev() {
+        let s = format!("{v:.p$e}");
+        if s.len() <= w {
+            return format!("{s:>w$}");
+        }
+    }
+    format!("{v:>w$e}")
+}
+
+fn int(v: u64, w: usize) -> String {
+    format!("{v:>w$}")
+}
+
+fn unrepresentable(what: impl Into<String>, why: &str) -> ShellError {
+    ShellError::value(what, format!("cannot be written as a keyword deck: {why}"))
+}
+
+/// Writes `model` as a keyword deck (fixed-width cards) that [`super::parse_deck`] reads
+/// back into an equal model (values that need more digits than a field holds are rounded to
+/// the field).
+///
+/// # Errors
+/// [`ShellError::Value`] for model features the supported keywords cannot express: Lobatto
+/// thickness integration, penalty walls, a fixed time step, different hourglass
+/// coefficients per mode, initial spins on single nodes or on all nodes, an ids too large
+/// for its field.
+pub fn write_deck(model: &ShellModel) -> Result<String> {
+    let mut s = String::new();
+    let mut w = |line: String| {
+        s.push_str(line.trim_end());
+        s.push('\n');
+    };
+    w("*KEYWORD".into());
+    w("*TITLE".into());
+    w(model.title.clone());
+    let c = &model.control;
+    if c.fixed_dt.is_some() {
+        return Err(unrepresentable("control", "a fixed time step"));
+    }
+    w("*CONTROL_TERMINATION".into());
+    w(format!(
+        "{}{}{}",
+        real(c.end_time, 10),
+        int(c.end_cycles, 10),
+        real(c.dtmin_factor, 10)
+    ));
+    w("*CONTROL_TIMESTEP".into());
+    w(format!(
+        "{}{}{}",
+        real(0.0, 10),
+        real(c.tssfac, 10),
+        int(u64::from(c.isdo_diagonal), 10)
+    ));
+    let hg = &model.hourglass;
+    if hg.membrane != hg.transverse || hg.membrane != hg.rotation {
+        return Err(unrepresentable(
+            "hourglass",
+            "different coefficients per mode",
+        ));
+    }
+    w("*CONTROL_HOURGLASS".into());
+    let ihq = match hg.form {
+        HourglassForm::Viscous => 1,
+        HourglassForm::Stiffness => 4,
+    };
+    w(format!("{}{}", int(ihq, 10), real(hg.membrane, 10)));
+    if model.damping != 0.0 {
+        w("*DAMPING_GLOBAL".into());
+        w(format!("{}{}", int(0, 10), real(model.damping, 10)));
+    }
+    if model.output.interval > 0.0 {
+        w("*DATABASE_NODOUT".into());
+        w(real(model.output.interval, 10));
+    }
+    if !model.output.history_nodes.is_empty() {
+        w("*DATABASE_HISTORY_NODE".into());
+        for chunk in model.output.history_nodes.chunks(8) {
+            w(chunk.iter().map(|&n| int(n, 10)).collect());
+        }
+    }
+    for m in &model.materials {
+        match m.law {
+            MaterialLaw::Elastic => {
+                w("*MAT_ELASTIC".into());
+                w(format!(
+                    "{}{}{}{}",
+                    int(m.id, 10),
+                    real(m.density, 10),
+                    real(m.youngs, 10),
+                    real(m.poisson, 10)
+                ));
+            }
+            MaterialLaw::Plastic {
+                yield_stress,
+                tangent_modulus,
+                rate,
+            } => {
+                w("*MAT_PLASTIC_KINEMATIC".into());
+                w(format!(
+                    "{}{}{}{}{}{}{}",
+                    int(m.id, 10),
+                    real(m.density, 10),
+                    real(m.youngs, 10),
+                    real(m.poisson, 10),
+                    real(yield_stress, 10),
+                    real(tangent_modulus, 10),
+                    real(1.0, 10)
+                ));
+                let (c, p) = rate.map_or((0.0, 0.0), |r| (r.c, r.p));
+                w(format!("{}{}", real(c, 10), real(p, 10)));
+            }
+        }
+    }
+    for sec in &model.sections {
+        if sec.rule == ThicknessRule::Lobatto {
+            return Err(unrepresentable(
+                format!("section {}", sec.id),
+                "Lobatto integration",
+            ));
+        }
+        w("*SECTION_SHELL".into());
+        w(format!(
+            "{}{}{}{}",
+            int(sec.id, 10),
+            int(2, 10),
+            real(sec.shear_factor, 10),
+            int(sec.nip as u64, 10)
+        ));
+        let t = real(sec.thickness, 10);
+        w(format!("{t}{t}{t}{t}"));
+    }
+    for p in &model.parts {
+        w("*PART".into());
+        w(p.title.clone());
+        w(format!(
+            "{}{}{}",
+            int(p.id, 10),
+            int(p.section, 10),
+            int(p.material, 10)
+        ));
+    }
+    for c in &model.curves {
+        w("*DEFINE_CURVE".into());
+        w(format!(
+            "{}{}{}{}{}{}",
+            int(c.id, 10),
+            int(0, 10),
+            real(c.sfa, 10),
+            real(c.sfo, 10),
+            real(c.offa, 10),
+            real(c.offo, 10)
+        ));
+        for &(a, o) in &c.points {
+            w(format!("{}{}", real(a, 20), real(o, 20)));
+        }
+    }
+    if let Some(b) = &model.body_load_z {
+        w("*LOAD_BODY_Z".into());
+        w(format!("{}{}", int(b.curve, 10), real(b.scale, 10)));
+    }
+    for set in &model.node_sets {
+        w("*SET_NODE_LIST".into());
+        w(int(set.id, 10));
+        for chunk in set.nodes.chunks(8) {
+            w(chunk.iter().map(|&n| int(n, 10)).collect());
+        }
+    }
+    check_width(model)?;
+    w("*NODE".into());
+    for n in &model.nodes {
+        w(format!(
+            "{}{}{}{}",
+            int(n.id, 8),
+            real(n.x[0], 16),
+            real(n.x[1], 16),
+            real(n.x[2], 16)
+        ));
+    }
+    w("*ELEMENT_SHELL".into());
+    for e in &model.shells {
+        w(format!(
+            "{}{}{}{}{}{}",
+            int(e.id, 8),
+            int(e.part, 8),
+            int(e.nodes[0], 8),
+            int(e.nodes[1], 8),
+            int(e.nodes[2], 8),
+            int(e.nodes[3], 8)
+        ));
+    }
+    if !model.masses.is_empty() {
+        w("*ELEMENT_MASS".into());
+        for m in &model.masses {
+            w(format!(
+                "{}{}{}",
+                int(m.id, 8),
+                int(m.node, 8),
+                real(m.mass, 16)
+            ));
+        }
+    }
+    for spc in &model.spcs {
+        let (kw, id) = match spc.target {
+            NodeTarget::Node(n) => ("*BOUNDARY_SPC_NODE", n),
+            NodeTarget::NodeSet(s) => ("*BOUNDARY_SPC_SET", s),
+        };
+        w(kw.into());
+        let dofs: String = spc.dofs.iter().map(|&d| int(u64::from(d), 10)).collect();
+        w(format!("{}{}{dofs}", int(id, 10), int(0, 10)));
+    }
+    for (k, iv) in model.initial_velocities.iter().enumerate() {
+        let v = |a: [f64; 3]| -> String { a.iter().map(|&c| real(c, 10)).collect() };
+        let spin = iv.omega != 0.0;
+        match (iv.target, spin) {
+            (VelocityTarget::Node(n), false) => {
+                w("*INITIAL_VELOCITY_NODE".into());
+                w(format!(
+                    "{}{}{}",
+                    int(n, 10),
+                    v(iv.translation),
+                    v(iv.rotation)
+                ));
+            }
+            (VelocityTarget::All, false) | (VelocityTarget::NodeSet(_), false) => {
+                let nsid = match iv.target {
+                    VelocityTarget::NodeSet(s) => s,
+                    _ => 0,
+                };
+                w("*INITIAL_VELOCITY".into());
+                w(int(nsid, 10));
+                w(format!("{}{}", v(iv.translation), v(iv.rotation)));
+            }
+            (VelocityTarget::Part(_), _) | (VelocityTarget::NodeSet(_), true) => {
+                let (id, styp) = match iv.target {
+                    VelocityTarget::Part(p) => (p, 2),
+                    VelocityTarget::NodeSet(s) => (s, 3),
+                    _ => (0, 0),
+                };
+                if iv.rotation != [0.0; 3] {
+                    return Err(unrepresentable(
+                        format!("initial velocity {}", k + 1),
+                        "nodal rotations with a generation",
+                    ));
+                }
+                w("*INITIAL_VELOCITY_GENERATION".into());
+                w(format!(
+                    "{}{}{}{}",
+                    int(id, 10),
+                    int(styp, 10),
+                    real(iv.omega, 10),
+                    v(iv.translation)
+                ));
+                w(format!("{}{}", v(iv.centre), v(iv.axis)));
+            }
+            (_, true) => {
+                return Err(unrepresentable(
+                    format!("initial velocity {}", k + 1),
+                    "a spin needs a part or node set target",
+                ));
+            }
+        }
+    }
+    for (k, wall) in model.walls.iter().enumerate() {
+        if let WallMethod::Penalty { .. } = wall.method {
+            return Err(unrepresentable(
+                format!("rigid wall {}", k + 1),
+                "penalty enforcement",
+            ));
+        }
+        if !(wall.friction.is_infinite() || wall.friction < 1.0) {
+            return Err(unrepresentable(
+                format!("rigid wall {}", k + 1),
+                "friction >= 1 (FRIC = 1 means no sliding)",
+            ));
+        }
+        w("*RIGIDWALL_PLANAR".into());
+        w(int(wall.nodes.unwrap_or(0), 10));
+        let fric = if wall.friction.is_infinite() {
+            1.0
+        } else {
+            wall.friction
+        };
+        let p: String = wall
+            .point
+            .iter()
+            .chain(&wall.head)
+            .map(|&c| real(c, 10))
+            .collect();
+        w(format!("{p}{}", real(fric, 10)));
+    }
+    w("*END".into());
+    Ok(s)
+}
+
+fn check_width(model: &ShellModel) -> Result<()> {
+    let max8 = 99_999_999;
+    let too_big = model
+        .nodes
+        .iter()
+        .map(|n| n.id)
+        .chain(
+            model
+                .shells
+                .iter()
+                .flat_map(|e| [e.id, e.part, e.nodes[0], e.nodes[1], e.nodes[2], e.nodes[3]]),
+        )
+        .chain(model.masses.iter().flat_map(|m| [m.id, m.node]))
+        .find(|&id| id > max8);
+    match too_big {
+        Some(id) => Err(unrepresentable(
+            format!("id {id}"),
+            "ids above 99999999 do not fit an 8-character field",
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Writes `model` to a deck file (see [`write_deck`]).
+///
+/// # Errors
+/// As [`write_deck`], plus [`ShellError::Io`].
+pub fn write_deck_file(model: &ShellModel, path: impl AsRef<Path>) -> Result<()> {
+    let text = write_deck(model)?;
+    let path = path.as_ref();
+    std::fs::write(path, text).map_err(|source| ShellError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    Ok(())
+}

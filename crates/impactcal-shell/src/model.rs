@@ -1,0 +1,502 @@
+//! The model description: nodes, shells, parts, sections, materials, masses, loads, the
+//! rigid wall, controls and output requests.
+//!
+//! A [`ShellModel`] is plain data with public fields, built in code or read from a keyword
+//! deck ([`crate::keyword`]). Nothing is checked here: [`crate::Simulation::new`] validates
+//! it once (undefined ids, missing nodes, degenerate elements, out-of-range values) and
+//! returns a typed error naming the entity at fault. Ids are the user's (LS-DYNA style,
+//! any positive integers, not necessarily contiguous).
+
+/// A node: id and coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Node {
+    /// Node id.
+    pub id: u64,
+    /// Coordinates `[x, y, z]`.
+    pub x: [f64; 3],
+}
+
+/// A shell element: 4 nodes, or 3 (a triangle, written with `n4 == n3`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shell {
+    /// Element id.
+    pub id: u64,
+    /// Part id.
+    pub part: u64,
+    /// Node ids, counter-clockwise seen from the positive normal; `nodes[3] == nodes[2]`
+    /// makes a triangle.
+    pub nodes: [u64; 4],
+}
+
+impl Shell {
+    /// True when the element is a triangle (`n4 == n3`).
+    pub fn is_triangle(&self) -> bool {
+        self.nodes[3] == self.nodes[2]
+    }
+}
+
+/// A part: a set of shells sharing a section and a material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Part {
+    /// Part id.
+    pub id: u64,
+    /// Free-text title.
+    pub title: String,
+    /// Section id.
+    pub section: u64,
+    /// Material id.
+    pub material: u64,
+}
+
+/// Through-thickness integration rule.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ThicknessRule {
+    /// Gauss-Legendre points (the default).
+    #[default]
+    Gauss,
+    /// Gauss-Lobatto points (points on both surfaces; needs at least 2 points).
+    Lobatto,
+}
+
+/// A shell section: thickness, through-thickness points, shear factor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Section {
+    /// Section id.
+    pub id: u64,
+    /// Shell thickness (length unit), > 0.
+    pub thickness: f64,
+    /// Number of through-thickness integration points, 1 to 10 (1 = membrane only).
+    pub nip: usize,
+    /// Transverse shear correction factor (5/6 by default).
+    pub shear_factor: f64,
+    /// Integration rule through the thickness.
+    pub rule: ThicknessRule,
+}
+
+impl Section {
+    /// A section of thickness `t` with the defaults: 5 Gauss points, shear factor 5/6.
+    pub fn new(id: u64, thickness: f64) -> Self {
+        Section {
+            id,
+            thickness,
+            nip: 5,
+            shear_factor: 5.0 / 6.0,
+            rule: ThicknessRule::Gauss,
+        }
+    }
+}
+
+/// Yield-stress strain-rate scaling of Cowper and Symonds:
+/// `sigma_y,dyn = sigma_y (1 + (rate / c)^(1/p))`, with the element's effective strain rate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CowperSymonds {
+    /// Rate constant C (1/time), > 0.
+    pub c: f64,
+    /// Exponent p, > 0.
+    pub p: f64,
+}
+
+/// The material law of a [`Material`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MaterialLaw {
+    /// Linear elastic (`*MAT_ELASTIC`).
+    Elastic,
+    /// Elastic-plastic, von Mises yield in plane stress, linear isotropic hardening
+    /// (`*MAT_PLASTIC_KINEMATIC` with BETA = 1).
+    Plastic {
+        /// Initial yield stress, > 0.
+        yield_stress: f64,
+        /// Tangent modulus Et of the uniaxial curve, 0 <= Et < E; the plastic modulus is
+        /// `H = E Et / (E - Et)`.
+        tangent_modulus: f64,
+        /// Optional Cowper-Symonds rate scaling.
+        rate: Option<CowperSymonds>,
+    },
+}
+
+/// A material: density, elastic constants and law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Material {
+    /// Material id.
+    pub id: u64,
+    /// Mass density, > 0.
+    pub density: f64,
+    /// Young's modulus, > 0.
+    pub youngs: f64,
+    /// Poisson's ratio, -1 < nu < 0.5.
+    pub poisson: f64,
+    /// The law.
+    pub law: MaterialLaw,
+}
+
+/// A concentrated mass added to a node (`*ELEMENT_MASS`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointMass {
+    /// Element id.
+    pub id: u64,
+    /// Node id.
+    pub node: u64,
+    /// Mass, >= 0.
+    pub mass: f64,
+}
+
+/// A named list of nodes (`*SET_NODE_LIST`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeSet {
+    /// Set id.
+    pub id: u64,
+    /// Node ids.
+    pub nodes: Vec<u64>,
+}
+
+/// Which nodes an initial velocity applies to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum VelocityTarget {
+    /// Every node.
+    All,
+    /// The nodes of a node set.
+    NodeSet(u64),
+    /// One node.
+    Node(u64),
+    /// The nodes of the shells of a part.
+    Part(u64),
+}
+
+/// An initial velocity: `v = translation + omega * axis x (x - centre)` and the nodal
+/// angular velocity `omega * axis + rotation`. Later entries override earlier ones.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InitialVelocity {
+    /// The nodes it applies to.
+    pub target: VelocityTarget,
+    /// Translational velocity.
+    pub translation: [f64; 3],
+    /// Angular velocity vector given to the rotational degrees of freedom (rad/time).
+    pub rotation: [f64; 3],
+    /// Rigid spin rate about `axis` through `centre` (rad/time), 0 for none.
+    pub omega: f64,
+    /// Centre of the rigid spin.
+    pub centre: [f64; 3],
+    /// Unit spin axis (normalised when built).
+    pub axis: [f64; 3],
+}
+
+impl InitialVelocity {
+    /// A pure translational velocity for `target`.
+    pub fn translation(target: VelocityTarget, v: [f64; 3]) -> Self {
+        InitialVelocity {
+            target,
+            translation: v,
+            rotation: [0.0; 3],
+            omega: 0.0,
+            centre: [0.0; 3],
+            axis: [0.0, 0.0, 1.0],
+        }
+    }
+}
+
+/// Which nodes a constraint applies to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum NodeTarget {
+    /// One node.
+    Node(u64),
+    /// The nodes of a node set.
+    NodeSet(u64),
+}
+
+/// A single-point constraint: the flagged degrees of freedom `[x, y, z, rx, ry, rz]` are
+/// held at zero velocity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spc {
+    /// The nodes.
+    pub target: NodeTarget,
+    /// Fixed degrees of freedom: translations x, y, z, rotations x, y, z.
+    pub dofs: [bool; 6],
+}
+
+/// How a rigid wall enforces non-penetration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WallMethod {
+    /// Kinematic constraint (the default): the normal velocity of a node that would cross
+    /// the plane during the next step is set so that it lands on the plane.
+    Kinematic,
+    /// Penalty spring with mass-based stiffness `k = alpha m / dt^2` on penetration.
+    Penalty {
+        /// The stiffness factor alpha (0.1 is a safe choice), 0 < alpha <= 1.
+        alpha: f64,
+    },
+}
+
+/// A stationary rigid plane (`*RIGIDWALL_PLANAR`): nodes may not pass to the negative side
+/// of the plane through `point` with normal `normal` (from tail to head).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidWall {
+    /// The nodes checked: `None` for all nodes (NSID = 0), or a node set.
+    pub nodes: Option<u64>,
+    /// A point of the plane (the tail, XT YT ZT).
+    pub point: [f64; 3],
+    /// The head point (XH YH ZH); the normal is `head - point`.
+    pub head: [f64; 3],
+    /// Coulomb friction coefficient mu >= 0; `f64::INFINITY` (FRIC = 1) forbids sliding.
+    pub friction: f64,
+    /// Enforcement method.
+    pub method: WallMethod,
+}
+
+/// A piecewise-linear curve `(abscissa, ordinate)` with constant extrapolation
+/// (`*DEFINE_CURVE`), with scale factors and offsets as in LS-DYNA:
+/// `f(t) = sfo * g(t / sfa - offa) + offo` where `g` interpolates `points`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curve {
+    /// Curve id.
+    pub id: u64,
+    /// Abscissa scale factor SFA (1 by default).
+    pub sfa: f64,
+    /// Ordinate scale factor SFO (1 by default).
+    pub sfo: f64,
+    /// Abscissa offset OFFA.
+    pub offa: f64,
+    /// Ordinate offset OFFO.
+    pub offo: f64,
+    /// Points, abscissae strictly increasing.
+    pub points: Vec<(f64, f64)>,
+}
+
+impl Curve {
+    /// A curve with unit scales and no offsets.
+    pub fn new(id: u64, points: Vec<(f64, f64)>) -> Self {
+        Curve {
+            id,
+            sfa: 1.0,
+            sfo: 1.0,
+            offa: 0.0,
+            offo: 0.0,
+            points,
+        }
+    }
+
+    /// Evaluates the curve at `t` (linear interpolation, constant outside the points).
+    pub fn eval(&self, t: f64) -> f64 {
+        let s = t / self.sfa - self.offa;
+        let p = &self.points;
+        let g = match p.len() {
+            0 => 0.0,
+            _ if s <= p[0].0 => p[0].1,
+            n if s >= p[n - 1].0 => p[n - 1].1,
+            _ => {
+                let k = p.partition_point(|q| q.0 <= s).saturating_sub(1);
+                let (a, b) = (p[k], p[k + 1]);
+                a.1 + (b.1 - a.1) * (s - a.0) / (b.0 - a.0)
+            }
+        };
+        self.sfo * g + self.offo
+    }
+}
+
+/// Body acceleration along z (`*LOAD_BODY_Z`): every node is accelerated by
+/// `-scale * curve(t)` along z (a positive value pulls toward -z, as gravity does).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyLoadZ {
+    /// Curve id.
+    pub curve: u64,
+    /// Scale factor SF.
+    pub scale: f64,
+}
+
+/// Hourglass control form.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum HourglassForm {
+    /// Stiffness form (LS-DYNA IHQ 4-6), the default: generalised hourglass forces grow
+    /// with the hourglass displacement; conservative.
+    #[default]
+    Stiffness,
+    /// Viscous form (LS-DYNA IHQ 1-3): forces proportional to the hourglass velocity.
+    Viscous,
+}
+
+/// Hourglass control: form and coefficients for the membrane, out-of-plane (w) and
+/// rotational modes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hourglass {
+    /// The form.
+    pub form: HourglassForm,
+    /// Coefficient of the membrane modes.
+    pub membrane: f64,
+    /// Coefficient of the out-of-plane (w) mode.
+    pub transverse: f64,
+    /// Coefficient of the rotational modes.
+    pub rotation: f64,
+}
+
+impl Default for Hourglass {
+    fn default() -> Self {
+        Hourglass {
+            form: HourglassForm::Stiffness,
+            membrane: 0.05,
+            transverse: 0.05,
+            rotation: 0.05,
+        }
+    }
+}
+
+/// Run controls.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Control {
+    /// End time, > 0.
+    pub end_time: f64,
+    /// Largest number of cycles (0 = no limit).
+    pub end_cycles: u64,
+    /// Time-step safety factor applied to the smallest element step (0.9 by default).
+    pub tssfac: f64,
+    /// A fixed time step overriding the computed one (for verification of the stability
+    /// limit); `None` by default.
+    pub fixed_dt: Option<f64>,
+    /// The run stops with an error when the step falls below `dtmin_factor` times the first
+    /// step (0 = never; LS-DYNA's DTMIN).
+    pub dtmin_factor: f64,
+    /// Characteristic length rule: false = area / max(longest side, longest diagonal)
+    /// (ISDO 0), true = area / longest diagonal (ISDO 1).
+    pub isdo_diagonal: bool,
+    /// Warping projection of the quads (on by default): rigid motions of warped elements
+    /// give no strain and element forces are self-equilibrated.
+    pub warping_projection: bool,
+    /// The run stops with an error when the energy ratio (total over initial plus external
+    /// work) exceeds this bound (1.5 by default).
+    pub energy_ratio_bound: f64,
+}
+
+impl Default for Control {
+    fn default() -> Self {
+        Control {
+            end_time: 1.0e-3,
+            end_cycles: 0,
+            tssfac: 0.9,
+            fixed_dt: None,
+            dtmin_factor: 0.0,
+            isdo_diagonal: false,
+            warping_projection: true,
+            energy_ratio_bound: 1.5,
+        }
+    }
+}
+
+/// Output requests: history nodes and the sampling interval of histories and energies.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Output {
+    /// Nodes whose displacement, velocity and acceleration are sampled.
+    pub history_nodes: Vec<u64>,
+    /// Sampling interval of nodal histories and energies; 0 means end time / 1000.
+    pub interval: f64,
+}
+
+/// A complete model.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ShellModel {
+    /// Title (`*TITLE`).
+    pub title: String,
+    /// Nodes.
+    pub nodes: Vec<Node>,
+    /// Shell elements.
+    pub shells: Vec<Shell>,
+    /// Parts.
+    pub parts: Vec<Part>,
+    /// Sections.
+    pub sections: Vec<Section>,
+    /// Materials.
+    pub materials: Vec<Material>,
+    /// Concentrated masses.
+    pub masses: Vec<PointMass>,
+    /// Node sets.
+    pub node_sets: Vec<NodeSet>,
+    /// Initial velocities, applied in order (later ones override).
+    pub initial_velocities: Vec<InitialVelocity>,
+    /// Single-point constraints.
+    pub spcs: Vec<Spc>,
+    /// Rigid walls.
+    pub walls: Vec<RigidWall>,
+    /// Curves.
+    pub curves: Vec<Curve>,
+    /// Body acceleration along z (gravity).
+    pub body_load_z: Option<BodyLoadZ>,
+    /// Mass-proportional damping constant D (1/time): nodal force `-D m v`.
+    pub damping: f64,
+    /// Hourglass control.
+    pub hourglass: Hourglass,
+    /// Run controls.
+    pub control: Control,
+    /// Output requests.
+    pub output: Output,
+}
+
+impl ShellModel {
+    /// An empty model with default controls.
+    pub fn new(title: impl Into<String>) -> Self {
+        ShellModel {
+            title: title.into(),
+            ..Default::default()
+        }
+    }
+
+    /// Adds a node.
+    pub fn add_node(&mut self, id: u64, x: [f64; 3]) -> &mut Self {
+        self.nodes.push(Node { id, x });
+        self
+    }
+
+    /// Adds a quad (or a triangle when `n4 == n3`).
+    pub fn add_shell(&mut self, id: u64, part: u64, nodes: [u64; 4]) -> &mut Self {
+        self.shells.push(Shell { id, part, nodes });
+        self
+    }
+
+    /// Adds a part.
+    pub fn add_part(&mut self, id: u64, section: u64, material: u64) -> &mut Self {
+        self.parts.push(Part {
+            id,
+            title: format!("part {id}"),
+            section,
+            material,
+        });
+        self
+    }
+
+    /// Adds a concentrated mass at a node.
+    pub fn add_mass(&mut self, id: u64, node: u64, mass: f64) -> &mut Self {
+        self.masses.push(PointMass { id, node, mass });
+        self
+    }
+
+    /// Sets gravity of magnitude `g` toward -z (a constant curve and `*LOAD_BODY_Z`). The
+    /// curve takes the first id above the existing ones.
+    pub fn set_gravity(&mut self, g: f64) -> &mut Self {
+        let id = self.curves.iter().map(|c| c.id).max().unwrap_or(0) + 1;
+        self.curves
+            .push(Curve::new(id, vec![(0.0, 1.0), (1.0e30, 1.0)]));
+        self.body_load_z = Some(BodyLoadZ {
+            curve: id,
+            scale: g,
+        });
+        self
+    }
+
+    /// The total mass of the shells (from density, thickness, area) and point masses, on
+    /// the initial geometry; elements whose references are undefined are skipped.
+    pub fn total_mass(&self) -> f64 {
+        let mut m: f64 = self.masses.iter().map(|p| p.mass).sum();
+        let node = |id: u64| self.nodes.iter().find(|n| n.id == id).map(|n| n.x);
+        for s in &self.shells {
+            let Some(part) = self.parts.iter().find(|p| p.id == s.part) else {
+                continue;
+            };
+            let sec = self.sections.iter().find(|q| q.id == part.section);
+            let mat = self.materials.iter().find(|q| q.id == part.material);
+            let (Some(sec), Some(mat)) = (sec, mat) else {
+                continue;
+            };
+            let xs: Option<Vec<[f64; 3]>> = s.nodes.iter().map(|&n| node(n)).collect();
+            if let Some(xs) = xs {
+                m += mat.density * sec.thickness * crate::geometry::polygon_area(&xs);
+            }
+        }
+        m
+    }
+}

@@ -1,0 +1,967 @@
+//! The explicit solver: central-difference time integration, assembly, rigid walls,
+//! constraints, energies and sampled outputs.
+//!
+//! One cycle, from `x^n`, `v^{n+1/2}`, `omega^{n+1/2}` and the step `dt^{n+1/2}`:
+//!
+//! 1. `x^{n+1} = x^n + dt^{n+1/2} v^{n+1/2}`, `t^{n+1} = t^n + dt^{n+1/2}`.
+//! 2. Element loop (rayon, one force slot per element) on `x^{n+1}` with the mid-step
+//!    velocities: stresses, internal forces, element steps, energy increments.
+//! 3. Gather of the slots at each node in a fixed order (node-to-element lists sorted by
+//!    element), so results are bit-identical for any thread count.
+//! 4. `a = (f_ext - f_int) / m - D v^{n+1/2}`, `alpha = -m_int / I`.
+//! 5. Next step `dt^{n+3/2} = TSSFAC min_e dt_e` and the velocity step
+//!    `dt^{n+1} = (dt^{n+1/2} + dt^{n+3/2}) / 2`.
+//! 6. Rigid walls correct `a` of nodes that would cross the plane; constraints zero the
+//!    fixed components.
+//! 7. `v^{n+1} = v^{n+1/2} + dt^{n+1/2}/2 a` (output), `v^{n+3/2} = v^{n+1/2} + dt^{n+1} a`.
+//! 8. Energies at `t^{n+1}`.
+//!
+//! The run starts stress-free with `a^0 = f_ext / m` and `v^{1/2} = v^0 + dt^{1/2}/2 a^0`.
+
+use impactcal_core::Histories;
+use rayon::prelude::*;
+
+use crate::element::{
+    self, ElementFault, ElementOutput, KernelOptions, STATE_HEAD, STATE_PER_POINT,
+};
+use crate::error::{Result, ShellError};
+use crate::geometry::{dot, sub};
+use crate::model::{Curve, ShellModel, WallMethod};
+use crate::setup::{Compiled, Elem, compile};
+
+/// Elements per rayon task in the element loop; fixed so that scheduling never changes the
+/// arithmetic.
+const ELEMENT_CHUNK: usize = 256;
+/// Nodes per rayon task in the node loops.
+const NODE_CHUNK: usize = 1024;
+
+/// Energies at one instant.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Energies {
+    /// Kinetic energy (translational and rotational).
+    pub kinetic: f64,
+    /// Internal (strain and plastic) energy.
+    pub internal: f64,
+    /// Hourglass energy.
+    pub hourglass: f64,
+    /// Energy removed by the rigid walls (normal impact and friction).
+    pub contact: f64,
+    /// The friction share of `contact`.
+    pub friction: f64,
+    /// Energy removed by mass-proportional damping.
+    pub damping: f64,
+    /// Work of the external (body) forces.
+    pub external_work: f64,
+    /// Initial energy (kinetic at t = 0).
+    pub initial: f64,
+}
+
+impl Energies {
+    /// Total: `kinetic + internal + hourglass + contact + damping`.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.internal + self.hourglass + self.contact + self.damping
+    }
+
+    /// Energy ratio `total / (initial + external_work)` (1 for a balanced run; 1 when the
+    /// reference is zero and nothing moved).
+    pub fn ratio(&self) -> f64 {
+        let r = self.initial + self.external_work;
+        if r.abs() > 0.0 { self.total() / r } else { 1.0 }
+    }
+}
+
+/// Which nodal quantity a history holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Quantity {
+    /// Displacement from the initial position.
+    Displacement,
+    /// Velocity (the default).
+    #[default]
+    Velocity,
+    /// Acceleration.
+    Acceleration,
+}
+
+/// A summary of a completed run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    /// Number of cycles.
+    pub cycles: u64,
+    /// Time reached.
+    pub end_time: f64,
+    /// First, smallest and largest time step.
+    pub dt_first: f64,
+    /// Smallest time step used.
+    pub dt_min: f64,
+    /// Largest time step used.
+    pub dt_max: f64,
+    /// Final energy ratio.
+    pub energy_ratio: f64,
+    /// Final hourglass energy over internal energy (0 when there is no internal energy).
+    pub hourglass_share: f64,
+    /// Largest normal wall force over the run.
+    pub peak_wall_force: f64,
+    /// Final energies.
+    pub energies: Energies,
+    /// Number of shells.
+    pub elements: usize,
+    /// Total nodal mass.
+    pub mass: f64,
+}
+
+/// The outputs of a run: sampled nodal histories (when history nodes were requested), the
+/// energy table and a summary.
+#[derive(Debug, Clone)]
+pub struct RunResult {
+    /// Displacements at the history nodes, labels `<node>.<x|y|z>`.
+    pub displacement: Option<Histories>,
+    /// Velocities at the history nodes.
+    pub velocity: Option<Histories>,
+    /// Accelerations at the history nodes.
+    pub acceleration: Option<Histories>,
+    /// Energies and the wall force, sampled at the output interval. Channels:
+    /// `kinetic, internal, hourglass, contact, friction, damping, external_work, total,
+    /// energy_ratio, wall_force, wall_fx, wall_fy, wall_fz` (the wall force is the force of
+    /// the walls on the structure; `wall_force` is its normal component).
+    pub energies: Histories,
+    /// Summary figures.
+    pub summary: RunSummary,
+}
+
+impl RunResult {
+    /// The nodal histories of one quantity, if history nodes were requested.
+    pub fn histories(&self, q: Quantity) -> Option<&Histories> {
+        match q {
+            Quantity::Displacement => self.displacement.as_ref(),
+            Quantity::Velocity => self.velocity.as_ref(),
+            Quantity::Acceleration => self.acceleration.as_ref(),
+        }
+    }
+}
+
+/// Progress of a run, passed to the callback of [`Simulation::run_with_progress`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Current time.
+    pub time: f64,
+    /// End time.
+    pub end_time: f64,
+    /// Cycles so far.
+    pub cycle: u64,
+    /// Current time step.
+    pub dt: f64,
+}
+
+/// The labels of the energy table, in order.
+pub const ENERGY_LABELS: [&str; 13] = [
+    "kinetic",
+    "internal",
+    "hourglass",
+    "contact",
+    "friction",
+    "damping",
+    "external_work",
+    "total",
+    "energy_ratio",
+    "wall_force",
+    "wall_fx",
+    "wall_fy",
+    "wall_fz",
+];
+
+/// A validated model with its state: build it with [`Simulation::new`], then
+/// [`run`](Simulation::run) it (or [`step`](Simulation::step) it cycle by cycle).
+pub struct Simulation {
+    c: Compiled,
+    body: Option<(Curve, f64)>,
+    damping: f64,
+    control: crate::model::Control,
+    kernel: KernelOptions,
+    interval: f64,
+    stride: usize,
+    state: Vec<f64>,
+    slots: Vec<Slot>,
+    csr_start: Vec<u32>,
+    csr: Vec<u32>,
+    x: Vec<[f64; 3]>,
+    v: Vec<[f64; 3]>,
+    w: Vec<[f64; 3]>,
+    a: Vec<[f64; 3]>,
+    alpha: Vec<[f64; 3]>,
+    v_int: Vec<[f64; 3]>,
+    w_int: Vec<[f64; 3]>,
+    time: f64,
+    cycle: u64,
+    dt_half: f64,
+    dt_first: f64,
+    dt_min: f64,
+    dt_max: f64,
+    energies: Energies,
+    wall_force: [f64; 3],
+    wall_normal: f64,
+    peak_wall: f64,
+    started: bool,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Slot {
+    out: ElementOutput,
+    fault: Option<ElementFault>,
+}
+
+impl Simulation {
+    /// Validates `model` and prepares the run (masses, inertias, initial velocities, first
+    /// time step).
+    ///
+    /// # Errors
+    /// [`ShellError::Reference`] for undefined or duplicate ids, [`ShellError::Element`] for
+    /// repeated nodes, degenerate or inverted elements, [`ShellError::Value`] for values out
+    /// of range (thickness, density, nu, NIP, friction, controls) and for nodes that start
+    /// behind a rigid wall.
+    pub fn new(model: &ShellModel) -> Result<Self> {
+        let c = compile(model)?;
+        let max_nip = c.parts.iter().map(|p| p.z.len()).max().unwrap_or(1);
+        let stride = STATE_HEAD + STATE_PER_POINT * max_nip;
+        let ne = c.elems.len();
+        let nn = c.x0.len();
+        // Node-to-slot lists, in element order.
+        let mut count = vec![0u32; nn + 1];
+        for e in &c.elems {
+            for &n in &e.nodes[..if e.tri { 3 } else { 4 }] {
+                count[n as usize + 1] += 1;
+            }
+        }
+        for i in 0..nn {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        let mut csr = vec![0u32; count[nn] as usize];
+        for (k, e) in c.elems.iter().enumerate() {
+            for (s, &n) in e.nodes[..if e.tri { 3 } else { 4 }].iter().enumerate() {
+                csr[fill[n as usize] as usize] = (k * 4 + s) as u32;
+                fill[n as usize] += 1;
+            }
+        }
+        let body = match &model.body_load_z {
+            Some(b) => model
+                .curves
+                .iter()
+                .find(|c| c.id == b.curve)
+                .map(|c| (c.clone(), b.scale)),
+            None => None,
+        };
+        let interval = if model.output.interval > 0.0 {
+            model.output.interval
+        } else {
+            model.control.end_time / 1000.0
+        };
+        let x = c.x0.clone();
+        let v = c.v0.clone();
+        let w = c.w0.clone();
+        let mut sim = Simulation {
+            body,
+            damping: model.damping,
+            control: model.control,
+            kernel: KernelOptions {
+                projection: model.control.warping_projection,
+                isdo_diagonal: model.control.isdo_diagonal,
+            },
+            interval,
+            stride,
+            state: vec![0.0; stride * ne],
+            slots: vec![Slot::default(); ne],
+            csr_start: count,
+            csr,
+            x,
+            v_int: v.clone(),
+            w_int: w.clone(),
+            v,
+            w,
+            a: vec![[0.0; 3]; nn],
+            alpha: vec![[0.0; 3]; nn],
+            time: 0.0,
+            cycle: 0,
+            dt_half: 0.0,
+            dt_first: 0.0,
+            dt_min: f64::INFINITY,
+            dt_max: 0.0,
+            energies: Energies::default(),
+            wall_force: [0.0; 3],
+            wall_normal: 0.0,
+            peak_wall: 0.0,
+            started: false,
+            c,
+        };
+        sim.start()?;
+        Ok(sim)
+    }
+
+    /// Node ids, in the order of [`positions`](Self::positions).
+    pub fn node_ids(&self) -> &[u64] {
+        &self.c.node_ids
+    }
+
+    /// Shell ids, in model order.
+    pub fn element_ids(&self) -> &[u64] {
+        &self.c.elem_ids
+    }
+
+    /// Current nodal positions.
+    pub fn positions(&self) -> &[[f64; 3]] {
+        &self.x
+    }
+
+    /// Velocities at the last completed cycle's time `t^n` (averaged from the half steps).
+    pub fn velocities(&self) -> &[[f64; 3]] {
+        &self.v_int
+    }
+
+    /// Lumped nodal masses (shells and point masses).
+    pub fn masses(&self) -> &[f64] {
+        &self.c.mass
+    }
+
+    /// Current time.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Completed cycles.
+    pub fn cycle(&self) -> u64 {
+        self.cycle
+    }
+
+    /// The time step of the next cycle.
+    pub fn dt(&self) -> f64 {
+        self.dt_half
+    }
+
+    /// The energies at the current time.
+    pub fn energies(&self) -> Energies {
+        self.energies
+    }
+
+    /// The force of the walls on the structure at the current time (sum over walls).
+    pub fn wall_force(&self) -> [f64; 3] {
+        self.wall_force
+    }
+
+    /// Stress state `[s_xx, s_yy, s_xy, eps_p]` of thickness point `k` of element index `e`
+    /// (model order), in the element frame.
+    pub fn point_state(&self, e: usize, k: usize) -> Option<[f64; 4]> {
+        let nip = self.c.parts[self.c.elems.get(e)?.part as usize].z.len();
+        if k >= nip {
+            return None;
+        }
+        let s = &self.state[e * self.stride + STATE_HEAD + STATE_PER_POINT * k..][..4];
+        Some([s[0], s[1], s[2], s[3]])
+    }
+
+    fn body_accel(&self, t: f64) -> f64 {
+        match &self.body {
+            Some((curve, sf)) => -sf * curve.eval(t),
+            None => 0.0,
+        }
+    }
+
+    /// Runs the element loop for a step `dt` on the current positions and mid-step
+    /// velocities; fills the slots.
+    fn element_loop(&mut self, dt: f64) {
+        let (x, v, w) = (&self.x, &self.v, &self.w);
+        let parts = &self.c.parts;
+        let kernel = self.kernel;
+        let stride = self.stride;
+        self.c
+            .elems
+            .par_iter()
+            .zip(self.state.par_chunks_mut(stride))
+            .zip(self.slots.par_iter_mut())
+            .with_min_len(ELEMENT_CHUNK)
+            .for_each(|((e, st), slot)| {
+                *slot = eval_element(e, x, v, w, &parts[e.part as usize], st, dt, kernel);
+            });
+    }
+
+    /// Gathers slot forces into accelerations (before walls and constraints).
+    fn gather(&mut self, t: f64) {
+        let g = self.body_accel(t);
+        let (slots, csr, start) = (&self.slots, &self.csr, &self.csr_start);
+        let (mass, inertia) = (&self.c.mass, &self.c.inertia);
+        let damping = self.damping;
+        let v = &self.v;
+        self.a
+            .par_iter_mut()
+            .zip(self.alpha.par_iter_mut())
+            .enumerate()
+            .with_min_len(NODE_CHUNK)
+            .for_each(|(i, (a, al))| {
+                let mut f = [0.0; 6];
+                for &k in &csr[start[i] as usize..start[i + 1] as usize] {
+                    let s = &slots[k as usize / 4].out.f[k as usize % 4];
+                    for d in 0..6 {
+                        f[d] += s[d];
+                    }
+                }
+                let m = mass[i];
+                if m > 0.0 {
+                    for d in 0..3 {
+                        a[d] = -f[d] / m - damping * v[i][d];
+                    }
+                    a[2] += g;
+                } else {
+                    *a = [0.0; 3];
+                }
+                let inr = inertia[i];
+                *al = if inr > 0.0 {
+                    [-f[3] / inr, -f[4] / inr, -f[5] / inr]
+                } else {
+                    [0.0; 3]
+                };
+            });
+    }
+
+    /// Rigid walls, constraints and the velocity update over `dt_v` (from `v^{n-1/2}` to
+    /// `v^{n+1/2}`), with `h_prev` the part of it before `t^n` and `dt_next` the next
+    /// position step. Returns the contact and friction energy removed.
+    fn kick(&mut self, h_prev: f64, dt_next: f64) {
+        let dt_v = h_prev + 0.5 * dt_next;
+        let mut force = [0.0; 3];
+        let mut normal_force = 0.0;
+        for wall in &self.c.walls {
+            for &i in &wall.nodes {
+                let i = i as usize;
+                let m = self.c.mass[i];
+                let n = wall.normal;
+                let d0 = dot(sub(self.x[i], wall.point), n);
+                let vold = self.v[i];
+                let mut vs = [0.0; 3];
+                for k in 0..3 {
+                    vs[k] = vold[k] + dt_v * self.a[i][k];
+                }
+                let vn = dot(vs, n);
+                let mut vt = [vs[0] - vn * n[0], vs[1] - vn * n[1], vs[2] - vn * n[2]];
+                let vt_len = dot(vt, vt).sqrt();
+                let (vn_new, dvn) = match wall.method {
+                    WallMethod::Kinematic => {
+                        let vmin = -d0 / dt_next;
+                        if vn >= vmin {
+                            continue;
+                        }
+                        (vmin, vmin - vn)
+                    }
+                    WallMethod::Penalty { alpha } => {
+                        if d0 >= 0.0 {
+                            continue;
+                        }
+                        let dvn = -alpha * d0 / dt_v;
+                        (vn + dvn, dvn)
+                    }
+                };
+                let reduce = wall.mu * dvn;
+                let keep = if wall.mu.is_infinite() || reduce >= vt_len {
+                    0.0
+                } else {
+                    1.0 - reduce / vt_len
+                };
+                for k in 0..3 {
+                    vt[k] *= keep;
+                }
+                let vnew = [
+                    vt[0] + vn_new * n[0],
+                    vt[1] + vn_new * n[1],
+                    vt[2] + vn_new * n[2],
+                ];
+                // Work of the wall impulse with the mean velocity over the kick (the power
+                // of a force in the central-difference energy balance).
+                let vbar = [
+                    0.5 * (vold[0] + vnew[0]),
+                    0.5 * (vold[1] + vnew[1]),
+                    0.5 * (vold[2] + vnew[2]),
+                ];
+                let imp = [
+                    m * (vnew[0] - vs[0]),
+                    m * (vnew[1] - vs[1]),
+                    m * (vnew[2] - vs[2]),
+                ];
+                let work = dot(imp, vbar);
+                let imp_n = dot(imp, n);
+                let work_t = work - imp_n * dot(vbar, n);
+                self.energies.contact -= work;
+                self.energies.friction -= work_t;
+                for k in 0..3 {
+                    let f = m * (vnew[k] - vs[k]) / dt_v;
+                    force[k] += f;
+                    self.a[i][k] = (vnew[k] - vold[k]) / dt_v;
+                }
+                normal_force += m * dvn / dt_v;
+            }
+        }
+        self.wall_force = force;
+        self.wall_normal = normal_force;
+        self.peak_wall = self.peak_wall.max(normal_force);
+        for &(i, mask) in &self.c.fixed {
+            let i = i as usize;
+            for d in 0..3 {
+                if mask[d] {
+                    self.a[i][d] = 0.0;
+                }
+                if mask[3 + d] {
+                    self.alpha[i][d] = 0.0;
+                }
+            }
+        }
+        // Damping energy over the kick, with the mid-step velocities.
+        if self.damping > 0.0 {
+            let e: f64 = chunked_sum(&self.v, &self.c.mass, |v, m| m * dot(*v, *v));
+            self.energies.damping += self.damping * e * dt_v;
+        }
+        let half = 0.5 * dt_next;
+        let (a, al) = (&self.a, &self.alpha);
+        self.v
+            .par_iter_mut()
+            .zip(self.w.par_iter_mut())
+            .zip(self.v_int.par_iter_mut().zip(self.w_int.par_iter_mut()))
+            .enumerate()
+            .with_min_len(NODE_CHUNK)
+            .for_each(|(i, ((v, w), (vi, wi)))| {
+                for d in 0..3 {
+                    vi[d] = v[d] + h_prev * a[i][d];
+                    v[d] = vi[d] + half * a[i][d];
+                    wi[d] = w[d] + h_prev * al[i][d];
+                    w[d] = wi[d] + half * al[i][d];
+                }
+            });
+        let ke_t = chunked_sum(&self.v_int, &self.c.mass, |v, m| 0.5 * m * dot(*v, *v));
+        let ke_r = chunked_sum(&self.w_int, &self.c.inertia, |w, i| 0.5 * i * dot(*w, *w));
+        self.energies.kinetic = ke_t + ke_r;
+    }
+
+    /// First step: stress-free forces, time step, `a^0` and the half-step velocities.
+    fn start(&mut self) -> Result<()> {
+        self.element_loop(0.0);
+        let dt = self.next_dt()?;
+        self.gather(0.0);
+        self.kick(0.0, dt);
+        self.energies.initial = self.energies.kinetic;
+        self.dt_half = dt;
+        self.dt_first = dt;
+        self.started = true;
+        Ok(())
+    }
+
+    /// The next stable step from the slots (`TSSFAC min dt_e`, or the fixed step), checking
+    /// for faults.
+    fn next_dt(&self) -> Result<f64> {
+        let mut min = f64::INFINITY;
+        let mut arg = 0;
+        for (k, s) in self.slots.iter().enumerate() {
+            if let Some(f) = s.fault {
+                return Err(self.unstable(k, f.to_string()));
+            }
+            if !(s.out.dt >= 0.0) {
+                return Err(self.unstable(k, "non-finite element time step".into()));
+            }
+            if s.out.dt < min {
+                min = s.out.dt;
+                arg = k;
+            }
+        }
+        let dt = match self.control.fixed_dt {
+            Some(dt) => dt,
+            None => self.control.tssfac * min,
+        };
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(self.unstable(arg, format!("time step {dt} is not positive")));
+        }
+        if self.started
+            && self.control.dtmin_factor > 0.0
+            && dt < self.control.dtmin_factor * self.dt_first
+        {
+            return Err(self.unstable(
+                arg,
+                format!(
+                    "time step {dt:.3e} fell below DTMIN x first step ({:.3e})",
+                    self.control.dtmin_factor * self.dt_first
+                ),
+            ));
+        }
+        Ok(dt)
+    }
+
+    fn unstable(&self, element: usize, cause: String) -> ShellError {
+        ShellError::Unstable {
+            time: self.time,
+            cycle: self.cycle,
+            element: self.c.elem_ids.get(element).copied().unwrap_or(0),
+            cause,
+        }
+    }
+
+    /// Advances one cycle.
+    ///
+    /// # Errors
+    /// [`ShellError::Unstable`] when an element degenerates or inverts, a force or velocity
+    /// becomes non-finite, the time step collapses below DTMIN, or the energy ratio exceeds
+    /// the bound; the state is then not usable.
+    pub fn step(&mut self) -> Result<()> {
+        let dt = self.dt_half;
+        let g0 = self.body_accel(self.time);
+        let mut mdz = 0.0;
+        for (x, (v, m)) in self.x.iter_mut().zip(self.v.iter().zip(&self.c.mass)) {
+            for d in 0..3 {
+                x[d] += dt * v[d];
+            }
+            mdz += m * dt * v[2];
+        }
+        self.time += dt;
+        self.cycle += 1;
+        self.element_loop(dt);
+        let dt_next = self.next_dt()?;
+        let (mut die, mut dhg) = (0.0, 0.0);
+        for chunk in self.slots.chunks(ELEMENT_CHUNK) {
+            let (mut a, mut b) = (0.0, 0.0);
+            for s in chunk {
+                a += s.out.internal;
+                b += s.out.hourglass;
+            }
+            die += a;
+            dhg += b;
+        }
+        self.energies.internal += die;
+        self.energies.hourglass += dhg;
+        let g1 = self.body_accel(self.time);
+        self.energies.external_work += 0.5 * (g0 + g1) * mdz;
+        self.gather(self.time);
+        self.kick(0.5 * dt, dt_next);
+        self.dt_half = dt_next;
+        self.dt_min = self.dt_min.min(dt);
+        self.dt_max = self.dt_max.max(dt);
+        self.check_health(die, dhg)
+    }
+
+    fn check_health(&self, die: f64, dhg: f64) -> Result<()> {
+        let e = &self.energies;
+        let total = e.total();
+        if !(total.is_finite() && die.is_finite() && dhg.is_finite()) {
+            let k = self
+                .slots
+                .iter()
+                .position(|s| {
+                    s.out.f.iter().flatten().any(|f| !f.is_finite()) || !s.out.internal.is_finite()
+                })
+                .unwrap_or(0);
+            return Err(self.unstable(k, "non-finite force or energy".into()));
+        }
+        if let Some(i) = self.v.iter().position(|v| v.iter().any(|c| !c.is_finite())) {
+            return Err(ShellError::Unstable {
+                time: self.time,
+                cycle: self.cycle,
+                element: self.element_at_node(i),
+                cause: format!("non-finite velocity at node {}", self.c.node_ids[i]),
+            });
+        }
+        let reference = e.initial + e.external_work;
+        if reference > 0.0 && total > self.control.energy_ratio_bound * reference {
+            let k = self
+                .slots
+                .iter()
+                .enumerate()
+                .max_by(|a, b| {
+                    let ea = (a.1.out.internal + a.1.out.hourglass).abs();
+                    let eb = (b.1.out.internal + b.1.out.hourglass).abs();
+                    ea.total_cmp(&eb)
+                })
+                .map_or(0, |(k, _)| k);
+            return Err(self.unstable(
+                k,
+                format!(
+                    "energy ratio {:.3} exceeds the bound {} (energy is being created)",
+                    total / reference,
+                    self.control.energy_ratio_bound
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn element_at_node(&self, i: usize) -> u64 {
+        self.csr
+            .get(self.csr_start[i] as usize)
+            .map_or(0, |&k| self.c.elem_ids[k as usize / 4])
+    }
+
+    /// Runs to the end time (or the cycle limit) and returns the sampled outputs.
+    ///
+    /// # Errors
+    /// As [`step`](Self::step); histories are only returned for a completed run.
+    pub fn run(&mut self) -> Result<RunResult> {
+        self.run_with_progress(|_| {})
+    }
+
+    /// As [`run`](Self::run), calling `progress` about every 1 % of the end time.
+    ///
+    /// # Errors
+    /// As [`step`](Self::step).
+    pub fn run_with_progress(&mut self, mut progress: impl FnMut(&Progress)) -> Result<RunResult> {
+        let end = self.control.end_time;
+        let interval = self.interval;
+        let n_samples = ((end / interval) * (1.0 + 1e-12)).floor() as usize + 1;
+        let hist = self.c.history.clone();
+        let nh = hist.len();
+        let mut samples: Vec<Vec<f64>> = Vec::with_capacity(n_samples);
+        let mut prev_t = self.time;
+        let mut prev = self.snapshot(&hist);
+        let mut next = 0usize;
+        let mut next_report = 0.0;
+        while next < n_samples {
+            let ts = next as f64 * interval;
+            if ts <= self.time * (1.0 + 1e-12) {
+                let cur = self.snapshot(&hist);
+                let span = self.time - prev_t;
+                let s = if span > 0.0 {
+                    ((ts - prev_t) / span).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                samples.push(
+                    prev.iter()
+                        .zip(&cur)
+                        .map(|(a, b)| a + s * (b - a))
+                        .collect(),
+                );
+                next += 1;
+                continue;
+            }
+            if self.control.end_cycles > 0 && self.cycle >= self.control.end_cycles {
+                break;
+            }
+            prev_t = self.time;
+            prev = self.snapshot(&hist);
+            self.step()?;
+            if self.time >= next_report {
+                progress(&Progress {
+                    time: self.time,
+                    end_time: end,
+                    cycle: self.cycle,
+                    dt: self.dt_half,
+                });
+                next_report = self.time + 0.01 * end;
+            }
+        }
+        if samples.is_empty() {
+            samples.push(self.snapshot(&hist));
+        }
+        let column = |r: usize| -> Vec<f64> { samples.iter().map(|s| s[r]).collect() };
+        let axes = ["x", "y", "z"];
+        let mut nodal = Vec::with_capacity(3);
+        for q in 0..3 {
+            if nh == 0 {
+                nodal.push(None);
+                continue;
+            }
+            let mut labels = Vec::with_capacity(3 * nh);
+            let mut chans = Vec::with_capacity(3 * nh);
+            for (j, &i) in hist.iter().enumerate() {
+                for (d, ax) in axes.iter().enumerate() {
+                    labels.push(format!("{}.{}", self.c.node_ids[i as usize], ax));
+                    chans.push(column(9 * j + 3 * q + d));
+                }
+            }
+            let unit = ["displacement", "velocity", "acceleration"][q];
+            nodal.push(Some(Histories::from_channels(
+                labels, chans, interval, 0.0, unit,
+            )?));
+        }
+        let energies = Histories::from_channels(
+            ENERGY_LABELS.iter().map(|s| s.to_string()).collect(),
+            (0..ENERGY_LABELS.len())
+                .map(|k| column(9 * nh + k))
+                .collect(),
+            interval,
+            0.0,
+            "energy",
+        )?;
+        let e = self.energies;
+        let mut it = nodal.into_iter();
+        Ok(RunResult {
+            displacement: it.next().flatten(),
+            velocity: it.next().flatten(),
+            acceleration: it.next().flatten(),
+            energies,
+            summary: RunSummary {
+                cycles: self.cycle,
+                end_time: self.time,
+                dt_first: self.dt_first,
+                dt_min: if self.dt_min.is_finite() {
+                    self.dt_min
+                } else {
+                    self.dt_first
+                },
+                dt_max: self.dt_max.max(self.dt_first),
+                energy_ratio: e.ratio(),
+                hourglass_share: if e.internal.abs() > 0.0 {
+                    e.hourglass / e.internal
+                } else {
+                    0.0
+                },
+                peak_wall_force: self.peak_wall,
+                energies: e,
+                elements: self.c.elems.len(),
+                mass: self.c.mass.iter().sum(),
+            },
+        })
+    }
+
+    fn snapshot(&self, hist: &[u32]) -> Vec<f64> {
+        let mut s = Vec::with_capacity(9 * hist.len() + ENERGY_LABELS.len());
+        for &i in hist {
+            let i = i as usize;
+            let u = sub(self.x[i], self.c.x0[i]);
+            s.extend_from_slice(&u);
+            s.extend_from_slice(&self.v_int[i]);
+            s.extend_from_slice(&self.a[i]);
+        }
+        let e = self.energies;
+        s.extend_from_slice(&[
+            e.kinetic,
+            e.internal,
+            e.hourglass,
+            e.contact,
+            e.friction,
+            e.damping,
+            e.external_work,
+            e.total(),
+            e.ratio(),
+            self.wall_normal,
+            self.wall_force[0],
+            self.wall_force[1],
+            self.wall_force[2],
+        ]);
+        s
+    }
+
+    /// Estimates the largest natural circular frequency `omega_max` of the undeformed,
+    /// stress-free model by power iteration on `M^-1 K` (translations and rotations, with
+    /// the hourglass stiffness; constraints applied), where `K u` is the internal-force
+    /// response to a small velocity `u` over a unit step. The stability limit of the
+    /// central-difference method is `2 / omega_max`.
+    ///
+    /// The state of the simulation is not changed.
+    pub fn max_frequency(&self, iterations: usize) -> f64 {
+        let nn = self.c.x0.len();
+        let mut free = vec![[true; 6]; nn];
+        for &(i, m) in &self.c.fixed {
+            for d in 0..6 {
+                free[i as usize][d] = !m[d];
+            }
+        }
+        // Deterministic start vector.
+        let mut u: Vec<[f64; 6]> = (0..nn)
+            .map(|i| {
+                let mut r = [0.0; 6];
+                for d in 0..6 {
+                    let h = ((i * 6 + d) as f64 * 0.618_033_988_749_895).fract() - 0.5;
+                    r[d] = if free[i][d] { h } else { 0.0 };
+                }
+                r
+            })
+            .collect();
+        let mut lambda = 0.0;
+        let eps = 1e-9;
+        for _ in 0..iterations {
+            let norm: f64 = u.iter().flatten().map(|c| c * c).sum::<f64>().sqrt();
+            if norm == 0.0 {
+                return 0.0;
+            }
+            for r in u.iter_mut() {
+                for c in r.iter_mut() {
+                    *c *= eps / norm;
+                }
+            }
+            let vel: Vec<[f64; 3]> = u.iter().map(|r| [r[0], r[1], r[2]]).collect();
+            let om: Vec<[f64; 3]> = u.iter().map(|r| [r[3], r[4], r[5]]).collect();
+            let mut f = vec![[0.0; 6]; nn];
+            for e in &self.c.elems {
+                let mut st = vec![0.0; self.stride];
+                let slot = eval_element(
+                    e,
+                    &self.c.x0,
+                    &vel,
+                    &om,
+                    &self.c.parts[e.part as usize],
+                    &mut st,
+                    1.0,
+                    self.kernel,
+                );
+                for (s, &n) in e.nodes[..if e.tri { 3 } else { 4 }].iter().enumerate() {
+                    for d in 0..6 {
+                        f[n as usize][d] += slot.out.f[s][d];
+                    }
+                }
+            }
+            let mut next = vec![[0.0; 6]; nn];
+            let mut num = 0.0;
+            let mut den = 0.0;
+            for i in 0..nn {
+                for d in 0..6 {
+                    if !free[i][d] {
+                        continue;
+                    }
+                    let m = if d < 3 {
+                        self.c.mass[i]
+                    } else {
+                        self.c.inertia[i]
+                    };
+                    if m <= 0.0 {
+                        continue;
+                    }
+                    next[i][d] = f[i][d] / m;
+                    // Rayleigh quotient in the mass metric: u.K u / u.M u.
+                    num += u[i][d] * f[i][d];
+                    den += u[i][d] * m * u[i][d];
+                }
+            }
+            lambda = if den > 0.0 { num / den } else { 0.0 };
+            u = next;
+        }
+        lambda.max(0.0).sqrt()
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn eval_element(
+    e: &Elem,
+    x: &[[f64; 3]],
+    v: &[[f64; 3]],
+    w: &[[f64; 3]],
+    props: &element::PartProps,
+    st: &mut [f64],
+    dt: f64,
+    kernel: KernelOptions,
+) -> Slot {
+    let n = e.nodes.map(|i| i as usize);
+    let res = if e.tri {
+        let g = |a: &[[f64; 3]]| [a[n[0]], a[n[1]], a[n[2]]];
+        element::triangle(&g(x), &g(v), &g(w), props, st, dt)
+    } else {
+        let g = |a: &[[f64; 3]]| [a[n[0]], a[n[1]], a[n[2]], a[n[3]]];
+        element::quad(&g(x), &g(v), &g(w), props, st, dt, kernel)
+    };
+    match res {
+        Ok(out) => Slot { out, fault: None },
+        Err(f) => Slot {
+            out: ElementOutput::default(),
+            fault: Some(f),
+        },
+    }
+}
+
+/// `sum_i f(a_i, b_i)` in fixed chunks, so the rounding does not depend on threads.
+fn chunked_sum<A: Sync>(a: &[A], b: &[f64], f: impl Fn(&A, f64) -> f64 + Sync) -> f64 {
+    let parts: Vec<f64> = a
+        .par_chunks(NODE_CHUNK)
+        .zip(b.par_chunks(NODE_CHUNK))
+        .map(|(ca, cb)| ca.iter().zip(cb).map(|(x, &m)| f(x, m)).sum())
+        .collect();
+    parts.iter().sum()
+}

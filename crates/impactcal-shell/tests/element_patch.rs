@@ -1,0 +1,353 @@
+//! V1 (rigid motion of a warped element, constant membrane and bending patches), V3
+//! (stability limit), conservation of momentum and thread-count independence.
+
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::float_cmp,
+    clippy::needless_range_loop
+)]
+
+mod common;
+
+use common::*;
+use impactcal_shell::element::{self, KernelOptions, PartProps, STATE_HEAD, STATE_PER_POINT};
+use impactcal_shell::material::MaterialProps;
+use impactcal_shell::{HourglassForm, InitialVelocity, ShellError, Simulation, VelocityTarget};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn props(t: f64, nip: usize) -> PartProps {
+    // Gauss points for 5; tests use 5.
+    assert_eq!(nip, 5);
+    let zeta = [
+        -0.906_179_845_938_664,
+        -0.538_469_310_105_683,
+        0.0,
+        0.538_469_310_105_683,
+        0.906_179_845_938_664,
+    ];
+    let w = [
+        0.236_926_885_056_189,
+        0.478_628_670_499_366,
+        0.568_888_888_888_889,
+        0.478_628_670_499_366,
+        0.236_926_885_056_189,
+    ];
+    PartProps {
+        t,
+        z: zeta.iter().map(|z| 0.5 * t * z).collect(),
+        w: w.iter().map(|w| 0.5 * w).collect(),
+        shear_factor: 5.0 / 6.0,
+        mat: MaterialProps::new(&aluminium(1)),
+        hg_form: HourglassForm::Stiffness,
+        hg: [0.05, 0.05, 0.05],
+    }
+}
+
+fn rotation(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
+    let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+    let [x, y, z] = [axis[0] / n, axis[1] / n, axis[2] / n];
+    let (s, c) = angle.sin_cos();
+    let k = 1.0 - c;
+    [
+        [c + x * x * k, x * y * k - z * s, x * z * k + y * s],
+        [y * x * k + z * s, c + y * y * k, y * z * k - x * s],
+        [z * x * k - y * s, z * y * k + x * s, c + z * z * k],
+    ]
+}
+
+fn apply(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Max |stress| over the points and max |force| after rotating a warped, distorted quad by
+/// 90 degrees about a skew axis in 10^4 increments while translating it.
+fn rigid_rotation_residual(projection: bool) -> (f64, f64) {
+    let x0 = [
+        [0.0, 0.0, 0.0],
+        [1.1, 0.1, 0.06],
+        [1.0, 0.9, -0.05],
+        [-0.1, 1.2, 0.07],
+    ]
+    .map(|p| p.map(|c| 0.1 * c));
+    let p = props(0.002, 5);
+    let mut st = vec![0.0; STATE_HEAD + 5 * STATE_PER_POINT];
+    let axis = [0.3, -0.5, 0.8];
+    let n = (0.09f64 + 0.25 + 0.64).sqrt();
+    let omega_rate = 200.0; // rad/s
+    let om = axis.map(|c| c / n * omega_rate);
+    let vt = [1.0, -2.0, 0.5];
+    let steps = 10_000;
+    let dt = std::f64::consts::FRAC_PI_2 / omega_rate / steps as f64;
+    let mut fmax: f64 = 0.0;
+    let opts = KernelOptions {
+        projection,
+        isdo_diagonal: false,
+    };
+    for k in 1..=steps {
+        let t = k as f64 * dt;
+        let r = rotation(axis, omega_rate * t);
+        let c = vt.map(|v| v * t);
+        let x = x0.map(|p| {
+            let q = apply(&r, p);
+            [q[0] + c[0], q[1] + c[1], q[2] + c[2]]
+        });
+        let v = x.map(|p| {
+            let w = cross(om, [p[0] - c[0], p[1] - c[1], p[2] - c[2]]);
+            [w[0] + vt[0], w[1] + vt[1], w[2] + vt[2]]
+        });
+        let out = element::quad(&x, &v, &[om; 4], &p, &mut st, dt, opts).unwrap();
+        fmax = fmax.max(out.f.iter().flatten().fold(0.0, |a, b| a.max(b.abs())));
+    }
+    let smax = st.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    (smax, fmax)
+}
+
+#[test]
+fn rigid_rotation_of_a_warped_quad_gives_no_strain_with_the_projection() {
+    let (s, f) = rigid_rotation_residual(true);
+    // Relative to the stress of a unit rotation-sized strain (E * 1 rad ~ 7e10 Pa).
+    assert!(s / E < 1e-10, "stress {s:.3e} Pa");
+    assert!(f < 1e-3, "force {f:.3e} N");
+    // Without the projection the same motion strains the warped element.
+    let (s_plain, _) = rigid_rotation_residual(false);
+    assert!(
+        s_plain / E > 1e-8 && s_plain > 1e3 * s,
+        "stress without projection {s_plain:.3e}"
+    );
+}
+
+/// Constant membrane strain rate on a distorted 2 x 2 patch: every element gets exactly
+/// `C de` and the interior node is in equilibrium.
+#[test]
+fn constant_membrane_and_bending_patches_are_exact() {
+    let xs = [
+        [0.0, 0.0],
+        [0.5, 0.0],
+        [1.0, 0.0],
+        [0.0, 0.5],
+        [0.62, 0.41],
+        [1.0, 0.5],
+        [0.0, 1.0],
+        [0.5, 1.0],
+        [1.0, 1.0],
+    ];
+    let quads = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]];
+    let t = 0.01;
+    let p = props(t, 5);
+    let mat = p.mat;
+    let dt = 1e-6;
+    // Membrane: v = L x with L = [[a, b], [c, d]].
+    let (la, lb, lc, ld) = (3.0, 1.0, -2.0, 0.5);
+    let mut interior = [0.0; 6];
+    for q in quads {
+        let x = q.map(|i| [xs[i][0], xs[i][1], 0.0]);
+        let v = x.map(|p| [la * p[0] + lb * p[1], lc * p[0] + ld * p[1], 0.0]);
+        let mut st = vec![0.0; STATE_HEAD + 5 * STATE_PER_POINT];
+        let out = element::quad(
+            &x,
+            &v,
+            &[[0.0; 3]; 4],
+            &p,
+            &mut st,
+            dt,
+            KernelOptions {
+                projection: true,
+                isdo_diagonal: false,
+            },
+        )
+        .unwrap();
+        let de = [la * dt, ld * dt, (lb + lc) * dt];
+        let sxx = mat.c11 * (de[0] + mat.nu * de[1]);
+        let syy = mat.c11 * (de[1] + mat.nu * de[0]);
+        let sxy = mat.g * de[2];
+        // Stresses are in the element frame: compare the in-plane invariants.
+        for k in 0..5 {
+            let s = &st[STATE_HEAD + STATE_PER_POINT * k..];
+            assert!((s[0] + s[1] - sxx - syy).abs() < 1e-9 * sxx.abs());
+            let det = s[0] * s[1] - s[2] * s[2];
+            assert!((det - (sxx * syy - sxy * sxy)).abs() < 1e-9 * sxx * sxx);
+        }
+        let slot = q.iter().position(|&i| i == 4).unwrap();
+        for d in 0..6 {
+            interior[d] += out.f[slot][d];
+        }
+    }
+    let scale = mat.c11 * 3.0 * dt * t * 0.5;
+    assert!(
+        interior.iter().all(|f| f.abs() < 1e-9 * scale),
+        "{interior:?}"
+    );
+
+    // Bending: omega_y = kx x, omega_x = -ky y gives curvature rates (kx, ky); the moment
+    // M = t sum w z s equals D (k + nu k) dt exactly with 5 Gauss points.
+    let (kx, ky) = (2.0, 2.0);
+    let d = mat.c11 * t * t * t / 12.0;
+    for q in quads {
+        let x = q.map(|i| [xs[i][0], xs[i][1], 0.0]);
+        let w = x.map(|p| [-ky * p[1], kx * p[0], 0.0]);
+        let mut st = vec![0.0; STATE_HEAD + 5 * STATE_PER_POINT];
+        element::quad(
+            &x,
+            &[[0.0; 3]; 4],
+            &w,
+            &p,
+            &mut st,
+            dt,
+            KernelOptions {
+                projection: true,
+                isdo_diagonal: false,
+            },
+        )
+        .unwrap();
+        // Equal curvatures in x and y: isotropic, so frame-independent.
+        let (mut mxx, mut myy, mut nxx) = (0.0, 0.0, 0.0);
+        for k in 0..5 {
+            let s = &st[STATE_HEAD + STATE_PER_POINT * k..];
+            mxx += t * p.w[k] * p.z[k] * s[0];
+            myy += t * p.w[k] * p.z[k] * s[1];
+            nxx += t * p.w[k] * s[0];
+        }
+        let exx = d * (kx + mat.nu * ky) * dt;
+        let eyy = d * (ky + mat.nu * kx) * dt;
+        assert!((mxx - exx).abs() < 1e-10 * exx.abs(), "{mxx} vs {exx}");
+        assert!((myy - eyy).abs() < 1e-10 * exx.abs(), "{myy} vs {eyy}");
+        assert!(nxx.abs() < 1e-10 * exx.abs() / t);
+    }
+}
+
+fn random_plate(seed: u64, n: u64, warp: f64) -> impactcal_shell::ShellModel {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let h = 0.01;
+    let mut m = plate(n, n, h * n as f64, h * n as f64, [0.0; 3]);
+    with_section(&mut m, 0.001, aluminium(1));
+    for p in m.nodes.iter_mut() {
+        p.x[0] += rng.random_range(-0.15..0.15) * h;
+        p.x[1] += rng.random_range(-0.15..0.15) * h;
+        p.x[2] += rng.random_range(-1.0..1.0) * warp * h;
+    }
+    for p in m.nodes.clone() {
+        let mut iv = InitialVelocity::translation(
+            VelocityTarget::Node(p.id),
+            [0.0; 3].map(|_: f64| rng.random_range(-1.0..1.0)),
+        );
+        iv.rotation = [0.0; 3].map(|_: f64| rng.random_range(-10.0..10.0));
+        m.initial_velocities.push(iv);
+    }
+    m
+}
+
+/// V3: the estimated step is below the stability limit 2 / omega_max (power iteration);
+/// a run at 0.9 x the limit stays stable, one at 1.2 x stops with a typed error.
+#[test]
+fn stable_below_and_unstable_above_the_critical_step() {
+    let m = random_plate(7, 4, 0.05);
+    let sim = Simulation::new(&m).unwrap();
+    let w_max = sim.max_frequency(3000);
+    let limit = 2.0 / w_max;
+    let estimate = sim.dt() / 0.9;
+    assert!(
+        estimate <= limit,
+        "estimated {estimate:.3e} > limit {limit:.3e}"
+    );
+    assert!(
+        estimate > 0.3 * limit,
+        "estimate {estimate:.3e} far below the limit {limit:.3e}"
+    );
+
+    let mut stable = m.clone();
+    stable.control.fixed_dt = Some(0.9 * limit);
+    stable.control.end_time = 3000.0 * 0.9 * limit;
+    let mut sim = Simulation::new(&stable).unwrap();
+    let vmax0 = sim
+        .velocities()
+        .iter()
+        .flatten()
+        .fold(0.0f64, |a, b| a.max(b.abs()));
+    let r = sim.run().unwrap();
+    assert!(r.summary.cycles >= 2999);
+    let vmax = sim
+        .velocities()
+        .iter()
+        .flatten()
+        .fold(0.0f64, |a, b| a.max(b.abs()));
+    assert!(vmax < 3.0 * vmax0, "velocities grew from {vmax0} to {vmax}");
+
+    let mut unstable = m;
+    unstable.control.fixed_dt = Some(1.2 * limit);
+    unstable.control.end_time = 3000.0 * 1.2 * limit;
+    match Simulation::new(&unstable).unwrap().run() {
+        Err(ShellError::Unstable { element, cycle, .. }) => {
+            assert!(element >= 1 && cycle < 3000);
+        }
+        other => panic!(
+            "expected an instability, got {:?}",
+            other.map(|r| r.summary)
+        ),
+    }
+}
+
+/// V13: free flight of a warped, distorted plate with random velocities conserves linear
+/// momentum to round-off (element forces are self-equilibrated).
+#[test]
+fn free_flight_conserves_linear_momentum() {
+    let m = random_plate(11, 5, 0.1);
+    let mut sim = Simulation::new(&m).unwrap();
+    let momentum = |s: &Simulation| {
+        let mut p = [0.0; 3];
+        for (v, m) in s.velocities().iter().zip(s.masses()) {
+            for d in 0..3 {
+                p[d] += m * v[d];
+            }
+        }
+        p
+    };
+    let p0 = momentum(&sim);
+    let mass: f64 = sim.masses().iter().sum();
+    for _ in 0..2000 {
+        sim.step().unwrap();
+    }
+    let p1 = momentum(&sim);
+    for d in 0..3 {
+        assert!(
+            (p1[d] - p0[d]).abs() < 1e-12 * mass,
+            "axis {d}: {} vs {}",
+            p1[d],
+            p0[d]
+        );
+    }
+}
+
+/// Results are bit-identical for 1, 2 and 3 threads.
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let mut m = random_plate(3, 24, 0.02);
+    m.control.end_time = 2e-4;
+    m.output.history_nodes = vec![1, 100, 300];
+    m.output.interval = 1e-5;
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| Simulation::new(&m).unwrap().run().unwrap())
+    };
+    let a = run(1);
+    for threads in [2, 3] {
+        let b = run(threads);
+        assert_eq!(
+            a.velocity.as_ref().unwrap().data(),
+            b.velocity.as_ref().unwrap().data()
+        );
+        assert_eq!(a.energies.data(), b.energies.data());
+    }
+}
