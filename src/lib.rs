@@ -11,6 +11,7 @@
 //! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
 //! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
+//! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -30,6 +31,7 @@ pub use impactcal_erbf as erbf;
 pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
 pub use impactcal_shell as shell;
+pub use impactcal_sobol as sobol;
 
 /// The types most programs need, in one import.
 pub mod prelude {
@@ -51,4 +53,7 @@ pub mod prelude {
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
     };
     pub use impactcal_shell::{ShellError, ShellModel, Simulation};
+    pub use impactcal_sobol::{
+        DesignLayout, OutputView, SaltelliDesign, SobolError, SobolIndices, SobolOptions,
+    };
 }

@@ -9,9 +9,11 @@ mod expand;
 mod optimize;
 mod output;
 mod place;
+mod sample;
 mod shapes;
 mod simulate;
 mod surrogate;
+mod sobol;
 
 use std::process::ExitCode;
 
@@ -46,6 +48,10 @@ enum Command {
     /// Run an LS-DYNA keyword deck with the built-in explicit shell solver; write nodal
     /// histories and energies as CSV.
     Simulate(simulate::Args),
+    /// Space-filling samples (Halton, Sobol', Latin hypercubes) and Saltelli designs.
+    Sample(sample::Args),
+    /// Sobol' sensitivity indices of every output column.
+    Sobol(sobol::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -57,6 +63,8 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Optimize(a) => optimize::run(a),
         Command::Place(a) => place::run(a),
         Command::Simulate(a) => simulate::run(a),
+        Command::Sample(a) => sample::run(a),
+        Command::Sobol(a) => sobol::run(a),
     }
 }
 
