@@ -12,8 +12,8 @@ mod place;
 mod sample;
 mod shapes;
 mod simulate;
-mod surrogate;
 mod sobol;
+mod surrogate;
 
 use std::process::ExitCode;
 
