@@ -70,6 +70,7 @@
 //! ```
 #![allow(clippy::needless_range_loop)]
 
+pub mod airframe;
 pub mod element;
 pub mod error;
 mod geometry;
