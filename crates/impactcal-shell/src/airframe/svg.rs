@@ -13,15 +13,30 @@ fn colour(p: AirframePart) -> &'static str {
     COLOURS[(p.id() - 1) as usize % COLOURS.len()]
 }
 
-/// One view: which coordinates go right and up, which parts are left out, the depth axis
-/// (elements are painted far to near) and the panel's title.
+/// One view: the direction toward the viewer, the parts left out, whether the near
+/// (left-hand, y > 0) skins are cut away, and the panel's title.
 struct View {
-    right: usize,
-    up: usize,
-    depth: usize,
-    flip_up: bool,
+    toward: [f64; 3],
     omit: &'static [AirframePart],
+    cut_near: bool,
     title: &'static str,
+}
+
+fn unit(v: [f64; 3]) -> [f64; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    [v[0] / n, v[1] / n, v[2] / n]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 pub(super) fn parts_svg(af: &Airframe) -> String {
@@ -29,41 +44,83 @@ pub(super) fn parts_svg(af: &Airframe) -> String {
     let nodes = af.node_positions();
     let views = [
         View {
-            right: 0,
-            up: 2,
-            depth: 1,
-            flip_up: false,
-            omit: &[],
-            title: "side view (left-hand skins, roof and nose cut away)",
+            toward: [-0.35, 1.0, 0.55],
+            omit: &[P::Roof],
+            cut_near: true,
+            title: "from the left, above and behind: roof and left-hand skins cut away",
         },
         View {
-            right: 0,
-            up: 1,
-            depth: 2,
-            flip_up: false,
+            toward: [0.55, 0.5, 0.8],
             omit: &[
                 P::Roof,
                 P::SideSkins,
                 P::Nose,
-                P::EngineFairing,
+                P::CabinFloor,
                 P::BackPanel,
+                P::EngineFairing,
+                P::TailBoom,
+                P::UpperTail,
+                P::LowerTail,
+                P::HorizontalStabilizer,
             ],
-            title: "plan view (skins, roof, nose, fairing and back panel removed)",
+            cut_near: false,
+            title: "subfloor from the front, left and above: floor and skins removed",
         },
     ];
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in nodes {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
+    // Screen frame of each view: right, up, toward the viewer.
+    let frames: Vec<[[f64; 3]; 3]> = views
+        .iter()
+        .map(|v| {
+            let w = unit(v.toward);
+            let up0 = if w[2].abs() > 0.99 {
+                [-1.0, 0.0, 0.0]
+            } else {
+                [0.0, 0.0, 1.0]
+            };
+            let mut r = unit(cross(w, up0));
+            if w[2].abs() > 0.99 {
+                r = [1.0, 0.0, 0.0];
+            }
+            let u = cross(r, w);
+            [r, u, w]
+        })
+        .collect();
+    let extent = |f: &[[f64; 3]; 3], view: &View| {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for (n, part) in af.shells() {
+            if view.omit.contains(&part) {
+                continue;
+            }
+            for &i in &n {
+                let p = nodes[i as usize - 1];
+                for k in 0..2 {
+                    let c = dot(p, f[k]);
+                    lo[k] = lo[k].min(c);
+                    hi[k] = hi[k].max(c);
+                }
+            }
         }
-    }
+        (lo, hi)
+    };
     let scale = 3.0;
     let margin = 20.0;
     let legend_w = 230.0;
-    let width = (hi[0] - lo[0]) * scale + 2.0 * margin + legend_w;
-    let heights = [(hi[2] - lo[2]) * scale, (hi[1] - lo[1]) * scale];
-    let height = heights[0] + heights[1] + 4.0 * margin + 40.0;
+    let exts: Vec<([f64; 2], [f64; 2])> = frames
+        .iter()
+        .zip(&views)
+        .map(|(f, v)| extent(f, v))
+        .collect();
+    let width = exts
+        .iter()
+        .map(|(lo, hi)| (hi[0] - lo[0]) * scale)
+        .fold(0.0, f64::max)
+        + 2.0 * margin
+        + legend_w;
+    let heights: Vec<f64> = exts
+        .iter()
+        .map(|(lo, hi)| (hi[1] - lo[1]) * scale)
+        .collect();
+    let height = heights.iter().sum::<f64>() + 4.0 * margin + 40.0;
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -73,6 +130,8 @@ pub(super) fn parts_svg(af: &Airframe) -> String {
     let mut top = margin + 14.0;
     for (vi, view) in views.iter().enumerate() {
         let h = heights[vi];
+        let f = frames[vi];
+        let (lo, hi) = exts[vi];
         let _ = writeln!(
             s,
             r#"<text x="{margin}" y="{:.1}" font-size="13" font-weight="bold">{}</text>"#,
@@ -80,9 +139,8 @@ pub(super) fn parts_svg(af: &Airframe) -> String {
             view.title
         );
         let map = |p: [f64; 3]| -> (f64, f64) {
-            let x = margin + (p[view.right] - lo[view.right]) * scale;
-            let v = (p[view.up] - lo[view.up]) * scale;
-            let y = if view.flip_up { top + v } else { top + h - v };
+            let x = margin + (dot(p, f[0]) - lo[0]) * scale;
+            let y = top + (hi[1] - dot(p, f[1])) * scale;
             (x, y)
         };
         let mut elems: Vec<(f64, [u64; 4], AirframePart)> = af
@@ -93,7 +151,7 @@ pub(super) fn parts_svg(af: &Airframe) -> String {
                 }
                 // In the side view, cut away the near (y > 0) skins to show the inside.
                 let cut = matches!(part, P::SideSkins | P::Roof | P::Nose | P::EngineFairing);
-                if vi == 0 && cut {
+                if view.cut_near && cut {
                     let yc: f64 = n.iter().map(|&i| nodes[i as usize - 1][1]).sum::<f64>() / 4.0;
                     return yc < 0.0;
                 }
@@ -102,13 +160,13 @@ pub(super) fn parts_svg(af: &Airframe) -> String {
             .map(|(n, part)| {
                 let d: f64 = n
                     .iter()
-                    .map(|&i| nodes[i as usize - 1][view.depth])
+                    .map(|&i| dot(nodes[i as usize - 1], f[2]))
                     .sum::<f64>()
                     / 4.0;
                 (d, n, part)
             })
             .collect();
-        // Far to near: the viewer looks from +y (side) and from +z (plan).
+        // Painted far to near.
         elems.sort_by(|a, b| a.0.total_cmp(&b.0));
         for (_, n, part) in &elems {
             let mut pts = String::new();
