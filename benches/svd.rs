@@ -7,23 +7,10 @@
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use faer::Mat;
 use impactcal::shapes::{ImpactShapes, ShapeOptions, SvdMethod, Truncation};
-use rand::{Rng, SeedableRng};
-
-fn benchmark_matrix(m: usize, n: usize, seed: u64) -> Mat<f64> {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    let a = Mat::from_fn(m, 60, |_, j| {
-        0.85f64.powi(j as i32) * rng.random_range(-1.0..1.0)
-    });
-    let b = Mat::from_fn(60, n, |_, _| rng.random_range(-1.0..1.0));
-    let mut y = &a * &b;
-    y.col_iter_mut().for_each(|c| {
-        c.iter_mut()
-            .for_each(|x| *x += 1e-4 * rng.random_range(-1.0..1.0))
-    });
-    y
-}
+#[path = "common/svd_matrix.rs"]
+mod svd_matrix;
+use svd_matrix::benchmark_matrix;
 
 fn svd(c: &mut Criterion) {
     let mut g = c.benchmark_group("impact_shapes");

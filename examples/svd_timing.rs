@@ -10,25 +10,10 @@
 use std::io::Write;
 use std::time::Instant;
 
-use faer::Mat;
 use impactcal::shapes::{ImpactShapes, ShapeOptions, SvdMethod, Truncation};
-use rand::{Rng, SeedableRng};
-
-/// `m x n` matrix with a decaying spectrum: 60 rank-one terms of weight 0.85^j plus noise.
-fn benchmark_matrix(m: usize, n: usize, seed: u64) -> Mat<f64> {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    let r = 60;
-    let a = Mat::from_fn(m, r, |_, j| {
-        0.85f64.powi(j as i32) * rng.random_range(-1.0..1.0)
-    });
-    let b = Mat::from_fn(r, n, |_, _| rng.random_range(-1.0..1.0));
-    let mut y = &a * &b;
-    y.col_iter_mut().for_each(|c| {
-        c.iter_mut()
-            .for_each(|x| *x += 1e-4 * rng.random_range(-1.0..1.0))
-    });
-    y
-}
+#[path = "../benches/common/svd_matrix.rs"]
+mod svd_matrix;
+use svd_matrix::benchmark_matrix;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);

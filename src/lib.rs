@@ -6,6 +6,7 @@
 //! |---|---|---|
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
+//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -21,6 +22,7 @@
 
 pub use impactcal_core as core;
 pub use impactcal_shapes as shapes;
+pub use impactcal_shell as shell;
 
 /// The types most programs need, in one import.
 pub mod prelude {
@@ -31,4 +33,5 @@ pub mod prelude {
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
     };
+    pub use impactcal_shell::{ShellError, ShellModel, Simulation};
 }

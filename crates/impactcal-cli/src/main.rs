@@ -8,6 +8,7 @@ mod error;
 mod expand;
 mod output;
 mod shapes;
+mod simulate;
 
 use std::process::ExitCode;
 
@@ -32,6 +33,9 @@ enum Command {
     Compare(compare::Args),
     /// Expand measured channels to the unmeasured channels of a model through its shapes.
     Expand(expand::Args),
+    /// Run an LS-DYNA keyword deck with the built-in explicit shell solver; write nodal
+    /// histories and energies as CSV.
+    Simulate(simulate::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -39,6 +43,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Shapes(a) => shapes::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
+        Command::Simulate(a) => simulate::run(a),
     }
 }
 

@@ -249,12 +249,8 @@ impl Histories {
     /// # Errors
     /// [`CoreError::Io`] when unreadable; otherwise as [`Histories::parse_csv`].
     pub fn read_csv(path: impl AsRef<Path>) -> Result<Histories> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| CoreError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
-        Histories::parse_csv(&text, &path.display().to_string())
+        let (text, name) = crate::table::read_text(path.as_ref())?;
+        Histories::parse_csv(&text, &name)
     }
 
     /// Parses wide CSV: a header `time,<label>,<label>,...`, then one row per sample. The

@@ -34,4 +34,4 @@ pub use error::{CoreError, Result, check_finite};
 pub use histories::Histories;
 pub use model::{BatchResults, Model, RunFailure};
 pub use space::{Parameter, ParameterSpace};
-pub use table::{Table, TableOptions};
+pub use table::{Table, TableOptions, read_text};

@@ -237,12 +237,8 @@ impl ParameterSpace {
     /// # Errors
     /// [`CoreError::Io`] when unreadable; otherwise as [`parse_csv`](Self::parse_csv).
     pub fn read_csv(path: impl AsRef<Path>) -> Result<Self> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| CoreError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
-        Self::parse_csv(&text, &path.display().to_string())
+        let (text, name) = crate::table::read_text(path.as_ref())?;
+        Self::parse_csv(&text, &name)
     }
 
     /// Parses bounds CSV text; see [`read_csv`](Self::read_csv).
@@ -252,11 +248,7 @@ impl ParameterSpace {
     /// column) for a wrong header, a ragged row, a number that does not parse or is not
     /// finite, `lower >= upper`, a nominal outside the bounds, or a repeated name.
     pub fn parse_csv(text: &str, source_name: &str) -> Result<Self> {
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .flexible(true)
-            .trim(csv::Trim::All)
-            .from_reader(text.as_bytes());
+        let mut reader = crate::table::csv_reader(text);
         let err = |row: usize, column: usize, message: String| CoreError::Csv {
             file: source_name.to_string(),
             row,

@@ -36,12 +36,8 @@ impl Table {
     /// # Errors
     /// [`CoreError::Io`] when the file cannot be read, otherwise as [`Table::parse`].
     pub fn read(path: impl AsRef<Path>, options: TableOptions) -> Result<Table> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| CoreError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
-        Table::parse(&text, &path.display().to_string(), options)
+        let (text, name) = read_text(path.as_ref())?;
+        Table::parse(&text, &name, options)
     }
 
     /// Parses CSV text whose first non-empty line is a header of column names.
@@ -54,11 +50,7 @@ impl Table {
     /// column name, a row with the wrong number of fields, text that is not a number, or a
     /// non-finite value (NaN and empty cells are accepted only with `allow_missing`).
     pub fn parse(text: &str, source_name: &str, options: TableOptions) -> Result<Table> {
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .flexible(true)
-            .trim(csv::Trim::All)
-            .from_reader(text.as_bytes());
+        let mut reader = csv_reader(text);
         let csv_error = |row: usize, column: usize, message: String| CoreError::Csv {
             file: source_name.to_string(),
             row,
@@ -156,6 +148,28 @@ impl Table {
         }
         out.flush().map_err(io)
     }
+}
+
+/// Reads a whole text file, returning its text and its path as a display name.
+///
+/// # Errors
+/// [`CoreError::Io`] naming the path.
+pub fn read_text(path: &Path) -> Result<(String, String)> {
+    let name = path.display().to_string();
+    match std::fs::read_to_string(path) {
+        Ok(text) => Ok((text, name)),
+        Err(source) => Err(CoreError::Io { path: name, source }),
+    }
+}
+
+/// The CSV reader every file goes through: no implicit header (callers check it), rows of
+/// any length (callers report ragged rows with a position), fields trimmed.
+pub(crate) fn csv_reader(text: &str) -> csv::Reader<&[u8]> {
+    csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes())
 }
 
 /// Maps byte offsets of a text to 1-based line numbers (the csv crate's own line count skips

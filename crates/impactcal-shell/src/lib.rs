@@ -68,7 +68,8 @@
 //! assert!(result.summary.energy_ratio < 1.05);
 //! # Ok::<(), impactcal_shell::ShellError>(())
 //! ```
-#![allow(clippy::needless_range_loop)]
+// `!(x > 0.0)` is used on purpose: it also rejects NaN.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod airframe;
 pub mod element;

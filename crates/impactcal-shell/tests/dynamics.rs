@@ -1,5 +1,12 @@
 //! Verification of the solver against analytic results (shell-solver.md section 5).
 
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::float_cmp,
+    clippy::needless_range_loop
+)]
+
 mod common;
 
 use common::*;

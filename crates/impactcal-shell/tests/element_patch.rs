@@ -1,6 +1,13 @@
 //! V1 (rigid motion of a warped element, constant membrane and bending patches), V3
 //! (stability limit), conservation of momentum and thread-count independence.
 
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::float_cmp,
+    clippy::needless_range_loop
+)]
+
 mod common;
 
 use common::*;

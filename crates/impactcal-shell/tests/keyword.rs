@@ -1,5 +1,12 @@
 //! Keyword decks: round trip, the supported cards, typed errors.
 
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::float_cmp,
+    clippy::needless_range_loop
+)]
+
 mod common;
 
 use common::*;

@@ -1,6 +1,6 @@
 //! LS-DYNA keyword decks: the subset this solver supports, in and out.
 //!
-//! [`parse_deck`] / [`read_deck`] turn a deck into a [`ShellModel`]; [`write_deck`] writes a
+//! [`parse_deck`] / [`read_deck`] turn a deck into a [`ShellModel`](crate::ShellModel); [`write_deck`] writes a
 //! model back in fixed-width format, and reading what it wrote gives the same model.
 //!
 //! Cards may be fixed-width (the widths of each keyword's manual page: 8/16 for `*NODE`,
@@ -11,7 +11,10 @@
 //! system id, a box, mass scaling) are errors too. The supported keywords and fields are
 //! listed card by card in `docs/shell-solver.md`.
 
+// Deck flags and defaults are exact values (0, 1): compare them exactly.
+#[allow(clippy::float_cmp)]
 mod reader;
+#[allow(clippy::float_cmp)]
 mod writer;
 
 pub use reader::{Deck, IGNORED_KEYWORDS, parse_deck, read_deck};

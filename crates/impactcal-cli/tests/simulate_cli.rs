@@ -1,0 +1,88 @@
+//! End-to-end tests of `impactcal simulate` on the shipped deck and on malformed decks.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use impactcal::core::Histories;
+
+fn deck(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/decks")
+        .join(name)
+}
+
+fn impactcal(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_impactcal"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+#[test]
+fn simulate_writes_histories_energies_and_a_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let h = dir.path().join("h.csv");
+    let e = dir.path().join("e.csv");
+    let d = deck("strip_drop.k");
+    let run = |threads: &str, q: &str| {
+        let out = impactcal(&[
+            "simulate",
+            "--deck",
+            d.to_str().unwrap(),
+            "--out",
+            h.to_str().unwrap(),
+            "--energies",
+            e.to_str().unwrap(),
+            "--quantity",
+            q,
+            "--threads",
+            threads,
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stderr).to_string()
+    };
+    let log = run("1", "velocity");
+    assert!(
+        log.contains("cycles") && log.contains("energy ratio"),
+        "{log}"
+    );
+    let v1 = Histories::read_csv(&h).unwrap();
+    assert_eq!(
+        v1.labels(),
+        ["21.x", "21.y", "21.z", "42.x", "42.y", "42.z"]
+    );
+    assert_eq!(v1.samples(), 101);
+    assert_eq!(v1.channel(2)[0], -5.0);
+    let energies = Histories::read_csv(&e).unwrap();
+    let ratio = energies.channel_by_label("energy_ratio").unwrap();
+    assert!(ratio.iter().all(|r| (r - 1.0).abs() < 0.05));
+    // Same histories on two threads.
+    run("2", "velocity");
+    assert_eq!(Histories::read_csv(&h).unwrap(), v1);
+    // Displacement: node 21 starts 6 mm up, comes down and never passes the floor.
+    run("2", "displacement");
+    let u = Histories::read_csv(&h).unwrap();
+    let uz = u.channel_by_label("21.z").unwrap();
+    let lowest = uz.iter().cloned().fold(f64::INFINITY, f64::min);
+    assert!((-0.006 - 1e-12..-0.004).contains(&lowest), "{lowest}");
+}
+
+#[test]
+fn a_bad_deck_is_an_input_error_naming_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.k");
+    std::fs::write(&bad, "*KEYWORD\n*CONTACT_AUTOMATIC_SINGLE_SURFACE\n*END\n").unwrap();
+    let out = impactcal(&["simulate", "--deck", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("line 2") && err.contains("*CONTACT_AUTOMATIC_SINGLE_SURFACE"),
+        "{err}"
+    );
+}
