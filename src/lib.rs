@@ -6,6 +6,7 @@
 //! |---|---|---|
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
+//! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
 //!
 //! ```
@@ -21,6 +22,7 @@
 //!
 
 pub use impactcal_core as core;
+pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
 pub use impactcal_shell as shell;
 
@@ -29,6 +31,10 @@ pub mod prelude {
     pub use impactcal_core::{
         BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
         TableOptions,
+    };
+    pub use impactcal_sensors::{
+        CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,
+        place_from_histories,
     };
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,

@@ -7,6 +7,7 @@ mod compare;
 mod error;
 mod expand;
 mod output;
+mod place;
 mod shapes;
 mod simulate;
 
@@ -33,6 +34,9 @@ enum Command {
     Compare(compare::Args),
     /// Expand measured channels to the unmeasured channels of a model through its shapes.
     Expand(expand::Args),
+    /// Sensor placement by effective independence (Kammer) on impact shapes or a shape
+    /// matrix.
+    Place(place::Args),
     /// Run an LS-DYNA keyword deck with the built-in explicit shell solver; write nodal
     /// histories and energies as CSV.
     Simulate(simulate::Args),
@@ -43,6 +47,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Shapes(a) => shapes::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
+        Command::Place(a) => place::run(a),
         Command::Simulate(a) => simulate::run(a),
     }
 }

@@ -1,0 +1,131 @@
+//! `impactcal place`: sensor placement by effective independence.
+
+use std::path::PathBuf;
+
+use clap::{Args as ClapArgs, ValueEnum};
+use impactcal::core::Histories;
+use impactcal::sensors::{
+    CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,
+    place_from_histories,
+};
+use serde::Serialize;
+
+use crate::error::CliError;
+use crate::output::write_json;
+use crate::shapes::options;
+
+/// Arguments of `impactcal place`.
+#[derive(ClapArgs, Debug)]
+#[command(group(clap::ArgGroup::new("input").required(true).args(["histories", "shape_matrix"])))]
+pub struct Args {
+    /// Simulated histories at every candidate DOF (wide CSV); repeat for an ensemble of
+    /// runs, which are concatenated in time before the impact-shape SVD.
+    #[arg(long, num_args = 1..)]
+    pub histories: Vec<PathBuf>,
+    /// Number of impact shapes to keep from the histories (default: all up to the rank).
+    #[arg(long, requires = "histories", conflicts_with = "contribution")]
+    pub shapes: Option<usize>,
+    /// Keep the fewest impact shapes whose cumulative contribution reaches this fraction.
+    #[arg(long, requires = "histories")]
+    pub contribution: Option<f64>,
+    /// A candidate shape matrix instead: CSV with header `label,shape1,shape2,...`.
+    #[arg(long)]
+    pub shape_matrix: Option<PathBuf>,
+    /// Number of sensors to keep (of nodes with --nodes).
+    #[arg(long)]
+    pub sensors: usize,
+    /// Place triaxial sensors: select whole nodes (labels `<node>.<x|y|z>`).
+    #[arg(long)]
+    pub nodes: bool,
+    /// DOF labels that must stay, comma separated.
+    #[arg(long, value_delimiter = ',')]
+    pub keep: Vec<String>,
+    /// DOF labels that may not be used, comma separated.
+    #[arg(long, value_delimiter = ',')]
+    pub exclude: Vec<String>,
+    /// Backward elimination (Kammer) or forward greedy from a pivoted-QR start.
+    #[arg(long, value_enum, default_value_t = MethodArg::Backward)]
+    pub method: MethodArg,
+    /// Refine the greedy result by determinant-raising swaps.
+    #[arg(long)]
+    pub swaps: bool,
+    /// Write the JSON here instead of stdout.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// The `--method` values.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum MethodArg {
+    /// Kammer's backward elimination.
+    Backward,
+    /// Forward greedy addition.
+    Forward,
+}
+
+#[derive(Serialize)]
+struct Report<'a> {
+    #[serde(flatten)]
+    placement: &'a Placement,
+    candidates: usize,
+    shapes: usize,
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let mut opts = PlacementOptions::new(args.sensors)
+        .grouping(if args.nodes {
+            Grouping::Node
+        } else {
+            Grouping::Dof
+        })
+        .method(match args.method {
+            MethodArg::Backward => Method::Backward,
+            MethodArg::Forward => Method::Forward,
+        })
+        .swap_refinement(args.swaps);
+    opts.keep = args.keep.iter().map(|s| s.trim().to_string()).collect();
+    opts.exclude = args.exclude.iter().map(|s| s.trim().to_string()).collect();
+    let (placement, candidates, shapes) = if let Some(path) = &args.shape_matrix {
+        let c = CandidateShapes::read_csv(path).map_err(sensors_error)?;
+        let p = place(&c, &opts).map_err(|e| in_file(path, e))?;
+        (p, c.candidates(), c.shapes_count())
+    } else {
+        let runs = args
+            .histories
+            .iter()
+            .map(Histories::read_csv)
+            .collect::<Result<Vec<_>, _>>()?;
+        let r = place_from_histories(&runs, &options(args.shapes, args.contribution), &opts)
+            .map_err(|e| in_file(&args.histories[0], e))?;
+        (r.placement, r.shapes.channels(), r.shapes.len())
+    };
+    for w in &placement.warnings {
+        eprintln!("impactcal: warning: {w}");
+    }
+    write_json(
+        &Report {
+            placement: &placement,
+            candidates,
+            shapes,
+        },
+        args.out.as_deref(),
+    )
+}
+
+/// A library error as a command error: numerical failures and I/O exit 1, the rest 2.
+fn sensors_error(e: SensorsError) -> CliError {
+    match e {
+        SensorsError::Core(c) => c.into(),
+        SensorsError::Numerical(_) => CliError::Failure(e.to_string()),
+        e => CliError::input(e),
+    }
+}
+
+/// As [`sensors_error`], naming the input file for errors that do not already.
+fn in_file(path: &std::path::Path, e: SensorsError) -> CliError {
+    match e {
+        SensorsError::Core(_) | SensorsError::Numerical(_) => sensors_error(e),
+        e => CliError::input(format!("{}: {e}", path.display())),
+    }
+}

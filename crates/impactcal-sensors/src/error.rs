@@ -1,0 +1,126 @@
+//! The error type of `impactcal-sensors`.
+
+use impactcal_core::CoreError;
+
+/// Everything that can stop a sensor placement.
+///
+/// Counts are numbers of candidate DOFs in per-DOF placement and numbers of nodes in
+/// node-grouped placement, as stated in each variant.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SensorsError {
+    /// Reading or validating shared input failed (a CSV fault names file, row and column).
+    #[error(transparent)]
+    Core(#[from] CoreError),
+    /// Computing impact shapes from an ensemble of histories failed.
+    #[error(transparent)]
+    Shapes(#[from] impactcal_shapes::ShapesError),
+    /// A shape value is NaN or infinite.
+    #[error("shape matrix: non-finite value {value} at candidate `{label}`, shape {shape}")]
+    NonFinite {
+        /// Label of the candidate row.
+        label: String,
+        /// 1-based shape (column) number.
+        shape: usize,
+        /// The value.
+        value: f64,
+    },
+    /// Fewer usable candidates than target shapes: the shapes cannot be told apart.
+    #[error(
+        "{candidates} usable candidate DOFs for {shapes} shapes: need at least as many candidates as shapes"
+    )]
+    TooFewCandidates {
+        /// Usable candidate DOFs (after exclusions and dropping all-zero rows).
+        candidates: usize,
+        /// Number of shapes (columns).
+        shapes: usize,
+    },
+    /// The target count is below the number of shapes (or, for nodes, the target nodes
+    /// cannot hold as many DOFs as there are shapes).
+    #[error("target of {target} {unit} cannot observe {shapes} shapes ({dofs} DOFs at most)")]
+    TargetBelowShapes {
+        /// The target count.
+        target: usize,
+        /// `"sensors"` or `"nodes"`.
+        unit: &'static str,
+        /// The most DOFs the target can hold.
+        dofs: usize,
+        /// Number of shapes.
+        shapes: usize,
+    },
+    /// The target count exceeds what is available.
+    #[error("target of {target} {unit} exceeds the {available} usable {unit}")]
+    TargetAboveCandidates {
+        /// The target count.
+        target: usize,
+        /// `"sensors"` or `"nodes"`.
+        unit: &'static str,
+        /// What is available.
+        available: usize,
+    },
+    /// The shape matrix (restricted to the usable candidates and weighted) does not have
+    /// full column rank.
+    #[error(
+        "the shape matrix has numerical rank {rank} but {shapes} shapes (sigma_min/sigma_max = {ratio:e}); truncate the shapes to {rank}"
+    )]
+    RankDeficient {
+        /// Number of singular values above the tolerance.
+        rank: usize,
+        /// Number of shapes (columns).
+        shapes: usize,
+        /// Smallest over largest singular value.
+        ratio: f64,
+    },
+    /// A label named in an option is not a candidate.
+    #[error("{option}: no candidate labelled `{label}`")]
+    UnknownLabel {
+        /// The option (`keep`, `exclude`).
+        option: &'static str,
+        /// The label.
+        label: String,
+    },
+    /// A label is both required and forbidden.
+    #[error("`{label}` is both kept and excluded")]
+    KeepExcludeConflict {
+        /// The label.
+        label: String,
+    },
+    /// More DOFs or nodes must stay than the target allows.
+    #[error("{kept} {unit} must stay but the target is {target}")]
+    TooManyKept {
+        /// Number that must stay.
+        kept: usize,
+        /// `"sensors"` or `"nodes"`.
+        unit: &'static str,
+        /// The target.
+        target: usize,
+    },
+    /// A label does not have the form `<node>.<x|y|z>` needed by node-grouped placement.
+    #[error("candidate `{label}`: node-grouped placement needs labels `<node>.<x|y|z>`")]
+    BadNodeLabel {
+        /// The label.
+        label: String,
+    },
+    /// An option value is invalid (for example a noise level that is not positive).
+    #[error("invalid option: {0}")]
+    InvalidOption(String),
+    /// Every removable candidate is essential: removing any would make the information
+    /// matrix singular (the DOFs that must stay do not span the shapes).
+    #[error(
+        "cannot go below {remaining} {unit}: every removable candidate is essential (score {score})"
+    )]
+    AllEssential {
+        /// Count still in the set.
+        remaining: usize,
+        /// `"sensors"` or `"nodes"`.
+        unit: &'static str,
+        /// The smallest score found.
+        score: f64,
+    },
+    /// A dense factorisation failed to converge.
+    #[error("numerical failure: {0}")]
+    Numerical(String),
+}
+
+/// `Result` with [`SensorsError`].
+pub type Result<T, E = SensorsError> = std::result::Result<T, E>;
