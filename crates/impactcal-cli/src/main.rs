@@ -3,6 +3,7 @@
 //! Each subcommand lives in its own module with an `Args` struct (clap) and a `run`
 //! function; this file only registers them. Numerical work happens in the library.
 
+mod airframe;
 mod compare;
 mod error;
 mod expand;
@@ -40,6 +41,9 @@ enum Command {
     /// Run an LS-DYNA keyword deck with the built-in explicit shell solver; write nodal
     /// histories and energies as CSV.
     Simulate(simulate::Args),
+    /// The built-in parametric helicopter airframe: write it as a keyword deck, list its
+    /// adjustable quantities and presets, draw its parts.
+    Airframe(airframe::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -49,6 +53,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Expand(a) => expand::run(a),
         Command::Place(a) => place::run(a),
         Command::Simulate(a) => simulate::run(a),
+        Command::Airframe(a) => airframe::run(a),
     }
 }
 
