@@ -131,6 +131,11 @@ pub(crate) const MASSES: [(&str, f64, &str); 5] = [
 /// The 386.09 in/s^2 of standard gravity.
 pub const GRAVITY: f64 = 386.088;
 
+/// `v * f` rounded to 12 significant digits, so that +-20 % bounds print as written.
+fn scaled(v: f64, f: f64) -> f64 {
+    format!("{:.11e}", v * f).parse().unwrap_or(v * f)
+}
+
 /// The full catalogue, in a fixed order: the globals, the concentrated masses, then each
 /// part's `t`, `E`, `Et`, `sigy`.
 ///
@@ -217,8 +222,8 @@ pub fn catalogue() -> Vec<Adjustable> {
         add(
             &format!("mass.{name}"),
             m,
-            0.8 * m,
-            1.2 * m,
+            scaled(m, 0.8),
+            scaled(m, 1.2),
             "lbf s^2/in",
             d.into(),
         );
@@ -226,7 +231,7 @@ pub fn catalogue() -> Vec<Adjustable> {
     for part in AirframePart::ALL {
         let (mat, t) = part.nominal();
         let p = part.name();
-        let (tl, tu) = table2_bounds(part).unwrap_or((0.8 * t, 1.2 * t));
+        let (tl, tu) = table2_bounds(part).unwrap_or((scaled(t, 0.8), scaled(t, 1.2)));
         add(
             &format!("{p}.t"),
             t,
@@ -238,24 +243,24 @@ pub fn catalogue() -> Vec<Adjustable> {
         add(
             &format!("{p}.E"),
             mat.youngs,
-            0.8 * mat.youngs,
-            1.2 * mat.youngs,
+            scaled(mat.youngs, 0.8),
+            scaled(mat.youngs, 1.2),
             "lbf/in^2",
             format!("{} Young's modulus", part.label()),
         );
         add(
             &format!("{p}.Et"),
             mat.tangent,
-            0.8 * mat.tangent,
-            1.2 * mat.tangent,
+            scaled(mat.tangent, 0.8),
+            scaled(mat.tangent, 1.2),
             "lbf/in^2",
             format!("{} tangent modulus", part.label()),
         );
         add(
             &format!("{p}.sigy"),
             mat.yield_stress,
-            0.8 * mat.yield_stress,
-            1.2 * mat.yield_stress,
+            scaled(mat.yield_stress, 0.8),
+            scaled(mat.yield_stress, 1.2),
             "lbf/in^2",
             format!("{} yield stress", part.label()),
         );
