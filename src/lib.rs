@@ -7,7 +7,7 @@
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
 //! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
-//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
+//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -38,6 +38,9 @@ pub mod prelude {
     };
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
+    };
+    pub use impactcal_shell::airframe::{
+        Airframe, AirframeModel, AirframeOptions, AirframeValues, MeshDensity, Preset,
     };
     pub use impactcal_shell::{ShellError, ShellModel, Simulation};
 }

@@ -1,6 +1,6 @@
 //! End-to-end tests of `impactcal airframe` and `impactcal simulate --model airframe`.
 
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 use std::process::{Command, Output};
 
@@ -56,7 +56,11 @@ fn deck_and_model_runs_agree() {
         "--svg",
         svg.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let picture = std::fs::read_to_string(&svg).unwrap();
     assert!(picture.starts_with("<svg") && picture.contains("keel_beam_stiffener"));
 
@@ -69,7 +73,11 @@ fn deck_and_model_runs_agree() {
         "--out",
         h_deck.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = impactcal(&[
         "simulate",
         "--model",
@@ -81,7 +89,11 @@ fn deck_and_model_runs_agree() {
         "--out",
         h_model.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let summary = String::from_utf8_lossy(&out.stderr).to_string();
     assert!(summary.contains("1948 shells"), "{summary}");
     let a = Histories::read_csv(&h_deck).unwrap();
