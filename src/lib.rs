@@ -6,6 +6,8 @@
 //! |---|---|---|
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
+//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
+//! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) |
 //! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe |
 //!
@@ -22,6 +24,8 @@
 //!
 
 pub use impactcal_core as core;
+pub use impactcal_cors as cors;
+pub use impactcal_erbf as erbf;
 pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
 pub use impactcal_shell as shell;
@@ -31,6 +35,12 @@ pub mod prelude {
     pub use impactcal_core::{
         BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
         TableOptions,
+    };
+    pub use impactcal_cors::{
+        Cors, CorsError, CorsOptions, InitialDesign, Outcome, StopReason, Suggestion, Transform,
+    };
+    pub use impactcal_erbf::{
+        Accuracy, ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions,
     };
     pub use impactcal_sensors::{
         CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,

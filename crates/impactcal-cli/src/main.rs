@@ -7,10 +7,12 @@ mod airframe;
 mod compare;
 mod error;
 mod expand;
+mod optimize;
 mod output;
 mod place;
 mod shapes;
 mod simulate;
+mod surrogate;
 
 use std::process::ExitCode;
 
@@ -28,6 +30,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// ERBF and RBF surrogates of sampled responses (whole time histories).
+    Surrogate(surrogate::Args),
     /// Impact shapes (SVD) of a histories file: singular values, contributions, shapes and
     /// time functions as JSON.
     Shapes(shapes::Args),
@@ -35,6 +39,8 @@ enum Command {
     Compare(compare::Args),
     /// Expand measured channels to the unmeasured channels of a model through its shapes.
     Expand(expand::Args),
+    /// CORS-RBF optimisation of an expensive model driven from the shell.
+    Optimize(optimize::Args),
     /// Sensor placement by effective independence (Kammer) on impact shapes or a shape
     /// matrix.
     Place(place::Args),
@@ -48,9 +54,11 @@ enum Command {
 
 fn run(command: Command) -> Result<(), CliError> {
     match command {
+        Command::Surrogate(args) => surrogate::run(args),
         Command::Shapes(a) => shapes::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
+        Command::Optimize(a) => optimize::run(a),
         Command::Place(a) => place::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::Airframe(a) => airframe::run(a),
