@@ -6,8 +6,13 @@
 //! |---|---|---|
 //! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
+//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
+//! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) |
 //! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
+//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
+//! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals |
+//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -22,15 +27,24 @@
 //!
 
 pub use impactcal_core as core;
+pub use impactcal_cors as cors;
+pub use impactcal_erbf as erbf;
 pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
 pub use impactcal_shell as shell;
+pub use impactcal_sobol as sobol;
 
 /// The types most programs need, in one import.
 pub mod prelude {
     pub use impactcal_core::{
         BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
         TableOptions,
+    };
+    pub use impactcal_cors::{
+        Cors, CorsError, CorsOptions, InitialDesign, Outcome, StopReason, Suggestion, Transform,
+    };
+    pub use impactcal_erbf::{
+        Accuracy, ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions,
     };
     pub use impactcal_sensors::{
         CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,
@@ -39,5 +53,11 @@ pub mod prelude {
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
     };
+    pub use impactcal_shell::airframe::{
+        Airframe, AirframeModel, AirframeOptions, AirframeValues, MeshDensity, Preset,
+    };
     pub use impactcal_shell::{ShellError, ShellModel, Simulation};
+    pub use impactcal_sobol::{
+        DesignLayout, OutputView, SaltelliDesign, SobolError, SobolIndices, SobolOptions,
+    };
 }

@@ -3,13 +3,18 @@
 //! Each subcommand lives in its own module with an `Args` struct (clap) and a `run`
 //! function; this file only registers them. Numerical work happens in the library.
 
+mod airframe;
 mod compare;
 mod error;
 mod expand;
+mod optimize;
 mod output;
 mod place;
+mod sample;
 mod shapes;
 mod simulate;
+mod sobol;
+mod surrogate;
 
 use std::process::ExitCode;
 
@@ -27,6 +32,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// ERBF and RBF surrogates of sampled responses (whole time histories).
+    Surrogate(surrogate::Args),
     /// Impact shapes (SVD) of a histories file: singular values, contributions, shapes and
     /// time functions as JSON.
     Shapes(shapes::Args),
@@ -34,21 +41,35 @@ enum Command {
     Compare(compare::Args),
     /// Expand measured channels to the unmeasured channels of a model through its shapes.
     Expand(expand::Args),
+    /// CORS-RBF optimisation of an expensive model driven from the shell.
+    Optimize(optimize::Args),
     /// Sensor placement by effective independence (Kammer) on impact shapes or a shape
     /// matrix.
     Place(place::Args),
     /// Run an LS-DYNA keyword deck with the built-in explicit shell solver; write nodal
     /// histories and energies as CSV.
     Simulate(simulate::Args),
+    /// Space-filling samples (Halton, Sobol', Latin hypercubes) and Saltelli designs.
+    Sample(sample::Args),
+    /// Sobol' sensitivity indices of every output column.
+    Sobol(sobol::Args),
+    /// The built-in parametric helicopter airframe: write it as a keyword deck, list its
+    /// adjustable quantities and presets, draw its parts.
+    Airframe(airframe::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
     match command {
+        Command::Surrogate(args) => surrogate::run(args),
         Command::Shapes(a) => shapes::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Expand(a) => expand::run(a),
+        Command::Optimize(a) => optimize::run(a),
         Command::Place(a) => place::run(a),
         Command::Simulate(a) => simulate::run(a),
+        Command::Sample(a) => sample::run(a),
+        Command::Sobol(a) => sobol::run(a),
+        Command::Airframe(a) => airframe::run(a),
     }
 }
 

@@ -5,6 +5,8 @@
 //! - [`ParameterSpace`] and [`Parameter`]: named bounded parameters, the unit-cube map, and
 //!   bounds files `name,lower,upper,nominal[,unit]`.
 //! - [`Model`]: a parameter vector in, histories out, with parallel batch evaluation.
+//! - [`sampling`]: Halton (plain and scrambled), Sobol' (Joe-Kuo, optionally Owen-scrambled),
+//!   Latin hypercube and symmetric Latin hypercube samples, seeded, mapped onto a space.
 //! - [`Table`]: the numeric CSV reader every file of the project goes through, reporting the
 //!   file, row and column of the first fault.
 //! - [`CoreError`]: the typed error of all of the above.
@@ -27,11 +29,13 @@
 pub mod error;
 pub mod histories;
 pub mod model;
+pub mod sampling;
 pub mod space;
 pub mod table;
 
 pub use error::{CoreError, Result, check_finite};
 pub use histories::Histories;
 pub use model::{BatchResults, Model, RunFailure};
+pub use sampling::{Method as SamplingMethod, Points};
 pub use space::{Parameter, ParameterSpace};
 pub use table::{Table, TableOptions, read_text};

@@ -1,0 +1,242 @@
+//! `impactcal surrogate fit|predict`: ERBF and RBF surrogates of sampled responses.
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args as ClapArgs, Subcommand, ValueEnum};
+use faer::Mat;
+use impactcal::core::{ParameterSpace, Table, TableOptions};
+use impactcal::erbf::{ErbfError, ErrorSummary, LooMethod, Surrogate, SurrogateKind};
+
+use crate::error::CliError;
+use crate::output::{write_json, writer};
+
+/// Fit a surrogate to samples, or predict with a saved one.
+#[derive(ClapArgs, Debug)]
+pub struct Args {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Fit a surrogate: prints the training residual and the leave-one-out error to stderr
+    /// and writes the model as JSON.
+    Fit(FitArgs),
+    /// Predict with a saved model at new parameter values.
+    Predict(PredictArgs),
+}
+
+/// Surrogate kinds on the command line.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum Kind {
+    /// Extended RBF (Mullur and Messac; n_t = 4, gamma = 0.15, r_c = 0.15).
+    Erbf,
+    /// Gaussian RBF (r_c = 0.15 in scaled inputs), no tail.
+    Gaussian,
+    /// Cubic RBF with a linear tail.
+    Cubic,
+    /// Thin-plate spline with a linear tail.
+    ThinPlate,
+    /// Multiquadric RBF (c = 0.15 in scaled inputs) with a constant tail.
+    Multiquadric,
+}
+
+impl From<Kind> for SurrogateKind {
+    fn from(k: Kind) -> Self {
+        match k {
+            Kind::Erbf => SurrogateKind::Erbf,
+            Kind::Gaussian => SurrogateKind::Gaussian,
+            Kind::Cubic => SurrogateKind::Cubic,
+            Kind::ThinPlate => SurrogateKind::ThinPlate,
+            Kind::Multiquadric => SurrogateKind::Multiquadric,
+        }
+    }
+}
+
+#[derive(ClapArgs, Debug)]
+struct FitArgs {
+    /// Bounds file: `name,lower,upper,nominal[,unit]`; inputs are scaled by these bounds.
+    #[arg(long)]
+    bounds: PathBuf,
+    /// Parameter samples: a header of parameter names (every name of the bounds file), one
+    /// row per sample.
+    #[arg(long)]
+    params: PathBuf,
+    /// Responses: a header of output names, one row per sample (same order as --params),
+    /// any number of columns (for example the samples of a time history).
+    #[arg(long)]
+    outputs: PathBuf,
+    /// Surrogate kind.
+    #[arg(long, value_enum, default_value = "erbf")]
+    kind: Kind,
+    /// Where to write the model (JSON); stdout when absent.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(ClapArgs, Debug)]
+struct PredictArgs {
+    /// A model written by `impactcal surrogate fit`.
+    #[arg(long)]
+    model: PathBuf,
+    /// Parameter values: a header of parameter names, one row per query.
+    #[arg(long)]
+    params: PathBuf,
+    /// Where to write the predictions (CSV with the model's output names); stdout when
+    /// absent.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<(), CliError> {
+    match args.command {
+        Command::Fit(a) => fit(a),
+        Command::Predict(a) => predict(a),
+    }
+}
+
+fn fit(a: FitArgs) -> Result<(), CliError> {
+    let space = ParameterSpace::read_csv(&a.bounds)?;
+    let params = Table::read(&a.params, TableOptions::default())?;
+    let outputs = Table::read(&a.outputs, TableOptions::default())?;
+    let x = parameter_matrix(&space, &params, &a.params)?;
+    if outputs.rows.len() != params.rows.len() {
+        return Err(CliError::Input(format!(
+            "{}: {} sample rows, but {} has {}; one response row per sample is required",
+            a.outputs.display(),
+            outputs.rows.len(),
+            a.params.display(),
+            params.rows.len()
+        )));
+    }
+    let f = Mat::from_fn(outputs.rows.len(), outputs.header.len(), |i, j| {
+        outputs.rows[i][j]
+    });
+    let model = Surrogate::fit(
+        &space,
+        a.kind.into(),
+        x.as_ref(),
+        f.as_ref(),
+        outputs.header.clone(),
+    )
+    .map_err(|e| fit_error(e, &params, &a.params))?;
+    eprintln!(
+        "surrogate ({:?}): {} samples, {} parameters, {} outputs",
+        model.kind(),
+        model.n_samples(),
+        space.dim(),
+        outputs.header.len()
+    );
+    eprintln!(
+        "training residual max|f(x_k) - F_k| / max|F| = {:.3e}",
+        model.training_residual()
+    );
+    match model.loo_errors(LooMethod::Auto) {
+        Ok(e) => {
+            let s = ErrorSummary::new(e.as_ref(), model.values());
+            eprintln!(
+                "leave-one-out error: rms {:.6e}, max {:.6e}, rms / std(F) {:.4}",
+                s.rms, s.max_abs, s.relative_rms
+            );
+        }
+        Err(e) => eprintln!("leave-one-out error: not available ({e})"),
+    }
+    write_json(&model, a.out.as_deref())
+}
+
+fn predict(a: PredictArgs) -> Result<(), CliError> {
+    let text = std::fs::read_to_string(&a.model)
+        .map_err(|e| CliError::Input(format!("{}: {e}", a.model.display())))?;
+    let model: Surrogate = serde_json::from_str(&text).map_err(|e| {
+        CliError::Input(format!(
+            "{}: not a surrogate model written by `impactcal surrogate fit`: {e}",
+            a.model.display()
+        ))
+    })?;
+    let params = Table::read(&a.params, TableOptions::default())?;
+    let x = parameter_matrix(model.space(), &params, &a.params)?;
+    let outside: Vec<usize> = (0..x.nrows())
+        .filter(|&i| {
+            let row: Vec<f64> = x.row(i).iter().copied().collect();
+            model.is_outside(&row)
+        })
+        .collect();
+    if let Some(&first) = outside.first() {
+        eprintln!(
+            "warning: {} of {} query rows lie outside the bounds (first at line {} of {}); \
+             the surrogate extrapolates there",
+            outside.len(),
+            x.nrows(),
+            params.lines.get(first).copied().unwrap_or(0),
+            a.params.display()
+        );
+    }
+    let y = model
+        .predict_batch(x.as_ref())
+        .map_err(|e| CliError::Input(format!("{}: {e}", a.params.display())))?;
+    let table = Table {
+        header: model.output_names().to_vec(),
+        rows: (0..y.nrows())
+            .map(|i| y.row(i).iter().copied().collect())
+            .collect(),
+        lines: Vec::new(),
+    };
+    let (out, name) = writer(a.out.as_deref())?;
+    table
+        .write(out, &name)
+        .map_err(|e| CliError::Failure(e.to_string()))
+}
+
+/// The samples as an `N x m` matrix in the order of `space`, matched by column name.
+fn parameter_matrix(
+    space: &ParameterSpace,
+    table: &Table,
+    path: &Path,
+) -> Result<Mat<f64>, CliError> {
+    let mut columns = Vec::with_capacity(space.dim());
+    for name in space.names() {
+        match table.column_index(name) {
+            Some(c) => columns.push(c),
+            None => {
+                return Err(CliError::Input(format!(
+                    "{}: no column `{name}` (the header must name every parameter of the \
+                     bounds file: {})",
+                    path.display(),
+                    space.names().join(", ")
+                )));
+            }
+        }
+    }
+    if let Some(extra) = table.header.iter().find(|h| space.index_of(h).is_none()) {
+        return Err(CliError::Input(format!(
+            "{}: column `{extra}` is not a parameter of the bounds file ({})",
+            path.display(),
+            space.names().join(", ")
+        )));
+    }
+    Ok(Mat::from_fn(table.rows.len(), columns.len(), |i, j| {
+        table.rows[i][columns[j]]
+    }))
+}
+
+/// Maps sample indices in a fit error to lines of the samples file.
+fn fit_error(e: ErbfError, params: &Table, path: &Path) -> CliError {
+    let line = |k: usize| params.lines.get(k).copied().unwrap_or(k + 2);
+    match e {
+        ErbfError::DuplicateSamples {
+            first,
+            second,
+            distance,
+            ..
+        } => CliError::Input(format!(
+            "{}: the samples on lines {} and {} are duplicates (scaled distance {distance:.3e}); \
+             remove or merge one of them",
+            path.display(),
+            line(first),
+            line(second)
+        )),
+        ErbfError::Singular { .. } => CliError::Failure(e.to_string()),
+        other => CliError::input(other),
+    }
+}

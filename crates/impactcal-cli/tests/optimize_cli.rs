@@ -1,0 +1,149 @@
+//! End-to-end tests of `impactcal optimize suggest`: a shell-style loop of suggest, run,
+//! append reproduces the library's closed loop, batches, failures and bad input.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::io::Write;
+use std::path::Path;
+use std::process::{Command, Output};
+
+use impactcal::core::{Table, TableOptions};
+use impactcal::cors::{Cors, CorsOptions, test_functions};
+
+fn impactcal(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_impactcal"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn suggest(bounds: &Path, history: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
+    let mut args = vec![
+        "optimize",
+        "suggest",
+        "--bounds",
+        bounds.to_str().unwrap(),
+        "--history",
+        history.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let out = impactcal(&args);
+    assert!(
+        out.status.success(),
+        "failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let t = Table::parse(&text, "stdout", TableOptions::default()).unwrap();
+    assert_eq!(t.header, vec!["x1", "x2"]);
+    t.rows
+}
+
+fn append(history: &Path, x: &[f64], value: f64) {
+    let new = !history.exists();
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(history)
+        .unwrap();
+    if new {
+        writeln!(f, "x1,x2,objective").unwrap();
+    }
+    let v = if value.is_nan() {
+        String::new()
+    } else {
+        value.to_string()
+    };
+    writeln!(f, "{},{},{v}", x[0], x[1]).unwrap();
+}
+
+fn branin_bounds(dir: &Path) -> std::path::PathBuf {
+    let p = dir.join("bounds.csv");
+    std::fs::write(&p, "name,lower,upper,nominal\nx1,-5,10,2.5\nx2,0,15,7.5\n").unwrap();
+    p
+}
+
+#[test]
+fn shell_loop_reproduces_the_library_loop() {
+    let f = test_functions::by_name("branin").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let bounds = branin_bounds(dir.path());
+    let history = dir.path().join("history.csv");
+    let n = 20;
+    let mut cli_points = Vec::new();
+    for _ in 0..n {
+        let x = suggest(&bounds, &history, &["--seed", "7"]).pop().unwrap();
+        append(&history, &x, f.eval(&x));
+        cli_points.push(x);
+    }
+    let mut study = Cors::new(f.space().unwrap(), CorsOptions::with_seed(7)).unwrap();
+    study.minimize(|x| f.eval(x), n).unwrap();
+    let lib_points: Vec<Vec<f64>> = study.evaluations().iter().map(|e| e.x.clone()).collect();
+    // Bit for bit: the history round-trips through shortest float formatting.
+    assert_eq!(cli_points, lib_points);
+}
+
+#[test]
+fn batch_failures_and_empty_history() {
+    let f = test_functions::by_name("branin").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let bounds = branin_bounds(dir.path());
+    let history = dir.path().join("history.csv");
+    // No history yet: the first three design points.
+    let first = suggest(&bounds, &history, &["--batch", "3"]);
+    assert_eq!(first.len(), 3);
+    let design = Cors::new(f.space().unwrap(), CorsOptions::with_seed(0))
+        .unwrap()
+        .design_points()
+        .unwrap();
+    assert_eq!(first, design[..3].to_vec());
+    // Run the whole design, one run failing; then a batch of four CORS points.
+    for (k, x) in design.iter().enumerate() {
+        append(&history, x, if k == 2 { f64::NAN } else { f.eval(x) });
+    }
+    let batch = suggest(&bounds, &history, &["--batch", "4"]);
+    assert_eq!(batch.len(), 4);
+    for (i, a) in batch.iter().enumerate() {
+        assert!(a[0] >= -5.0 && a[0] <= 10.0 && a[1] >= 0.0 && a[1] <= 15.0);
+        for b in batch.iter().skip(i + 1).chain(design.iter()) {
+            assert!(
+                (a[0] - b[0]).abs() + (a[1] - b[1]).abs() > 1e-6,
+                "{a:?} repeats {b:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_history_is_an_input_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let bounds = branin_bounds(dir.path());
+    let history = dir.path().join("history.csv");
+    std::fs::write(&history, "x1,objective\n1,2\n").unwrap();
+    let out = impactcal(&[
+        "optimize",
+        "suggest",
+        "--bounds",
+        bounds.to_str().unwrap(),
+        "--history",
+        history.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no column `x2`"), "{err}");
+    std::fs::write(&history, "x1,x2,objective\n100,2,1\n").unwrap();
+    let out = impactcal(&[
+        "optimize",
+        "suggest",
+        "--bounds",
+        bounds.to_str().unwrap(),
+        "--history",
+        history.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("history row 1") && err.contains("outside"),
+        "{err}"
+    );
+}

@@ -1,0 +1,213 @@
+//! End-to-end tests of `impactcal surrogate fit|predict` on CSV files.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::Path;
+use std::process::Command;
+
+fn impactcal(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_impactcal"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Response history of sample (a, b) at 20 instants.
+fn response(a: f64, b: f64) -> Vec<f64> {
+    (0..20)
+        .map(|t| (0.3 * t as f64 * a).sin() * b + 0.01 * a * b)
+        .collect()
+}
+
+fn write_case(dir: &Path, n: usize) -> (Vec<[f64; 2]>, Vec<Vec<f64>>) {
+    std::fs::write(
+        dir.join("bounds.csv"),
+        "name,lower,upper,nominal,unit\na,1,3,2,mm\nb,-5,5,0,\n",
+    )
+    .unwrap();
+    // A Latin-square style design: stratified in both inputs, columns in reverse order.
+    let pts: Vec<[f64; 2]> = (0..n)
+        .map(|i| {
+            let u = (i as f64 + 0.5) / n as f64;
+            let v = (((7 * i + 3) % n) as f64 + 0.5) / n as f64;
+            [1.0 + 2.0 * u, -5.0 + 10.0 * v]
+        })
+        .collect();
+    let mut p = String::from("b,a\n");
+    let mut y = (0..20)
+        .map(|t| format!("y{t}"))
+        .collect::<Vec<_>>()
+        .join(",")
+        + "\n";
+    let mut ys = Vec::new();
+    for q in &pts {
+        p.push_str(&format!("{},{}\n", q[1], q[0]));
+        let r = response(q[0], q[1]);
+        y.push_str(
+            &r.iter()
+                .map(|v| v.to_string())
+                .collect::<Vec<_>>()
+                .join(","),
+        );
+        y.push('\n');
+        ys.push(r);
+    }
+    std::fs::write(dir.join("P.csv"), p).unwrap();
+    std::fs::write(dir.join("Y.csv"), y).unwrap();
+    (pts, ys)
+}
+
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn fit_then_predict_reproduces_the_training_histories_for_every_kind() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, ys) = write_case(dir.path(), 23);
+    let d = |f: &str| dir.path().join(f).display().to_string();
+    for kind in ["erbf", "gaussian", "cubic", "thin-plate", "multiquadric"] {
+        let (code, _, err) = impactcal(&[
+            "surrogate",
+            "fit",
+            "--bounds",
+            &d("bounds.csv"),
+            "--params",
+            &d("P.csv"),
+            "--outputs",
+            &d("Y.csv"),
+            "--kind",
+            kind,
+            "--out",
+            &d("model.json"),
+        ]);
+        assert_eq!(code, 0, "{kind}: {err}");
+        assert!(err.contains("training residual"), "{err}");
+        assert!(err.contains("leave-one-out error: rms"), "{err}");
+        let (code, _, err) = impactcal(&[
+            "surrogate",
+            "predict",
+            "--model",
+            &d("model.json"),
+            "--params",
+            &d("P.csv"),
+            "--out",
+            &d("Yhat.csv"),
+        ]);
+        assert_eq!(code, 0, "{kind}: {err}");
+        assert!(!err.contains("warning"), "{err}");
+        let (header, rows) = read_csv(&dir.path().join("Yhat.csv"));
+        assert_eq!(header.len(), 20);
+        assert_eq!(header[3], "y3");
+        for (row, truth) in rows.iter().zip(&ys) {
+            for (a, b) in row.iter().zip(truth) {
+                assert!((a - b).abs() < 1e-9, "{kind}: {a} vs {b}");
+            }
+        }
+    }
+}
+
+#[test]
+fn predict_warns_outside_the_bounds_and_interpolates_inside() {
+    let dir = tempfile::tempdir().unwrap();
+    write_case(dir.path(), 40);
+    let d = |f: &str| dir.path().join(f).display().to_string();
+    let (code, stdout, err) = impactcal(&[
+        "surrogate",
+        "fit",
+        "--bounds",
+        &d("bounds.csv"),
+        "--params",
+        &d("P.csv"),
+        "--outputs",
+        &d("Y.csv"),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::write(dir.path().join("model.json"), stdout).unwrap();
+    std::fs::write(dir.path().join("Q.csv"), "a,b\n2.1,0.7\n3.5,0\n").unwrap();
+    let (code, stdout, err) = impactcal(&[
+        "surrogate",
+        "predict",
+        "--model",
+        &d("model.json"),
+        "--params",
+        &d("Q.csv"),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("1 of 2 query rows lie outside"), "{err}");
+    assert!(err.contains("line 3"), "{err}");
+    let first: Vec<f64> = stdout
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let truth = response(2.1, 0.7);
+    let err_max = first
+        .iter()
+        .zip(&truth)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(err_max < 0.1, "interpolation error {err_max}");
+}
+
+#[test]
+fn bad_input_exits_with_code_2_and_says_where() {
+    let dir = tempfile::tempdir().unwrap();
+    write_case(dir.path(), 10);
+    let d = |f: &str| dir.path().join(f).display().to_string();
+    let fit = |params: &str| {
+        impactcal(&[
+            "surrogate",
+            "fit",
+            "--bounds",
+            &d("bounds.csv"),
+            "--params",
+            params,
+            "--outputs",
+            &d("Y.csv"),
+        ])
+    };
+    // A duplicated sample: lines 3 and 6 of the file.
+    let text = std::fs::read_to_string(dir.path().join("P.csv")).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[5] = lines[2];
+    std::fs::write(dir.path().join("dup.csv"), lines.join("\n") + "\n").unwrap();
+    let (code, _, err) = fit(&d("dup.csv"));
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("lines 3 and 6"), "{err}");
+    // A missing parameter column.
+    std::fs::write(dir.path().join("nob.csv"), "a\n1\n2\n").unwrap();
+    let (code, _, err) = fit(&d("nob.csv"));
+    assert_eq!(code, 2);
+    assert!(err.contains("no column `b`"), "{err}");
+    // Row counts that differ.
+    let short: Vec<&str> = text.lines().take(5).collect();
+    std::fs::write(dir.path().join("short.csv"), short.join("\n") + "\n").unwrap();
+    let (code, _, err) = fit(&d("short.csv"));
+    assert_eq!(code, 2);
+    assert!(err.contains("one response row per sample"), "{err}");
+    // Not a model.
+    let (code, _, err) = impactcal(&[
+        "surrogate",
+        "predict",
+        "--model",
+        &d("bounds.csv"),
+        "--params",
+        &d("P.csv"),
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("not a surrogate model"), "{err}");
+}

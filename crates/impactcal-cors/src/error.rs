@@ -1,0 +1,114 @@
+//! The error type of `impactcal-cors`.
+
+use impactcal_core::CoreError;
+use impactcal_erbf::ErbfError;
+
+/// Everything that can go wrong while setting up or running a CORS-RBF study.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CorsError {
+    /// A fault of the parameter space, a point or a file (from `impactcal-core`).
+    #[error(transparent)]
+    Core(#[from] CoreError),
+    /// A fault of the RBF surrogate that could not be worked around.
+    #[error("RBF surrogate: {0}")]
+    Rbf(#[from] ErbfError),
+    /// An option outside its admissible range.
+    #[error("option `{name}` = {value}: {message}")]
+    InvalidOption {
+        /// The option.
+        name: &'static str,
+        /// The value given, as text.
+        value: String,
+        /// What is required.
+        message: String,
+    },
+    /// A point or list whose length is not what the parameter space requires.
+    #[error("{what}: expected {expected}, found {found}")]
+    DimensionMismatch {
+        /// The quantity whose size is wrong.
+        what: String,
+        /// The size required.
+        expected: usize,
+        /// The size given.
+        found: usize,
+    },
+    /// A point outside the bounds of the parameter space.
+    #[error("{what}: parameter `{parameter}` = {value} lies outside [{lower}, {upper}]")]
+    OutOfBounds {
+        /// Which point (for example `existing evaluation 3`).
+        what: String,
+        /// The parameter's name.
+        parameter: String,
+        /// The coordinate given.
+        value: f64,
+        /// Lower bound.
+        lower: f64,
+        /// Upper bound.
+        upper: f64,
+    },
+    /// A NaN or infinite coordinate.
+    #[error("{what}: non-finite coordinate {value} for parameter `{parameter}`")]
+    NonFinitePoint {
+        /// Which point.
+        what: String,
+        /// The parameter's name.
+        parameter: String,
+        /// The coordinate given.
+        value: f64,
+    },
+    /// Two evaluated points that (nearly) coincide, which an interpolant cannot fit.
+    #[error(
+        "evaluations {first} and {second} nearly coincide (distance {distance:.3e} in the unit \
+         box, tolerance {tolerance:.1e}); merge them or drop one"
+    )]
+    NearDuplicate {
+        /// Index of the first point (in the evaluation history).
+        first: usize,
+        /// Index of the second point.
+        second: usize,
+        /// Their distance in the unit box.
+        distance: f64,
+        /// The tolerance below which points count as duplicates.
+        tolerance: f64,
+    },
+    /// The initial set cannot support an RBF with a linear tail: it needs `dim + 1`
+    /// affinely independent successful evaluations.
+    #[error(
+        "the initial set cannot support the surrogate: its {successes} successful evaluations \
+         span an affine space of dimension {rank_minus_one}, but {dim} parameters need {needed} \
+         affinely independent points (add evaluations, or let the optimiser run its design)"
+    )]
+    InsufficientInitialSet {
+        /// Number of successful evaluations.
+        successes: usize,
+        /// Affine rank minus one of their points.
+        rank_minus_one: usize,
+        /// Number of parameters.
+        dim: usize,
+        /// Points needed: `dim + 1`.
+        needed: usize,
+    },
+    /// A value that the chosen objective transform cannot take.
+    #[error("evaluation value {value}: {message}")]
+    TransformDomain {
+        /// The value.
+        value: f64,
+        /// Why it cannot be transformed.
+        message: String,
+    },
+    /// `tell` with an id that is not a pending suggestion.
+    #[error("no pending suggestion has id {0} (already told, or never suggested)")]
+    UnknownSuggestion(u64),
+    /// A saved state that cannot be read back.
+    #[error("optimiser state {source_name}: {message}")]
+    State {
+        /// The file or text the state came from.
+        source_name: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// `Result` with [`CorsError`].
+pub type Result<T, E = CorsError> = std::result::Result<T, E>;

@@ -1,0 +1,249 @@
+//! Options of the CORS-RBF optimiser, checked once by [`CorsOptions::validate`].
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{CorsError, Result};
+
+/// The radial kernel of the surrogate; both take a linear tail.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SurrogateKernel {
+    /// `phi(r) = r^3` (the default, as in pySOT and the later Regis-Shoemaker papers).
+    #[default]
+    Cubic,
+    /// `phi(r) = r^2 ln r`.
+    ThinPlate,
+}
+
+/// A monotone transform applied to the successful objective values before the surrogate is
+/// fitted. The optimiser still reports and compares raw values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Transform {
+    /// `g = f`.
+    #[default]
+    Identity,
+    /// `g = ln f`; every value must be positive (a non-positive value is refused by `tell`).
+    Log,
+    /// `g = ln(1 + f - f_min)` over the current successes: any sign, compresses large values.
+    ShiftedLog,
+    /// `g = min(f, median f)` (Gutmann's capping): flattens the high part of the surface so
+    /// that it does not dominate the fit near the minimum.
+    MedianCap,
+}
+
+impl Transform {
+    /// Transforms `values` (all finite) in place.
+    pub fn apply(self, values: &mut [f64]) {
+        match self {
+            Transform::Identity => {}
+            Transform::Log => values.iter_mut().for_each(|v| *v = v.ln()),
+            Transform::ShiftedLog => {
+                let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+                values.iter_mut().for_each(|v| *v = (*v - lo).ln_1p());
+            }
+            Transform::MedianCap => {
+                if values.is_empty() {
+                    return;
+                }
+                let mut sorted = values.to_vec();
+                sorted.sort_by(f64::total_cmp);
+                let m = sorted.len();
+                let median = if m % 2 == 1 {
+                    sorted[m / 2]
+                } else {
+                    0.5 * (sorted[m / 2 - 1] + sorted[m / 2])
+                };
+                values.iter_mut().for_each(|v| *v = v.min(median));
+            }
+        }
+    }
+
+    /// Checks that a successful value lies in the transform's domain.
+    ///
+    /// # Errors
+    /// [`CorsError::TransformDomain`] for a non-positive value under [`Transform::Log`].
+    pub fn check(self, value: f64) -> Result<()> {
+        if self == Transform::Log && value <= 0.0 {
+            return Err(CorsError::TransformDomain {
+                value,
+                message: "the log transform needs positive values; use the shifted-log \
+                          transform or transform the objective yourself"
+                    .into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Where the initial set of evaluations comes from (the three variants users ask for).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum InitialDesign {
+    /// The evaluations told before the first suggestion are the initial set when they hold
+    /// `dim + 1` affinely independent successes; otherwise the symmetric Latin hypercube
+    /// design is run as well.
+    #[default]
+    Auto,
+    /// Always run the design, on top of any existing evaluations.
+    Design,
+    /// The existing evaluations are the whole initial set; the first suggestion fails with
+    /// [`CorsError::InsufficientInitialSet`] when they cannot support the surrogate.
+    Existing,
+}
+
+/// When a study stops besides its evaluation budget.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Stopping {
+    /// Stop once the best raw value is at or below this target.
+    pub target: Option<f64>,
+    /// Stop after this many consecutive evaluations without an improvement of the best
+    /// value by more than `min_improvement * max(|best|, 1e-12)`.
+    pub patience: Option<usize>,
+    /// Relative improvement that resets the patience counter (default 0: any decrease).
+    pub min_improvement: f64,
+}
+
+/// Options of [`Cors`](crate::Cors).
+///
+/// All distances are in the unit box `[0, 1]^d` of the parameter space. The defaults are
+/// those of Regis & Shoemaker (2005) where the reference gives one.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CorsOptions {
+    /// The surrogate's kernel (linear tail in both cases).
+    pub kernel: SurrogateKernel,
+    /// The search pattern `<beta_1 .. beta_k>`, each in `[0, 1]`; the distance constraint
+    /// of the `n`-th new point is `beta_n Delta_n` with `Delta_n` the maximin distance.
+    pub pattern: Vec<f64>,
+    /// How the initial set is formed.
+    pub initial: InitialDesign,
+    /// Size of the symmetric Latin hypercube design; `None` is `2 (d + 1)`. At least
+    /// `d + 1`.
+    pub design_size: Option<usize>,
+    /// Transform of the objective values for the surrogate.
+    pub transform: Transform,
+    /// Quasi-random (randomly shifted Sobol') candidates per dimension for the auxiliary problem
+    /// and the maximin distance.
+    pub candidates_per_dim: usize,
+    /// Candidates per dimension drawn around the best point (Gaussian perturbations of
+    /// standard deviation 0.1, 0.02 and 0.004), which let the local stages of the cycle
+    /// resolve the surrogate's minimum near the incumbent.
+    pub local_candidates_per_dim: usize,
+    /// Number of the best feasible candidates polished by the constrained local method.
+    pub polish_starts: usize,
+    /// Distance floor, times `sqrt(d)`, kept at `beta = 0` so that no point repeats.
+    pub min_distance: f64,
+    /// Radius, times `sqrt(d)`, around a failed evaluation inside which no point is
+    /// proposed.
+    pub failure_radius: f64,
+    /// Stopping rules besides the budget.
+    pub stopping: Stopping,
+    /// Seed of the design and of every candidate set.
+    pub seed: u64,
+}
+
+/// The search pattern of Regis & Shoemaker (2005).
+pub const DEFAULT_PATTERN: [f64; 6] = [0.9, 0.75, 0.25, 0.05, 0.03, 0.0];
+
+impl Default for CorsOptions {
+    fn default() -> Self {
+        CorsOptions {
+            kernel: SurrogateKernel::Cubic,
+            pattern: DEFAULT_PATTERN.to_vec(),
+            initial: InitialDesign::Auto,
+            design_size: None,
+            transform: Transform::Identity,
+            candidates_per_dim: 300,
+            local_candidates_per_dim: 100,
+            polish_starts: 5,
+            min_distance: 1e-3,
+            failure_radius: 0.05,
+            stopping: Stopping::default(),
+            seed: 0,
+        }
+    }
+}
+
+impl CorsOptions {
+    /// The default options with `seed`.
+    pub fn with_seed(seed: u64) -> Self {
+        CorsOptions {
+            seed,
+            ..Self::default()
+        }
+    }
+
+    /// The design size for `dim` parameters: `design_size` or `2 (dim + 1)`.
+    pub fn design_size_for(&self, dim: usize) -> usize {
+        self.design_size.unwrap_or(2 * (dim + 1))
+    }
+
+    /// Checks every option for a space of `dim` parameters.
+    ///
+    /// # Errors
+    /// [`CorsError::InvalidOption`] for an empty pattern or a `beta` outside `[0, 1]`, a
+    /// design smaller than `dim + 1`, no candidates, no polishing start, or a distance that
+    /// is negative or not finite, or a negative patience threshold.
+    pub fn validate(&self, dim: usize) -> Result<()> {
+        let bad = |name: &'static str, value: String, message: &str| {
+            Err(CorsError::InvalidOption {
+                name,
+                value,
+                message: message.into(),
+            })
+        };
+        if self.pattern.is_empty() {
+            return bad("pattern", "[]".into(), "needs at least one beta");
+        }
+        if let Some(b) = self.pattern.iter().find(|b| !(**b >= 0.0 && **b <= 1.0)) {
+            return bad("pattern", b.to_string(), "every beta must lie in [0, 1]");
+        }
+        let n0 = self.design_size_for(dim);
+        if n0 < dim + 1 {
+            return bad(
+                "design_size",
+                n0.to_string(),
+                &format!("must be at least d + 1 = {}", dim + 1),
+            );
+        }
+        if self.candidates_per_dim == 0 {
+            return bad("candidates_per_dim", "0".into(), "must be positive");
+        }
+        if self.polish_starts == 0 {
+            return bad("polish_starts", "0".into(), "must be positive");
+        }
+        for (name, v) in [
+            ("min_distance", self.min_distance),
+            ("failure_radius", self.failure_radius),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(name, v.to_string(), "must be finite and non-negative");
+            }
+        }
+        if self.min_distance <= 0.0 {
+            return bad(
+                "min_distance",
+                self.min_distance.to_string(),
+                "must be positive, or points could repeat",
+            );
+        }
+        let s = &self.stopping;
+        if !(s.min_improvement.is_finite() && s.min_improvement >= 0.0) {
+            return bad(
+                "stopping.min_improvement",
+                s.min_improvement.to_string(),
+                "must be finite and non-negative",
+            );
+        }
+        if let Some(t) = s.target
+            && !t.is_finite()
+        {
+            return bad("stopping.target", t.to_string(), "must be finite");
+        }
+        if s.patience == Some(0) {
+            return bad("stopping.patience", "0".into(), "must be positive");
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,375 @@
+//! The auxiliary problem of a CORS step and the maximin distance.
+//!
+//! With `X` the evaluated and pending points, a CORS step solves
+//!
+//! ```text
+//! minimise s(x)  over x in [0, 1]^d
+//! subject to |x - x_j| >= r_j for every x_j in X,
+//! ```
+//!
+//! where `r_j = max(beta Delta, floor)` (and at least the failure radius around a failed
+//! point) and `Delta = max_x min_j |x - x_j|` is the maximin distance, the radius of the
+//! largest empty ball centred in the box.
+//!
+//! The solver is a multistart: randomly shifted Sobol' candidates (which also estimate `Delta`,
+//! refined by a compass search on the maximin point) and Gaussian perturbations of the best
+//! point are screened; the `K` feasible candidates with the lowest `s` and the maximin point
+//! start a projected-gradient descent (steps along `-grad s`, projection onto the box and
+//! radially out of every violated ball, Armijo backtracking, only feasible iterates
+//! accepted). The best feasible end point wins; the maximin point, feasible for every
+//! `beta <= 1`, is the fallback.
+
+use impactcal_core::sampling::Sobol;
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+
+use crate::geometry::{clip_unit, distance};
+use crate::surrogate::Surrogate;
+
+/// Candidates per parallel task: small batches cost more in scheduling than they save.
+const PAR_CHUNK: usize = 1024;
+
+/// Points that a new point must keep away from, in the unit box.
+#[derive(Debug, Clone, Default)]
+pub struct Blockers {
+    /// Dimension.
+    pub dim: usize,
+    /// Successful, pending and already chosen points, row-major.
+    pub ok: Vec<f64>,
+    /// Failed points, row-major.
+    pub failed: Vec<f64>,
+}
+
+impl Blockers {
+    /// An empty set in `dim` dimensions.
+    pub fn new(dim: usize) -> Self {
+        Blockers {
+            dim,
+            ..Default::default()
+        }
+    }
+
+    /// Whether there is no point at all.
+    pub fn is_empty(&self) -> bool {
+        self.ok.is_empty() && self.failed.is_empty()
+    }
+
+    /// `(min distance to ok points, min distance to failed points)`.
+    fn min_distances(&self, x: &[f64]) -> (f64, f64) {
+        let m = |pts: &[f64]| {
+            pts.chunks_exact(self.dim)
+                .map(|p| crate::geometry::squared_distance(x, p))
+                .fold(f64::INFINITY, f64::min)
+                .sqrt()
+        };
+        (m(&self.ok), m(&self.failed))
+    }
+
+    /// Distance to the nearest point of either kind.
+    pub fn min_distance(&self, x: &[f64]) -> f64 {
+        let (a, b) = self.min_distances(x);
+        a.min(b)
+    }
+}
+
+/// The radii of one step.
+#[derive(Debug, Clone, Copy)]
+pub struct Radii {
+    /// Around successful and pending points.
+    pub ok: f64,
+    /// Around failed points.
+    pub failed: f64,
+}
+
+impl Radii {
+    /// Slack `min_j (|x - x_j| - r_j)`: feasible when non-negative.
+    fn slack(&self, dists: (f64, f64)) -> f64 {
+        (dists.0 - self.ok).min(dists.1 - self.failed)
+    }
+}
+
+/// Settings of one step.
+#[derive(Debug, Clone, Copy)]
+pub struct StepSettings {
+    /// `beta` of this step.
+    pub beta: f64,
+    /// Absolute distance floor.
+    pub floor: f64,
+    /// Absolute radius around failed points.
+    pub failure_radius: f64,
+    /// Number of quasi-random candidates.
+    pub candidates: usize,
+    /// Number of candidates around the best point.
+    pub local_candidates: usize,
+    /// Number of polished starts.
+    pub polish_starts: usize,
+}
+
+/// What a step chose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Choice {
+    /// The point in the unit box.
+    pub x: Vec<f64>,
+    /// The estimated maximin distance `Delta` before the point was added.
+    pub delta: f64,
+    /// The distance imposed, `max(beta Delta, floor)`.
+    pub radius: f64,
+    /// The surrogate value at `x` (NaN for a maximin point chosen without a surrogate).
+    pub predicted: f64,
+}
+
+/// Sobol' candidates of the unit box with a random digital shift (every coordinate's bits
+/// XORed with a random word, which keeps the net structure and is far cheaper than Owen
+/// scrambling), drawn from the stream.
+fn global_candidates(dim: usize, n: usize, rng: &mut impl Rng) -> Vec<f64> {
+    const SCALE: f64 = 1.0 / 4_294_967_296.0;
+    let shift: Vec<u32> = (0..dim).map(|_| rng.random()).collect();
+    match (Sobol::new(dim), u32::try_from(n)) {
+        (Ok(sobol), Ok(n)) => {
+            let mut out = Vec::with_capacity(n as usize * dim);
+            let mut bits = vec![0u32; dim];
+            for i in 0..n {
+                sobol.point_bits(i, &mut bits);
+                out.extend(
+                    bits.iter()
+                        .zip(&shift)
+                        .map(|(b, s)| (f64::from(b ^ s) + 0.5) * SCALE),
+                );
+            }
+            out
+        }
+        // Beyond the Sobol' dimensions (thousands): independent uniform points.
+        _ => (0..n * dim).map(|_| rng.random::<f64>()).collect(),
+    }
+}
+
+/// Gaussian perturbations of `centre`, clipped to the box, with the standard deviation
+/// cycling through 0.1, 0.02, 0.004.
+fn local_candidates(centre: &[f64], n: usize, rng: &mut impl Rng) -> Vec<f64> {
+    const SIGMAS: [f64; 3] = [0.1, 0.02, 0.004];
+    let mut out = Vec::with_capacity(n * centre.len());
+    for k in 0..n {
+        let sigma = SIGMAS[k % SIGMAS.len()];
+        let mut x: Vec<f64> = centre
+            .iter()
+            .map(|c| {
+                let z: f64 = StandardNormal.sample(rng);
+                c + sigma * z
+            })
+            .collect();
+        clip_unit(&mut x);
+        out.extend(x);
+    }
+    out
+}
+
+/// Maximises the distance to the nearest blocker from `x` by a compass search.
+fn refine_maximin(blockers: &Blockers, mut x: Vec<f64>, mut h: f64) -> (Vec<f64>, f64) {
+    let mut best = blockers.min_distance(&x);
+    while h > 1e-5 {
+        let mut improved = false;
+        for j in 0..x.len() {
+            for sign in [1.0, -1.0] {
+                let mut y = x.clone();
+                y[j] = (y[j] + sign * h).clamp(0.0, 1.0);
+                let m = blockers.min_distance(&y);
+                if m > best {
+                    best = m;
+                    x = y;
+                    improved = true;
+                }
+            }
+        }
+        if !improved {
+            h *= 0.5;
+        }
+    }
+    (x, best)
+}
+
+/// The maximin point of the box with respect to `blockers` and its distance `Delta`,
+/// estimated from `n` shifted Sobol' candidates and refined by a compass search.
+pub fn maximin(blockers: &Blockers, n: usize, rng: &mut impl Rng) -> (Vec<f64>, f64) {
+    let dim = blockers.dim;
+    let cands = global_candidates(dim, n.max(1), rng);
+    let dists: Vec<f64> = cands
+        .par_chunks_exact(dim)
+        .with_min_len(PAR_CHUNK)
+        .map(|c| blockers.min_distance(c))
+        .collect();
+    let i = argmax(&dists);
+    let start = cands[i * dim..(i + 1) * dim].to_vec();
+    let h = 0.5 / (n.max(2) as f64).powf(1.0 / dim as f64);
+    refine_maximin(blockers, start, h)
+}
+
+fn argmax(v: &[f64]) -> usize {
+    let mut k = 0;
+    for (i, x) in v.iter().enumerate() {
+        if *x > v[k] {
+            k = i;
+        }
+    }
+    k
+}
+
+/// One CORS step: the feasible point of lowest surrogate value found by the multistart.
+/// `best` is the best successful point (centre of the local candidates).
+pub fn cors_step(
+    surrogate: &Surrogate,
+    best: &[f64],
+    blockers: &Blockers,
+    settings: &StepSettings,
+    rng: &mut impl Rng,
+) -> Choice {
+    let dim = blockers.dim;
+    let n_global = settings.candidates.max(1);
+    let mut cands = global_candidates(dim, n_global, rng);
+    cands.extend(local_candidates(best, settings.local_candidates, rng));
+    let screened: Vec<((f64, f64), f64)> = cands
+        .par_chunks_exact(dim)
+        .with_min_len(PAR_CHUNK)
+        .map(|c| (blockers.min_distances(c), surrogate.value(c)))
+        .collect();
+    // Delta from the global candidates, refined around the best of them.
+    let global_min: Vec<f64> = screened[..n_global]
+        .iter()
+        .map(|((a, b), _)| a.min(*b))
+        .collect();
+    let i = argmax(&global_min);
+    let h = 0.5 / (n_global.max(2) as f64).powf(1.0 / dim as f64);
+    let (maximin_x, delta) = refine_maximin(blockers, cands[i * dim..(i + 1) * dim].to_vec(), h);
+    let r = settings.beta * delta;
+    let radii = Radii {
+        ok: r.max(settings.floor),
+        failed: r.max(settings.failure_radius).max(settings.floor),
+    };
+    let radius = radii.ok;
+    // The K feasible candidates of lowest surrogate value (ties by index).
+    let mut feasible: Vec<usize> = (0..screened.len())
+        .filter(|&k| radii.slack(screened[k].0) >= 0.0)
+        .collect();
+    feasible.sort_by(|&a, &b| screened[a].1.total_cmp(&screened[b].1).then(a.cmp(&b)));
+    feasible.truncate(settings.polish_starts);
+    let mut starts: Vec<Vec<f64>> = feasible
+        .iter()
+        .map(|&k| cands[k * dim..(k + 1) * dim].to_vec())
+        .collect();
+    let maximin_ok = radii.slack(blockers.min_distances(&maximin_x)) >= 0.0;
+    if maximin_ok {
+        starts.push(maximin_x.clone());
+    }
+    // A handful of short descents: cheaper in sequence than through the thread pool.
+    let polished: Vec<(Vec<f64>, f64)> = starts
+        .into_iter()
+        .map(|x0| polish(surrogate, blockers, radii, x0))
+        .collect();
+    let mut chosen: Option<(Vec<f64>, f64)> = None;
+    for (x, f) in polished {
+        if chosen.as_ref().is_none_or(|(_, g)| f < *g) {
+            chosen = Some((x, f));
+        }
+    }
+    match chosen {
+        Some((x, predicted)) => Choice {
+            x,
+            delta,
+            radius,
+            predicted,
+        },
+        None => {
+            // No feasible start (only when failed points crowd the maximin point): the
+            // candidate with the largest slack.
+            let k = argmax(
+                &screened
+                    .iter()
+                    .map(|(d, _)| radii.slack(*d))
+                    .collect::<Vec<_>>(),
+            );
+            let x = if maximin_ok || screened.is_empty() {
+                maximin_x
+            } else {
+                cands[k * dim..(k + 1) * dim].to_vec()
+            };
+            let predicted = surrogate.value(&x);
+            Choice {
+                x,
+                delta,
+                radius,
+                predicted,
+            }
+        }
+    }
+}
+
+/// Moves `y` into the box and radially out of every ball it violates (a few passes).
+fn project(blockers: &Blockers, radii: Radii, y: &mut [f64]) {
+    let dim = blockers.dim;
+    clip_unit(y);
+    for _ in 0..4 {
+        let mut moved = false;
+        for (pts, r) in [(&blockers.ok, radii.ok), (&blockers.failed, radii.failed)] {
+            for p in pts.chunks_exact(dim) {
+                let dist = distance(y, p);
+                if dist < r && dist > 0.0 {
+                    let scale = r * (1.0 + 1e-9) / dist;
+                    for (yj, pj) in y.iter_mut().zip(p) {
+                        *yj = pj + (*yj - pj) * scale;
+                    }
+                    moved = true;
+                }
+            }
+        }
+        clip_unit(y);
+        if !moved {
+            break;
+        }
+    }
+}
+
+/// Projected-gradient descent of `s` from the feasible `x0`; returns the end point and its
+/// value. Every accepted iterate is feasible.
+fn polish(s: &Surrogate, blockers: &Blockers, radii: Radii, x0: Vec<f64>) -> (Vec<f64>, f64) {
+    const MAX_ITER: usize = 100;
+    let dim = s.dim();
+    let mut x = x0;
+    let mut grad = vec![0.0; dim];
+    let mut f = s.value_gradient(&x, &mut grad);
+    let mut step = 0.05;
+    let mut y = vec![0.0; dim];
+    for _ in 0..MAX_ITER {
+        let gnorm = grad.iter().map(|g| g * g).sum::<f64>().sqrt();
+        if !(gnorm > 0.0 && gnorm.is_finite()) {
+            break;
+        }
+        let mut accepted = false;
+        while step > 1e-9 {
+            for ((yj, xj), gj) in y.iter_mut().zip(&x).zip(&grad) {
+                *yj = xj - step * gj / gnorm;
+            }
+            project(blockers, radii, &mut y);
+            let descent: f64 = grad
+                .iter()
+                .zip(&x)
+                .zip(&y)
+                .map(|((g, a), b)| g * (a - b))
+                .sum();
+            if descent > 0.0 && radii.slack(blockers.min_distances(&y)) >= 0.0 {
+                let fy = s.value(&y);
+                if fy <= f - 1e-4 * descent {
+                    x.copy_from_slice(&y);
+                    f = s.value_gradient(&x, &mut grad);
+                    step = (step * 2.0).min(0.5);
+                    accepted = true;
+                    break;
+                }
+            }
+            step *= 0.5;
+        }
+        if !accepted {
+            break;
+        }
+    }
+    (x, f)
+}

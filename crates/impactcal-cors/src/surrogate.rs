@@ -1,0 +1,125 @@
+//! The RBF surrogate of one CORS step: fitted by `impactcal-erbf`, evaluated by a compact
+//! copy of its coefficients.
+//!
+//! `s(x) = sum_i c_i phi(|x - x_i|) + a_0 + a^T x` in the unit box. The interpolant of
+//! `impactcal-erbf` solves the augmented system; its tail is affine, so `a_0` and `a` are
+//! recovered exactly (up to rounding) from `d + 1` predictions minus the kernel part. The
+//! copy evaluates value and gradient without allocation, which the candidate screening
+//! (thousands of points) and the local polish (hundreds of gradient steps) need.
+
+use faer::MatRef;
+use impactcal_erbf::{Kernel, RbfInterpolant, RbfOptions};
+
+use crate::error::Result;
+use crate::options::SurrogateKernel;
+
+/// A fitted cubic or thin-plate RBF with a linear tail on the unit box.
+#[derive(Debug, Clone)]
+pub struct Surrogate {
+    kernel: Kernel,
+    dim: usize,
+    /// Centres, row-major `N x d`.
+    centres: Vec<f64>,
+    weights: Vec<f64>,
+    a0: f64,
+    a: Vec<f64>,
+}
+
+impl Surrogate {
+    /// Fits the interpolant to `points` (rows of length `d`, distinct, affinely spanning)
+    /// and `values`. When the system is numerically singular, a smoothing of `1e-10` of the
+    /// largest kernel entry is tried once before giving up.
+    ///
+    /// # Errors
+    /// The error of `impactcal-erbf` ([`impactcal_erbf::ErbfError`]) when the fit fails.
+    pub fn fit(points: &[Vec<f64>], values: &[f64], kernel: SurrogateKernel) -> Result<Self> {
+        let options = match kernel {
+            SurrogateKernel::Cubic => RbfOptions::cubic(),
+            SurrogateKernel::ThinPlate => RbfOptions::thin_plate(),
+        };
+        let rbf = match RbfInterpolant::fit_rows(points, values, options) {
+            Ok(r) => r,
+            Err(first) => {
+                let d = points.first().map_or(1, Vec::len) as f64;
+                let kmax = options.kernel.value(d.sqrt()).abs().max(1.0);
+                RbfInterpolant::fit_rows(points, values, options.with_smoothing(1e-10 * kmax))
+                    .map_err(|_| first)?
+            }
+        };
+        Self::from_interpolant(&rbf)
+    }
+
+    /// Copies the coefficients of a single-output interpolant with a linear tail.
+    ///
+    /// # Errors
+    /// Those of [`RbfInterpolant::predict`] (not expected for a fitted model).
+    pub fn from_interpolant(rbf: &RbfInterpolant) -> Result<Self> {
+        let dim = rbf.dim();
+        let n = rbf.n_samples();
+        let pts: MatRef<'_, f64> = rbf.points();
+        let mut centres = Vec::with_capacity(n * dim);
+        for i in 0..n {
+            centres.extend(pts.row(i).iter().copied());
+        }
+        let weights: Vec<f64> = rbf.kernel_weights().col(0).iter().copied().collect();
+        let mut s = Surrogate {
+            kernel: rbf.options().kernel,
+            dim,
+            centres,
+            weights,
+            a0: 0.0,
+            a: vec![0.0; dim],
+        };
+        // The tail is s(x) minus the kernel part, and it is affine: read it at the origin
+        // and the unit vectors.
+        let mut x = vec![0.0; dim];
+        let a0 = rbf.predict(&x)?[0] - s.kernel_part(&x);
+        let mut a = vec![0.0; dim];
+        for j in 0..dim {
+            x[j] = 1.0;
+            a[j] = rbf.predict(&x)?[0] - s.kernel_part(&x) - a0;
+            x[j] = 0.0;
+        }
+        s.a0 = a0;
+        s.a = a;
+        Ok(s)
+    }
+
+    /// Dimension `d`.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    fn kernel_part(&self, x: &[f64]) -> f64 {
+        self.centres
+            .chunks_exact(self.dim)
+            .zip(&self.weights)
+            .map(|(c, w)| {
+                let r = crate::geometry::distance(x, c);
+                w * self.kernel.value(r)
+            })
+            .sum()
+    }
+
+    /// `s(x)`.
+    pub fn value(&self, x: &[f64]) -> f64 {
+        let tail: f64 = self.a.iter().zip(x).map(|(a, v)| a * v).sum();
+        self.kernel_part(x) + self.a0 + tail
+    }
+
+    /// `s(x)`, with `grad s(x)` written into `grad` (length `d`):
+    /// `sum_i c_i (phi'(r_i) / r_i) (x - x_i) + a`.
+    pub fn value_gradient(&self, x: &[f64], grad: &mut [f64]) -> f64 {
+        grad.copy_from_slice(&self.a);
+        let mut v = self.a0 + self.a.iter().zip(x).map(|(a, v)| a * v).sum::<f64>();
+        for (c, w) in self.centres.chunks_exact(self.dim).zip(&self.weights) {
+            let r = crate::geometry::distance(x, c);
+            v += w * self.kernel.value(r);
+            let g = w * self.kernel.derivative_over_r(r);
+            for ((gj, xj), cj) in grad.iter_mut().zip(x).zip(c) {
+                *gj += g * (xj - cj);
+            }
+        }
+        v
+    }
+}

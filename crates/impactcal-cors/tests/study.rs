@@ -1,0 +1,415 @@
+//! Behaviour of a CORS-RBF study: design, warm start, failures, batches, resume, stateless
+//! rebuild, stopping, transforms, typed errors.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use impactcal_core::{Parameter, ParameterSpace};
+use impactcal_cors::design::{affine_rank, symmetric_design};
+use impactcal_cors::{
+    Cors, CorsError, CorsOptions, InitialDesign, Mode, Origin, StopReason, Stopping, Transform,
+    test_functions,
+};
+
+fn unit_distance(space: &ParameterSpace, a: &[f64], b: &[f64]) -> f64 {
+    let (ua, ub) = (space.to_unit(a).unwrap(), space.to_unit(b).unwrap());
+    ua.iter()
+        .zip(&ub)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+#[test]
+fn design_is_a_spanning_symmetric_latin_hypercube() {
+    for d in [1, 2, 3, 6] {
+        let n = 2 * (d + 1);
+        let pts = symmetric_design(n, d, 5).unwrap();
+        assert_eq!(pts.len(), n);
+        assert_eq!(affine_rank(&pts), d + 1);
+        for j in 0..d {
+            // One point per stratum, at the centres, mirrored in pairs.
+            let mut col: Vec<f64> = pts.iter().map(|p| p[j]).collect();
+            col.sort_by(f64::total_cmp);
+            for (k, v) in col.iter().enumerate() {
+                assert!((v - (k as f64 + 0.5) / n as f64).abs() < 1e-12);
+            }
+            for i in 0..n {
+                assert!((pts[i][j] + pts[n - 1 - i][j] - 1.0).abs() < 1e-12);
+            }
+        }
+    }
+}
+
+#[test]
+fn affine_rank_sees_collinear_points() {
+    let line: Vec<Vec<f64>> = (0..5)
+        .map(|k| vec![0.1 * k as f64, 0.2 * k as f64])
+        .collect();
+    assert_eq!(affine_rank(&line), 2);
+    let mut tri = line.clone();
+    tri.push(vec![0.9, 0.1]);
+    assert_eq!(affine_rank(&tri), 3);
+}
+
+#[test]
+fn cors_points_respect_the_distance_constraint_and_cycle() {
+    let f = test_functions::by_name("hartmann3").unwrap();
+    let space = f.space().unwrap();
+    let mut study = Cors::new(space.clone(), CorsOptions::with_seed(3)).unwrap();
+    let mut betas = Vec::new();
+    for _ in 0..26 {
+        let s = study.suggest(1).unwrap().pop().unwrap();
+        if s.origin == Origin::Cors {
+            betas.push(s.beta.unwrap());
+            let delta = s.delta.unwrap();
+            let radius = (s.beta.unwrap() * delta).max(1e-3 * 3f64.sqrt());
+            for e in study.evaluations() {
+                let r = unit_distance(&space, &s.x, &e.x);
+                assert!(r >= radius * (1.0 - 1e-9), "{r} < {radius}");
+                // Delta is the largest empty-ball radius: no point is farther from all.
+                assert!(delta <= 3f64.sqrt());
+            }
+        }
+        let v = f.eval(&s.x);
+        study.tell(s.id, v).unwrap();
+    }
+    assert_eq!(study.evaluations().len(), 26);
+    assert_eq!(
+        study.evaluations()[..8]
+            .iter()
+            .filter(|e| e.origin == Origin::Design)
+            .count(),
+        8
+    );
+    // The pattern, advancing once per evaluation, from its start right after the design.
+    let expected: Vec<f64> = (0..18)
+        .map(|k| [0.9, 0.75, 0.25, 0.05, 0.03, 0.0][k % 6])
+        .collect();
+    assert_eq!(betas, expected);
+}
+
+#[test]
+fn warm_start_replaces_the_design_and_improves() {
+    // The source study: 50 existing runs, then 60 more.
+    let f = test_functions::by_name("hartmann6").unwrap();
+    let space = f.space().unwrap();
+    let existing = impactcal_core::sampling::sample(
+        &space,
+        impactcal_core::SamplingMethod::LatinHypercube,
+        50,
+        11,
+    )
+    .unwrap()
+    .points
+    .to_rows();
+    let values: Vec<f64> = existing.iter().map(|x| f.eval(x)).collect();
+    let best_existing = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut study = Cors::new(space, CorsOptions::with_seed(2)).unwrap();
+    study.warm_start(&existing, &values).unwrap();
+    let out = study.minimize(|x| f.eval(x), 60).unwrap();
+    assert_eq!(study.mode(), Some(Mode::Existing));
+    assert_eq!(out.evaluations, 60);
+    assert_eq!(study.evaluations().len(), 110);
+    assert!(
+        study.evaluations()[50..]
+            .iter()
+            .all(|e| e.origin == Origin::Cors)
+    );
+    let best = out.best.unwrap().value.unwrap();
+    // A Latin hypercube of 50 leaves Hartmann6 far from its minimum (more than 25% off);
+    // 60 CORS steps get within 10% of it.
+    assert!(f.relative_error(best_existing) > 0.25, "{best_existing}");
+    assert!(f.relative_error(best) < 0.1, "best {best}");
+}
+
+#[test]
+fn warm_start_checks_its_input() {
+    let space = test_functions::by_name("branin").unwrap().space().unwrap();
+    let mut study = Cors::new(space.clone(), CorsOptions::default()).unwrap();
+    let dup = study.warm_start(
+        &[vec![1.0, 2.0], vec![3.0, 4.0], vec![1.0, 2.0 + 1e-12]],
+        &[1.0, 2.0, 3.0],
+    );
+    assert!(matches!(
+        dup,
+        Err(CorsError::NearDuplicate {
+            first: 0,
+            second: 2,
+            ..
+        })
+    ));
+    assert!(matches!(
+        study.warm_start(&[vec![1.0]], &[1.0]),
+        Err(CorsError::DimensionMismatch { .. })
+    ));
+    assert!(matches!(
+        study.warm_start(&[vec![11.0, 2.0]], &[1.0]),
+        Err(CorsError::OutOfBounds { .. })
+    ));
+    assert!(study.evaluations().is_empty());
+    // Existing-only on collinear points: the surrogate cannot be fitted.
+    let options = CorsOptions {
+        initial: InitialDesign::Existing,
+        ..CorsOptions::default()
+    };
+    let mut only = Cors::new(space.clone(), options).unwrap();
+    only.warm_start(
+        &[
+            vec![0.0, 0.0],
+            vec![1.0, 1.0],
+            vec![2.0, 2.0],
+            vec![3.0, 3.0],
+        ],
+        &[1.0, 2.0, 3.0, 4.0],
+    )
+    .unwrap();
+    assert!(matches!(
+        only.suggest(1),
+        Err(CorsError::InsufficientInitialSet {
+            successes: 4,
+            rank_minus_one: 1,
+            needed: 3,
+            ..
+        })
+    ));
+    // The same set under Auto: the design is run as well.
+    let mut auto = Cors::new(space, CorsOptions::default()).unwrap();
+    auto.warm_start(
+        &[
+            vec![0.0, 0.0],
+            vec![1.0, 1.0],
+            vec![2.0, 2.0],
+            vec![3.0, 3.0],
+        ],
+        &[1.0, 2.0, 3.0, 4.0],
+    )
+    .unwrap();
+    assert_eq!(auto.suggest(1).unwrap()[0].origin, Origin::Design);
+    assert_eq!(auto.mode(), Some(Mode::Design));
+}
+
+#[test]
+fn failures_are_recorded_avoided_and_the_run_goes_on() {
+    let f = test_functions::by_name("branin").unwrap();
+    let space = f.space().unwrap();
+    // The simulation crashes for x1 > 7 (a third of the box).
+    let objective = |x: &[f64]| if x[0] > 7.0 { f64::NAN } else { f.eval(x) };
+    let mut study = Cors::new(space.clone(), CorsOptions::with_seed(4)).unwrap();
+    let out = study.minimize(objective, 60).unwrap();
+    let failed: Vec<_> = study
+        .evaluations()
+        .iter()
+        .filter(|e| !e.is_success())
+        .collect();
+    assert!(!failed.is_empty());
+    assert!(failed.iter().all(|e| e.x[0] > 7.0 && e.value.is_none()));
+    // No later point inside the no-go radius of an earlier failure.
+    let radius = 0.05 * 2f64.sqrt();
+    let evals = study.evaluations();
+    for (k, e) in evals.iter().enumerate() {
+        for g in evals[..k].iter().filter(|g| !g.is_success()) {
+            if e.origin == Origin::Cors {
+                assert!(unit_distance(&space, &e.x, &g.x) >= radius * (1.0 - 1e-9));
+            }
+        }
+    }
+    // Two of Branin's three minima lie in the working region; one is found.
+    let best = out.best.unwrap().value.unwrap();
+    assert!(f.relative_error(best) < 0.01, "best {best}");
+}
+
+#[test]
+fn resume_from_json_gives_the_same_sequence() {
+    let f = test_functions::by_name("hartmann3").unwrap();
+    let options = CorsOptions::with_seed(9);
+    let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
+    whole.minimize(|x| f.eval(x), 30).unwrap();
+
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("state.json");
+    let mut first = Cors::new(f.space().unwrap(), options).unwrap();
+    first.minimize(|x| f.eval(x), 14).unwrap();
+    // Crash with a suggestion out for evaluation.
+    let pending = first.suggest(1).unwrap().pop().unwrap();
+    first.save(&path).unwrap();
+    drop(first);
+    let mut resumed = Cors::load(&path).unwrap();
+    assert_eq!(resumed.pending().len(), 1);
+    resumed.tell(pending.id, f.eval(&pending.x)).unwrap();
+    resumed.minimize(|x| f.eval(x), 15).unwrap();
+    assert_eq!(resumed.evaluations(), whole.evaluations());
+}
+
+#[test]
+fn from_history_matches_the_library_loop() {
+    let f = test_functions::by_name("shekel5").unwrap();
+    let options = CorsOptions::with_seed(21);
+    let mut study = Cors::new(f.space().unwrap(), options.clone()).unwrap();
+    study.minimize(|x| f.eval(x), 25).unwrap();
+    let xs: Vec<Vec<f64>> = study.evaluations().iter().map(|e| e.x.clone()).collect();
+    let fs: Vec<f64> = study
+        .evaluations()
+        .iter()
+        .map(|e| e.value.unwrap())
+        .collect();
+    for n in [0, 3, 10, 11, 24] {
+        let mut rebuilt = Cors::from_history(
+            f.space().unwrap(),
+            options.clone(),
+            &xs[..n],
+            &fs[..n],
+            None,
+        )
+        .unwrap();
+        let next = rebuilt.suggest(1).unwrap().pop().unwrap();
+        assert_eq!(next.x, xs[n], "after {n} rows");
+    }
+}
+
+#[test]
+fn batches_hold_distinct_points_with_consecutive_betas() {
+    let f = test_functions::by_name("hartmann6").unwrap();
+    let space = f.space().unwrap();
+    let mut study = Cors::new(space.clone(), CorsOptions::with_seed(1)).unwrap();
+    // The design (14 points) in two batches, told out of order.
+    let mut a = study.suggest(10).unwrap();
+    let b = study.suggest(10).unwrap();
+    assert_eq!(a.len(), 10);
+    assert_eq!(b.len(), 10);
+    assert_eq!(b.iter().filter(|s| s.origin == Origin::Design).count(), 4);
+    // Fill points while no surrogate exists (the design is still pending).
+    assert!(b[4..].iter().all(|s| s.origin == Origin::Fill));
+    a.reverse();
+    for s in a.iter().chain(&b) {
+        study.tell(s.id, f.eval(&s.x)).unwrap();
+    }
+    let batch = study.suggest(6).unwrap();
+    // The six fill points took places 14..19 of the cycle that starts after the design.
+    let betas: Vec<f64> = batch.iter().map(|s| s.beta.unwrap()).collect();
+    assert_eq!(betas, vec![0.9, 0.75, 0.25, 0.05, 0.03, 0.0]);
+    for (i, s) in batch.iter().enumerate() {
+        for t in &batch[i + 1..] {
+            assert!(unit_distance(&space, &s.x, &t.x) >= 1e-3 * 6f64.sqrt() * (1.0 - 1e-9));
+        }
+        for e in study.evaluations() {
+            assert!(unit_distance(&space, &s.x, &e.x) >= 1e-3 * 6f64.sqrt() * (1.0 - 1e-9));
+        }
+    }
+    assert!(matches!(
+        study.tell(12345, 1.0),
+        Err(CorsError::UnknownSuggestion(12345))
+    ));
+}
+
+#[test]
+fn stopping_rules() {
+    let f = test_functions::by_name("branin").unwrap();
+    let options = CorsOptions {
+        stopping: Stopping {
+            target: Some(0.45),
+            ..Stopping::default()
+        },
+        ..CorsOptions::with_seed(0)
+    };
+    let mut study = Cors::new(f.space().unwrap(), options).unwrap();
+    let out = study.minimize(|x| f.eval(x), 200).unwrap();
+    assert_eq!(out.stop, StopReason::Target);
+    assert!(out.best.unwrap().value.unwrap() <= 0.45);
+    assert!(out.evaluations < 200);
+    // A constant objective never improves after its first value.
+    let options = CorsOptions {
+        stopping: Stopping {
+            patience: Some(10),
+            ..Stopping::default()
+        },
+        ..CorsOptions::with_seed(0)
+    };
+    let mut flat = Cors::new(f.space().unwrap(), options).unwrap();
+    let out = flat.minimize(|_| 1.0, 200).unwrap();
+    assert_eq!(out.stop, StopReason::NoImprovement);
+    assert_eq!(out.evaluations, 11);
+}
+
+#[test]
+fn transforms() {
+    let mut v = vec![5.0, 1.0, 100.0, 3.0, 2.0];
+    Transform::MedianCap.apply(&mut v);
+    assert_eq!(v, vec![3.0, 1.0, 3.0, 3.0, 2.0]);
+    let mut v = vec![2.0, 1.0, 1.0 + std::f64::consts::E - 1.0];
+    Transform::ShiftedLog.apply(&mut v);
+    assert!((v[0] - 2f64.ln()).abs() < 1e-15 && v[1] == 0.0 && (v[2] - 1.0).abs() < 1e-15);
+    // Goldstein-Price spans 3 to 1e6: under a log transform CORS reaches 1% quickly.
+    let f = test_functions::by_name("goldstein-price").unwrap();
+    let options = CorsOptions {
+        transform: Transform::Log,
+        ..CorsOptions::with_seed(0)
+    };
+    let mut study = Cors::new(f.space().unwrap(), options).unwrap();
+    let out = study.minimize(|x| f.eval(x), 100).unwrap();
+    assert!(f.relative_error(out.best.unwrap().value.unwrap()) < 0.01);
+    // The log transform refuses non-positive values instead of recording them.
+    let s = study.suggest(1).unwrap().pop().unwrap();
+    assert!(matches!(
+        study.tell(s.id, -1.0),
+        Err(CorsError::TransformDomain { .. })
+    ));
+    assert_eq!(study.pending().len(), 1);
+}
+
+#[test]
+fn thin_plate_kernel_works() {
+    let f = test_functions::by_name("branin").unwrap();
+    let options = CorsOptions {
+        kernel: impactcal_cors::SurrogateKernel::ThinPlate,
+        ..CorsOptions::with_seed(2)
+    };
+    let mut study = Cors::new(f.space().unwrap(), options).unwrap();
+    let out = study.minimize(|x| f.eval(x), 60).unwrap();
+    assert!(f.relative_error(out.best.unwrap().value.unwrap()) < 0.01);
+}
+
+#[test]
+fn options_are_validated() {
+    let space = ParameterSpace::new(vec![
+        Parameter::new("a", 0.0, 1.0, 0.5).unwrap(),
+        Parameter::new("b", 0.0, 1.0, 0.5).unwrap(),
+    ])
+    .unwrap();
+    let bad = [
+        CorsOptions {
+            pattern: vec![],
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            pattern: vec![0.5, 1.5],
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            design_size: Some(2),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            min_distance: 0.0,
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            polish_starts: 0,
+            ..CorsOptions::default()
+        },
+    ];
+    for o in bad {
+        assert!(matches!(
+            Cors::new(space.clone(), o),
+            Err(CorsError::InvalidOption { .. })
+        ));
+    }
+    let text = Cors::new(space, CorsOptions::default())
+        .unwrap()
+        .to_json()
+        .unwrap()
+        .replace("impactcal-cors/1", "other/9");
+    assert!(matches!(
+        Cors::from_json(&text, "x.json"),
+        Err(CorsError::State { .. })
+    ));
+}

@@ -1,0 +1,196 @@
+//! Input checks shared by both surrogates, and the serialised form of a matrix.
+
+use faer::{Mat, MatRef};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{ErbfError, Result};
+
+/// A dense matrix in serialisable form: its shape and its entries in column-major order
+/// (entry `(i, j)` at `data[i + j * nrows]`). faer 0.24 has no serde support, so fitted
+/// models store their matrices this way.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StoredMat {
+    /// Number of rows.
+    pub nrows: usize,
+    /// Number of columns.
+    pub ncols: usize,
+    /// `nrows * ncols` entries, column-major.
+    pub data: Vec<f64>,
+}
+
+impl StoredMat {
+    /// Copies a matrix.
+    pub fn from_mat(m: MatRef<'_, f64>) -> Self {
+        let mut data = Vec::with_capacity(m.nrows() * m.ncols());
+        for j in 0..m.ncols() {
+            data.extend(m.col(j).iter().copied());
+        }
+        StoredMat {
+            nrows: m.nrows(),
+            ncols: m.ncols(),
+            data,
+        }
+    }
+
+    /// The matrix, after checking that the data length matches the shape.
+    ///
+    /// # Errors
+    /// [`ErbfError::InvalidModel`] when `data.len() != nrows * ncols`.
+    pub fn to_mat(&self, what: &str) -> Result<Mat<f64>> {
+        if self.nrows.checked_mul(self.ncols) != Some(self.data.len()) {
+            return Err(ErbfError::InvalidModel(format!(
+                "{what}: {} entries do not fill a {} x {} matrix",
+                self.data.len(),
+                self.nrows,
+                self.ncols
+            )));
+        }
+        Ok(MatRef::from_column_major_slice(&self.data, self.nrows, self.ncols).to_owned())
+    }
+}
+
+/// Builds an `n x d` matrix from rows, checking that all rows have length `d` (the length
+/// of the first row).
+///
+/// # Errors
+/// [`ErbfError::NoSamples`] for no rows; [`ErbfError::DimensionMismatch`] for a ragged row.
+pub fn mat_from_rows(rows: &[Vec<f64>], what: &str) -> Result<Mat<f64>> {
+    let Some(first) = rows.first() else {
+        return Err(ErbfError::NoSamples);
+    };
+    let d = first.len();
+    for (i, r) in rows.iter().enumerate() {
+        if r.len() != d {
+            return Err(ErbfError::DimensionMismatch {
+                what: format!("{what}: length of row {i}"),
+                expected: d,
+                found: r.len(),
+            });
+        }
+    }
+    Ok(Mat::from_fn(rows.len(), d, |i, j| rows[i][j]))
+}
+
+/// Checks that every entry is finite.
+pub(crate) fn check_finite(what: &str, m: MatRef<'_, f64>) -> Result<()> {
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            let v = m[(i, j)];
+            if !v.is_finite() {
+                return Err(ErbfError::NonFinite {
+                    what: what.to_string(),
+                    row: i,
+                    column: j,
+                    value: v,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks the training set: at least one sample, points `N x d` with `d >= 1` (or exactly
+/// `expected_dim` when given), values `N x T` with `T >= 1`, all finite.
+pub(crate) fn check_training(
+    points: MatRef<'_, f64>,
+    values: MatRef<'_, f64>,
+    expected_dim: Option<usize>,
+) -> Result<()> {
+    if points.nrows() == 0 {
+        return Err(ErbfError::NoSamples);
+    }
+    if let Some(d) = expected_dim
+        && points.ncols() != d
+    {
+        return Err(ErbfError::DimensionMismatch {
+            what: "training points: number of columns (parameters)".into(),
+            expected: d,
+            found: points.ncols(),
+        });
+    }
+    if points.ncols() == 0 {
+        return Err(ErbfError::DimensionMismatch {
+            what: "training points: number of columns (parameters), at least".into(),
+            expected: 1,
+            found: 0,
+        });
+    }
+    if values.nrows() != points.nrows() {
+        return Err(ErbfError::DimensionMismatch {
+            what: "training values: number of rows (one per sample)".into(),
+            expected: points.nrows(),
+            found: values.nrows(),
+        });
+    }
+    if values.ncols() == 0 {
+        return Err(ErbfError::DimensionMismatch {
+            what: "training values: number of columns (outputs), at least".into(),
+            expected: 1,
+            found: 0,
+        });
+    }
+    check_finite("training points", points)?;
+    check_finite("training values", values)?;
+    Ok(())
+}
+
+/// Checks query points: `d` columns, all finite.
+pub(crate) fn check_queries(points: MatRef<'_, f64>, d: usize) -> Result<()> {
+    if points.ncols() != d {
+        return Err(ErbfError::DimensionMismatch {
+            what: "query points: number of columns (parameters)".into(),
+            expected: d,
+            found: points.ncols(),
+        });
+    }
+    check_finite("query points", points)
+}
+
+/// Returns the first pair `(i, j)`, `i < j`, of rows closer than `tol` (Euclidean), with
+/// their distance. `O(N^2 d)`.
+pub(crate) fn find_duplicate(points: MatRef<'_, f64>, tol: f64) -> Option<(usize, usize, f64)> {
+    let n = points.nrows();
+    for j in 1..n {
+        for i in 0..j {
+            let d2: f64 = (0..points.ncols())
+                .map(|c| {
+                    let t = points[(i, c)] - points[(j, c)];
+                    t * t
+                })
+                .sum();
+            let dist = d2.sqrt();
+            if dist <= tol {
+                return Some((i, j, dist));
+            }
+        }
+    }
+    None
+}
+
+/// Errors with [`ErbfError::DuplicateSamples`] when two rows are closer than `tol`.
+pub(crate) fn reject_duplicates(points: MatRef<'_, f64>, tol: f64) -> Result<()> {
+    match find_duplicate(points, tol) {
+        None => Ok(()),
+        Some((first, second, distance)) => Err(ErbfError::DuplicateSamples {
+            first,
+            second,
+            distance,
+            tolerance: tol,
+        }),
+    }
+}
+
+/// A copy of `m` without row `k`.
+pub(crate) fn without_row(m: MatRef<'_, f64>, k: usize) -> Mat<f64> {
+    Mat::from_fn(m.nrows() - 1, m.ncols(), |i, j| {
+        m[(if i < k { i } else { i + 1 }, j)]
+    })
+}
+
+/// A copy of `m` with the rows of `extra` appended.
+pub(crate) fn stack_rows(m: MatRef<'_, f64>, extra: MatRef<'_, f64>) -> Mat<f64> {
+    let n = m.nrows();
+    Mat::from_fn(n + extra.nrows(), m.ncols(), |i, j| {
+        if i < n { m[(i, j)] } else { extra[(i - n, j)] }
+    })
+}

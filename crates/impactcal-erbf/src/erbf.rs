@@ -1,0 +1,613 @@
+//! The extended radial basis function (ERBF) metamodel of Mullur and Messac.
+//!
+//! Inputs are first mapped to the unit cube by the bounds of a [`ParameterSpace`],
+//! `x^j = (q^j - lo_j) / (hi_j - lo_j)`; the widths `r_c` and `gamma` are meant in that
+//! scaled space. With samples `x_1..x_N` and `m` inputs the model is
+//!
+//! ```text
+//! f(x) = sum_i sigma_i psi_i(x)
+//!      + sum_i sum_j [ aL_ij phi_L(xi_ij) + aR_ij phi_R(xi_ij) + b_ij xi_ij ],
+//! psi_i(x) = exp(-|x - x_i|^2 / (2 r_c^2)),   xi_ij = x^j - x_i^j,
+//! ```
+//!
+//! with `phi_L`, `phi_R` the non-radial functions of [`crate::nrbf`]: `M = N (3 m + 1)`
+//! coefficients for `N` interpolation conditions. Writing `b(x)` for the `M` basis values
+//! (radial first, then ordered by sample `i`, input `j` and `{L, R, beta}`, each family
+//! multiplied by its weight of [`FamilyWeights`]), the conditions read `A c = F` with
+//! `A` the `N x M` matrix whose row `k` is `b(x_k)^T`, and `F` the `N x T` responses.
+//!
+//! The system is under-determined; the fit takes its minimum-norm solution
+//! `c = A^T (A A^T)^{-1} F` without forming `A A^T`: a Householder QR factorisation
+//! `A^T = Q_1 R` (`Q_1` is `M x N` with orthonormal columns, `R` is `N x N` upper
+//! triangular) gives `c = Q_1 Z` with `R^T Z = F`. One factorisation serves all `T`
+//! columns, and the solution is linear in `F`. A prediction is
+//! `f(x) = (Q_1^T b(x))^T Z`, costing `O(M N + N T)` per point, which for time histories
+//! (`T >> N`) is far below the `O(M T)` of `b(x)^T c`; when `T <= N` the model stores `c`
+//! and uses the cheaper direct product.
+
+use faer::linalg::matmul::matmul;
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{Accum, Mat, MatRef, Par};
+use impactcal_core::ParameterSpace;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::data::{StoredMat, check_queries, check_training, reject_duplicates, without_row};
+use crate::error::{ErbfError, Result};
+use crate::loo::LooMethod;
+use crate::nrbf::{LeftRight, dphi_l, dphi_r};
+use crate::rbf::{condition_number, relative_max_error};
+
+/// Multipliers of the three basis families. The minimum-norm solution is not invariant
+/// to them (rescaling a family changes how much of the data it carries), so they are an
+/// implicit hyper-parameter; the paper's form is all ones.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FamilyWeights {
+    /// Weight of the Gaussian radial functions `psi_i`.
+    pub radial: f64,
+    /// Weight of the `phi_L` and `phi_R` functions.
+    pub left_right: f64,
+    /// Weight of the linear functions `xi`.
+    pub beta: f64,
+}
+
+impl Default for FamilyWeights {
+    fn default() -> Self {
+        FamilyWeights {
+            radial: 1.0,
+            left_right: 1.0,
+            beta: 1.0,
+        }
+    }
+}
+
+/// Options of an ERBF model. The defaults are those of Horta et al.: local polynomial
+/// order `n_t = 4`, smoothness (half-width) `gamma = 0.15`, Gaussian radius `r_c = 0.15`,
+/// all in unit-scaled inputs.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ErbfOptions {
+    /// Order `n_t` of the local monomials; even, at least 2.
+    pub order: u32,
+    /// Half-width `gamma > 0` of the polynomial region of the N-RBFs.
+    pub gamma: f64,
+    /// Gaussian radius `r_c > 0`.
+    pub rc: f64,
+    /// Family weights (all 1 by default).
+    pub weights: FamilyWeights,
+    /// Subtract each output column's mean before fitting and add it back when predicting
+    /// (off by default; not part of the original method).
+    pub center_outputs: bool,
+    /// Two samples closer than this (Euclidean distance in unit-scaled inputs) are
+    /// rejected as duplicates.
+    pub duplicate_tolerance: f64,
+}
+
+impl Default for ErbfOptions {
+    fn default() -> Self {
+        ErbfOptions {
+            order: 4,
+            gamma: 0.15,
+            rc: 0.15,
+            weights: FamilyWeights::default(),
+            center_outputs: false,
+            duplicate_tolerance: 1e-9,
+        }
+    }
+}
+
+impl ErbfOptions {
+    /// Checks every option.
+    ///
+    /// # Errors
+    /// [`ErbfError::InvalidOption`] for an odd order or one below 2, a `gamma` or `r_c`
+    /// that is not finite and positive, a negative or non-finite family weight or
+    /// duplicate tolerance, or all weights zero.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name: &'static str, value: String, message: &str| {
+            Err(ErbfError::InvalidOption {
+                name,
+                value,
+                message: message.into(),
+            })
+        };
+        if self.order < 2 || self.order % 2 != 0 || self.order > 64 {
+            return bad(
+                "order (n_t)",
+                self.order.to_string(),
+                "must be an even integer between 2 and 64",
+            );
+        }
+        for (name, v) in [("gamma", self.gamma), ("r_c", self.rc)] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(name, v.to_string(), "must be finite and positive");
+            }
+        }
+        let w = self.weights;
+        for (name, v) in [
+            ("radial weight", w.radial),
+            ("left/right weight", w.left_right),
+            ("beta weight", w.beta),
+            ("duplicate tolerance", self.duplicate_tolerance),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(name, v.to_string(), "must be finite and non-negative");
+            }
+        }
+        if w.radial == 0.0 && w.left_right == 0.0 && w.beta == 0.0 {
+            return bad(
+                "weights",
+                "0".into(),
+                "at least one family weight must be positive",
+            );
+        }
+        Ok(())
+    }
+}
+
+/// A fitted ERBF model of `T` outputs over a parameter space of `m` inputs.
+///
+/// Serialises as its space, options and training data; a deserialised model is refitted
+/// (milliseconds) and predicts the same.
+#[derive(Debug, Clone)]
+pub struct Erbf {
+    space: ParameterSpace,
+    options: ErbfOptions,
+    points: Mat<f64>,
+    unit: Mat<f64>,
+    values: Mat<f64>,
+    mean: Vec<f64>,
+    lower: Vec<f64>,
+    width: Vec<f64>,
+    q1: Mat<f64>,
+    r: Mat<f64>,
+    z: Mat<f64>,
+    coef: Option<Mat<f64>>,
+    r_ratio: f64,
+}
+
+impl Erbf {
+    /// Fits the model to samples `points` (`N x m`, raw parameter values, one sample per
+    /// row, columns in the order of `space`) and responses `values` (`N x T`).
+    ///
+    /// Cost: `O(N^2 m)` to build `A`, `O(M N^2)` to factorise, `O(N^2 T)` to solve.
+    ///
+    /// # Errors
+    /// - [`ErbfError::InvalidOption`] for invalid options;
+    /// - [`ErbfError::NoSamples`] for `N = 0`;
+    /// - [`ErbfError::DimensionMismatch`] when `points` has not `m` columns or `values` has
+    ///   not `N` rows;
+    /// - [`ErbfError::NonFinite`] for NaN or infinite entries;
+    /// - [`ErbfError::DuplicateSamples`] for two samples closer than the tolerance in
+    ///   scaled inputs, naming both;
+    /// - [`ErbfError::Singular`] when `min |R_ii| / max |R_ii|` falls below `N eps`.
+    pub fn fit(
+        space: &ParameterSpace,
+        points: MatRef<'_, f64>,
+        values: MatRef<'_, f64>,
+        options: ErbfOptions,
+    ) -> Result<Self> {
+        options.validate()?;
+        check_training(points, values, Some(space.dim()))?;
+        let lower = space.lower();
+        let width: Vec<f64> = space.parameters().iter().map(|p| p.width()).collect();
+        let unit = Mat::from_fn(points.nrows(), points.ncols(), |i, j| {
+            (points[(i, j)] - lower[j]) / width[j]
+        });
+        reject_duplicates(unit.as_ref(), options.duplicate_tolerance)?;
+        let t = values.ncols();
+        let mean: Vec<f64> = if options.center_outputs {
+            (0..t)
+                .map(|c| values.col(c).iter().sum::<f64>() / values.nrows() as f64)
+                .collect()
+        } else {
+            vec![0.0; t]
+        };
+        let f = Mat::from_fn(values.nrows(), t, |i, c| values[(i, c)] - mean[c]);
+        let factor = Factor::new(unit.as_ref(), &options)?;
+        let mut z = f;
+        solve_lower_triangular_in_place(factor.r.transpose(), z.as_mut(), par());
+        let n = unit.nrows();
+        let coef = (t <= n).then(|| &factor.q1 * &z);
+        Ok(Erbf {
+            space: space.clone(),
+            options,
+            points: points.to_owned(),
+            unit,
+            values: values.to_owned(),
+            mean,
+            lower,
+            width,
+            q1: factor.q1,
+            r: factor.r,
+            z,
+            coef,
+            r_ratio: factor.ratio,
+        })
+    }
+
+    /// Fits one output from rows of raw parameter values.
+    ///
+    /// # Errors
+    /// As [`fit`](Self::fit); [`ErbfError::DimensionMismatch`] for ragged rows or a
+    /// `values` length different from the number of rows.
+    pub fn fit_rows(
+        space: &ParameterSpace,
+        points: &[Vec<f64>],
+        values: &[f64],
+        options: ErbfOptions,
+    ) -> Result<Self> {
+        let x = crate::data::mat_from_rows(points, "training points")?;
+        let f = MatRef::from_column_major_slice(values, values.len(), 1);
+        Self::fit(space, x.as_ref(), f, options)
+    }
+
+    /// The parameter space whose bounds scale the inputs.
+    pub fn space(&self) -> &ParameterSpace {
+        &self.space
+    }
+
+    /// The options.
+    pub fn options(&self) -> &ErbfOptions {
+        &self.options
+    }
+
+    /// Number of inputs `m`.
+    pub fn dim(&self) -> usize {
+        self.points.ncols()
+    }
+
+    /// Number of training samples `N`.
+    pub fn n_samples(&self) -> usize {
+        self.points.nrows()
+    }
+
+    /// Number of outputs `T`.
+    pub fn n_outputs(&self) -> usize {
+        self.values.ncols()
+    }
+
+    /// Number of basis functions (coefficients per output), `M = N (3 m + 1)`.
+    pub fn n_basis(&self) -> usize {
+        self.n_samples() * (3 * self.dim() + 1)
+    }
+
+    /// The training points (raw), `N x m`.
+    pub fn points(&self) -> MatRef<'_, f64> {
+        self.points.as_ref()
+    }
+
+    /// The training responses, `N x T`.
+    pub fn values(&self) -> MatRef<'_, f64> {
+        self.values.as_ref()
+    }
+
+    /// The interpolation matrix `A` (`N x M`, row `k` = `b(x_k)^T`), rebuilt on demand.
+    pub fn interpolation_matrix(&self) -> Mat<f64> {
+        basis_matrix_t(self.unit.as_ref(), self.unit.as_ref(), &self.options)
+            .transpose()
+            .to_owned()
+    }
+
+    /// The coefficients `c = Q_1 Z` (`M x T`), formed on demand (`O(M N T)` time and
+    /// `M T` memory; large for long histories).
+    pub fn coefficients(&self) -> Mat<f64> {
+        match &self.coef {
+            Some(c) => c.clone(),
+            None => &self.q1 * &self.z,
+        }
+    }
+
+    /// `min |R_ii| / max |R_ii|` of the factorisation `A^T = Q_1 R`: a cheap conditioning
+    /// indicator (near `1e-16` means `A` is close to rank deficient).
+    pub fn r_diagonal_ratio(&self) -> f64 {
+        self.r_ratio
+    }
+
+    /// The 2-norm condition number of `A` (the ratio of the extreme singular values of
+    /// `R`), computed on demand in `O(N^3)`.
+    ///
+    /// # Errors
+    /// [`ErbfError::Singular`] when the singular value decomposition does not converge.
+    pub fn condition_number(&self) -> Result<f64> {
+        condition_number(self.r.as_ref())
+    }
+
+    /// Whether `x` (raw) lies outside the bounds of the parameter space, where the model
+    /// extrapolates linearly.
+    pub fn is_outside(&self, x: &[f64]) -> bool {
+        !self.space.contains(x)
+    }
+
+    /// The prediction at `x` (raw parameters): `T` values.
+    ///
+    /// # Errors
+    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for a bad `x`.
+    pub fn predict(&self, x: &[f64]) -> Result<Vec<f64>> {
+        let out = self.predict_batch(MatRef::from_row_major_slice(x, 1, x.len()))?;
+        Ok(out.row(0).iter().copied().collect())
+    }
+
+    /// Predictions at the rows of `points` (`Q x m`, raw): a `Q x T` matrix. Basis vectors
+    /// are built in parallel and the products run in blocks of queries; the result does not
+    /// depend on the number of threads.
+    ///
+    /// # Errors
+    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for bad points.
+    pub fn predict_batch(&self, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
+        check_queries(points, self.dim())?;
+        let q = points.nrows();
+        let mut out = Mat::<f64>::zeros(q, self.n_outputs());
+        let mut start = 0;
+        while start < q {
+            let len = BLOCK.min(q - start);
+            let block = points.subrows(start, len);
+            let unit = Mat::from_fn(len, self.dim(), |i, j| {
+                (block[(i, j)] - self.lower[j]) / self.width[j]
+            });
+            let bt = basis_matrix_t(unit.as_ref(), self.unit.as_ref(), &self.options);
+            self.apply(bt.as_ref(), out.as_mut().subrows_mut(start, len));
+            start += len;
+        }
+        for c in 0..self.n_outputs() {
+            let m = self.mean[c];
+            if m != 0.0 {
+                out.col_mut(c).iter_mut().for_each(|v| *v += m);
+            }
+        }
+        Ok(out)
+    }
+
+    /// The gradient of every output with respect to the raw parameters at `x`: a `T x m`
+    /// matrix whose row `t` is `grad f_t(x)`.
+    ///
+    /// With `u` the scaled input, `d psi_i / d u^j = -(u^j - x_i^j) / r_c^2 psi_i`, the
+    /// N-RBF derivatives of [`crate::nrbf`], `d xi / d u^j = 1`, and the chain rule
+    /// `d / d q^j = (1 / (hi_j - lo_j)) d / d u^j`.
+    ///
+    /// # Errors
+    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for a bad `x`.
+    pub fn predict_gradient(&self, x: &[f64]) -> Result<Mat<f64>> {
+        check_queries(MatRef::from_row_major_slice(x, 1, x.len()), self.dim())?;
+        let m = self.dim();
+        let u: Vec<f64> = (0..m)
+            .map(|j| (x[j] - self.lower[j]) / self.width[j])
+            .collect();
+        let db = basis_gradient(&u, self.unit.as_ref(), &self.options);
+        let mut g = Mat::<f64>::zeros(m, self.n_outputs());
+        self.apply(db.as_ref(), g.as_mut());
+        Ok(Mat::from_fn(self.n_outputs(), m, |t, j| {
+            g[(j, t)] / self.width[j]
+        }))
+    }
+
+    /// Leave-one-out errors `e_kt = F_kt - f^{(-k)}_t(x_k)`, an `N x T` matrix.
+    ///
+    /// [`LooMethod::Refit`] is exact: for each `k` the model is refitted without sample `k`
+    /// and its basis functions (`O(M N^2 + N T)` per sample, in parallel).
+    /// [`LooMethod::Closed`] uses the kernel view `G = A A^T = R^T R`:
+    /// `e_k ~ (G^{-1} F)_k / (G^{-1})_kk`, `O(N^3 + N^2 T)`; it is approximate because the
+    /// basis functions centred at `x_k` stay in the model. [`LooMethod::Auto`] refits up to
+    /// 200 samples.
+    ///
+    /// # Errors
+    /// [`ErbfError::LooUndefined`] for a single sample, or when a reduced problem is
+    /// singular.
+    pub fn loo_errors(&self, method: LooMethod) -> Result<Mat<f64>> {
+        let n = self.n_samples();
+        let t = self.n_outputs();
+        if n < 2 {
+            return Err(ErbfError::LooUndefined {
+                sample: 0,
+                message: "needs at least two samples".into(),
+            });
+        }
+        let exact = match method {
+            LooMethod::Refit => true,
+            LooMethod::Closed => false,
+            LooMethod::Auto => n <= 200,
+        };
+        let f = Mat::from_fn(n, t, |i, c| self.values[(i, c)] - self.mean[c]);
+        if !exact {
+            // alpha = G^{-1} F = R^{-1} Z; (G^{-1})_kk = |row k of R^{-1}|^2.
+            let mut rinv = Mat::<f64>::identity(n, n);
+            solve_upper_triangular_in_place(self.r.as_ref(), rinv.as_mut(), par());
+            let mut alpha = self.z.clone();
+            solve_upper_triangular_in_place(self.r.as_ref(), alpha.as_mut(), par());
+            return Ok(Mat::from_fn(n, t, |k, c| {
+                let h: f64 = rinv.row(k).iter().map(|v| v * v).sum();
+                alpha[(k, c)] / h
+            }));
+        }
+        let rows: Vec<Result<Vec<f64>>> = (0..n)
+            .into_par_iter()
+            .map(|k| {
+                let undefined = |message: String| ErbfError::LooUndefined { sample: k, message };
+                let unit = without_row(self.unit.as_ref(), k);
+                let factor = Factor::new(unit.as_ref(), &self.options)
+                    .map_err(|e| undefined(e.to_string()))?;
+                let uk = Mat::from_fn(1, self.dim(), |_, j| self.unit[(k, j)]);
+                let b = basis_matrix_t(uk.as_ref(), unit.as_ref(), &self.options);
+                // w = R^{-1} Q_1^T b, so that f^{(-k)}(x_k) = F_{-k}^T w.
+                let mut w = factor.q1.transpose() * &b;
+                solve_upper_triangular_in_place(factor.r.as_ref(), w.as_mut(), Par::Seq);
+                let fk = without_row(f.as_ref(), k);
+                Ok((0..t)
+                    .map(|c| {
+                        let p: f64 = (0..n - 1).map(|i| fk[(i, c)] * w[(i, 0)]).sum();
+                        f[(k, c)] - p
+                    })
+                    .collect())
+            })
+            .collect();
+        let mut e = Mat::<f64>::zeros(n, t);
+        for (k, row) in rows.into_iter().enumerate() {
+            for (c, v) in row?.into_iter().enumerate() {
+                e[(k, c)] = v;
+            }
+        }
+        Ok(e)
+    }
+
+    /// `max_k |f(x_k) - F_k| / max |F|` over all outputs: the reproduction error of the
+    /// training data (near `1e-14` for a well-posed fit).
+    pub fn training_residual(&self) -> f64 {
+        match self.predict_batch(self.points.as_ref()) {
+            Ok(p) => relative_max_error(p.as_ref(), self.values.as_ref()),
+            Err(_) => f64::NAN,
+        }
+    }
+
+    /// `out = B^T Q_1 Z` (or `B^T c`) for a block of basis vectors `B` (`M x Q`).
+    fn apply(&self, bt: MatRef<'_, f64>, out: faer::MatMut<'_, f64>) {
+        match &self.coef {
+            Some(c) => matmul(out, Accum::Replace, bt.transpose(), c.as_ref(), 1.0, par()),
+            None => {
+                let w = self.q1.transpose() * bt;
+                matmul(
+                    out,
+                    Accum::Replace,
+                    w.transpose(),
+                    self.z.as_ref(),
+                    1.0,
+                    par(),
+                );
+            }
+        }
+    }
+}
+
+/// Query rows per block of batch prediction.
+const BLOCK: usize = 1024;
+
+fn par() -> Par {
+    faer::get_global_parallelism()
+}
+
+/// The thin QR factors of `A^T` for samples `unit` (scaled).
+struct Factor {
+    q1: Mat<f64>,
+    r: Mat<f64>,
+    ratio: f64,
+}
+
+impl Factor {
+    fn new(unit: MatRef<'_, f64>, options: &ErbfOptions) -> Result<Self> {
+        let at = basis_matrix_t(unit, unit, options);
+        let qr = at.qr();
+        let n = unit.nrows();
+        let r = qr.thin_R().to_owned();
+        let q1 = qr.compute_thin_Q();
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
+        for i in 0..n {
+            lo = lo.min(r[(i, i)].abs());
+            hi = hi.max(r[(i, i)].abs());
+        }
+        let ratio = if hi > 0.0 { lo / hi } else { 0.0 };
+        let threshold = n as f64 * f64::EPSILON;
+        if ratio.is_nan() || ratio <= threshold {
+            return Err(ErbfError::Singular { ratio, threshold });
+        }
+        Ok(Factor { q1, r, ratio })
+    }
+}
+
+/// The basis vectors of the queries `u` (`Q x m`, scaled) with respect to the centres
+/// `centres` (`N x m`, scaled), as the columns of an `M x Q` matrix.
+fn basis_matrix_t(u: MatRef<'_, f64>, centres: MatRef<'_, f64>, o: &ErbfOptions) -> Mat<f64> {
+    let n = centres.nrows();
+    let m = centres.ncols();
+    // Centres row-major, so that the inner loop reads contiguous memory.
+    let c: Vec<f64> = (0..n)
+        .flat_map(|i| (0..m).map(move |j| centres[(i, j)]))
+        .collect();
+    let lr = LeftRight::new(o.order as i32, o.gamma);
+    let inv2rc2 = 0.5 / (o.rc * o.rc);
+    let w = o.weights;
+    let mut bt = Mat::<f64>::zeros(n * (3 * m + 1), u.nrows());
+    bt.par_col_chunks_mut(1)
+        .enumerate()
+        .for_each(|(q, mut col)| {
+            let x: Vec<f64> = (0..m).map(|j| u[(q, j)]).collect();
+            let Some(col) = col.as_mut().col_mut(0).try_as_col_major_mut() else {
+                return;
+            };
+            let col = col.as_slice_mut();
+            let (radial, rest) = col.split_at_mut(n);
+            for (i, (r, out)) in radial
+                .iter_mut()
+                .zip(rest.chunks_exact_mut(3 * m))
+                .enumerate()
+            {
+                let ci = &c[i * m..(i + 1) * m];
+                let mut d2 = 0.0;
+                for ((&xj, &cj), o3) in x.iter().zip(ci).zip(out.chunks_exact_mut(3)) {
+                    let xi = xj - cj;
+                    d2 += xi * xi;
+                    let (l, rr) = lr.values(xi);
+                    o3[0] = w.left_right * l;
+                    o3[1] = w.left_right * rr;
+                    o3[2] = w.beta * xi;
+                }
+                *r = w.radial * (-d2 * inv2rc2).exp();
+            }
+        });
+    bt
+}
+
+/// Derivatives of the basis vector at the scaled point `u`: an `M x m` matrix whose column
+/// `j` is `d b / d u^j`.
+fn basis_gradient(u: &[f64], centres: MatRef<'_, f64>, o: &ErbfOptions) -> Mat<f64> {
+    let n = centres.nrows();
+    let m = centres.ncols();
+    let order = o.order as i32;
+    let w = o.weights;
+    let mut db = Mat::<f64>::zeros(n * (3 * m + 1), m);
+    for i in 0..n {
+        let d2: f64 = (0..m).map(|j| (u[j] - centres[(i, j)]).powi(2)).sum();
+        let psi = w.radial * (-0.5 * d2 / (o.rc * o.rc)).exp();
+        for j in 0..m {
+            let xi = u[j] - centres[(i, j)];
+            db[(i, j)] = -xi / (o.rc * o.rc) * psi;
+            let base = n + 3 * (i * m + j);
+            db[(base, j)] = w.left_right * dphi_l(xi, order, o.gamma);
+            db[(base + 1, j)] = w.left_right * dphi_r(xi, order, o.gamma);
+            db[(base + 2, j)] = w.beta;
+        }
+    }
+    db
+}
+
+/// The serialised form of an [`Erbf`]: space, options and training data.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct ErbfData {
+    space: ParameterSpace,
+    options: ErbfOptions,
+    points: StoredMat,
+    values: StoredMat,
+}
+
+impl Serialize for Erbf {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        ErbfData {
+            space: self.space.clone(),
+            options: self.options,
+            points: StoredMat::from_mat(self.points.as_ref()),
+            values: StoredMat::from_mat(self.values.as_ref()),
+        }
+        .serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for Erbf {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let data = ErbfData::deserialize(d)?;
+        let build = || -> Result<Self> {
+            let points = data.points.to_mat("points")?;
+            let values = data.values.to_mat("values")?;
+            Erbf::fit(&data.space, points.as_ref(), values.as_ref(), data.options)
+        };
+        build().map_err(serde::de::Error::custom)
+    }
+}

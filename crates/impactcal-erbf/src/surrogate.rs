@@ -1,0 +1,226 @@
+//! One type for every surrogate kind over a parameter space, with named outputs: what the
+//! `impactcal surrogate` command fits, saves and loads.
+//!
+//! All kinds see inputs scaled to the unit cube by the space's bounds. The classic RBF
+//! kinds use the ERBF defaults where they have a width: Gaussian `exp(-r^2 / (2 r_c^2))`
+//! with `r_c = 0.15` and no tail ("Gaussian-only"), multiquadric `-sqrt(r^2 + c^2)` with
+//! `c = 0.15` and a constant tail, cubic and thin-plate with a linear tail.
+
+use faer::{Mat, MatRef};
+use impactcal_core::ParameterSpace;
+use serde::{Deserialize, Serialize};
+
+use crate::erbf::{Erbf, ErbfOptions};
+use crate::error::{ErbfError, Result};
+use crate::kernel::Kernel;
+use crate::loo::LooMethod;
+use crate::rbf::{RbfInterpolant, RbfOptions};
+
+/// The kinds of surrogate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SurrogateKind {
+    /// ERBF with the default options ([`ErbfOptions::default`]).
+    Erbf,
+    /// Gaussian RBF, width 0.15 in scaled inputs, no tail.
+    Gaussian,
+    /// Cubic RBF with a linear tail.
+    Cubic,
+    /// Thin-plate spline with a linear tail.
+    ThinPlate,
+    /// Multiquadric RBF, `c = 0.15` in scaled inputs, constant tail.
+    Multiquadric,
+}
+
+impl SurrogateKind {
+    /// The classic RBF options of this kind (`None` for ERBF).
+    pub fn rbf_options(self) -> Option<RbfOptions> {
+        match self {
+            SurrogateKind::Erbf => None,
+            SurrogateKind::Gaussian => Some(RbfOptions::new(Kernel::Gaussian { width: 0.15 })),
+            SurrogateKind::Cubic => Some(RbfOptions::cubic()),
+            SurrogateKind::ThinPlate => Some(RbfOptions::thin_plate()),
+            SurrogateKind::Multiquadric => Some(RbfOptions::new(Kernel::Multiquadric { c: 0.15 })),
+        }
+    }
+}
+
+/// The fitted model inside a [`Surrogate`].
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum SurrogateModel {
+    /// An ERBF model (it scales its inputs itself).
+    Erbf(Erbf),
+    /// A classic RBF interpolant fitted in unit-scaled inputs.
+    Rbf {
+        /// The kind (Gaussian, cubic, thin-plate or multiquadric).
+        rbf_kind: SurrogateKind,
+        /// The space whose bounds scale the inputs.
+        space: ParameterSpace,
+        /// The interpolant in scaled inputs.
+        interpolant: RbfInterpolant,
+    },
+}
+
+/// A fitted surrogate of named outputs over a parameter space.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Surrogate {
+    /// Names of the outputs (columns of the training responses).
+    output_names: Vec<String>,
+    /// The model.
+    model: SurrogateModel,
+}
+
+impl Surrogate {
+    /// Fits a surrogate of `kind` to raw samples `points` (`N x m`, columns in the order of
+    /// `space`) and responses `values` (`N x T`) with one name per output column.
+    ///
+    /// # Errors
+    /// [`ErbfError::DimensionMismatch`] when the names do not match the columns; otherwise
+    /// as [`Erbf::fit`] or [`RbfInterpolant::fit`].
+    pub fn fit(
+        space: &ParameterSpace,
+        kind: SurrogateKind,
+        points: MatRef<'_, f64>,
+        values: MatRef<'_, f64>,
+        output_names: Vec<String>,
+    ) -> Result<Self> {
+        if output_names.len() != values.ncols() {
+            return Err(ErbfError::DimensionMismatch {
+                what: "output names (one per output column)".into(),
+                expected: values.ncols(),
+                found: output_names.len(),
+            });
+        }
+        let model = match kind.rbf_options() {
+            None => SurrogateModel::Erbf(Erbf::fit(space, points, values, ErbfOptions::default())?),
+            Some(options) => {
+                let unit = to_unit(space, points)?;
+                SurrogateModel::Rbf {
+                    rbf_kind: kind,
+                    space: space.clone(),
+                    interpolant: RbfInterpolant::fit(unit.as_ref(), values, options)?,
+                }
+            }
+        };
+        Ok(Surrogate {
+            output_names,
+            model,
+        })
+    }
+
+    /// The kind of the model.
+    pub fn kind(&self) -> SurrogateKind {
+        match &self.model {
+            SurrogateModel::Erbf(_) => SurrogateKind::Erbf,
+            SurrogateModel::Rbf { rbf_kind, .. } => *rbf_kind,
+        }
+    }
+
+    /// The model.
+    pub fn model(&self) -> &SurrogateModel {
+        &self.model
+    }
+
+    /// The parameter space.
+    pub fn space(&self) -> &ParameterSpace {
+        match &self.model {
+            SurrogateModel::Erbf(e) => e.space(),
+            SurrogateModel::Rbf { space, .. } => space,
+        }
+    }
+
+    /// Names of the outputs.
+    pub fn output_names(&self) -> &[String] {
+        &self.output_names
+    }
+
+    /// Number of training samples.
+    pub fn n_samples(&self) -> usize {
+        match &self.model {
+            SurrogateModel::Erbf(e) => e.n_samples(),
+            SurrogateModel::Rbf { interpolant, .. } => interpolant.n_samples(),
+        }
+    }
+
+    /// Predictions at raw points (`Q x m`): `Q x T`.
+    ///
+    /// # Errors
+    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for bad points.
+    pub fn predict_batch(&self, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
+        match &self.model {
+            SurrogateModel::Erbf(e) => e.predict_batch(points),
+            SurrogateModel::Rbf {
+                space, interpolant, ..
+            } => interpolant.predict_batch(to_unit(space, points)?.as_ref()),
+        }
+    }
+
+    /// Gradient with respect to the raw parameters at `x`: `T x m`.
+    ///
+    /// # Errors
+    /// As [`predict_batch`](Self::predict_batch).
+    pub fn predict_gradient(&self, x: &[f64]) -> Result<Mat<f64>> {
+        match &self.model {
+            SurrogateModel::Erbf(e) => e.predict_gradient(x),
+            SurrogateModel::Rbf {
+                space, interpolant, ..
+            } => {
+                let u = space.to_unit(x)?;
+                let g = interpolant.predict_gradient(&u)?;
+                let p = space.parameters();
+                Ok(Mat::from_fn(g.nrows(), g.ncols(), |t, j| {
+                    g[(t, j)] / p[j].width()
+                }))
+            }
+        }
+    }
+
+    /// Whether the raw point `x` lies outside the space's bounds.
+    pub fn is_outside(&self, x: &[f64]) -> bool {
+        !self.space().contains(x)
+    }
+
+    /// Relative reproduction error of the training data (see
+    /// [`Erbf::training_residual`]).
+    pub fn training_residual(&self) -> f64 {
+        match &self.model {
+            SurrogateModel::Erbf(e) => e.training_residual(),
+            SurrogateModel::Rbf { interpolant, .. } => interpolant.training_residual(),
+        }
+    }
+
+    /// Leave-one-out errors, `N x T` (see [`Erbf::loo_errors`] and
+    /// [`RbfInterpolant::loo_errors`]).
+    ///
+    /// # Errors
+    /// [`ErbfError::LooUndefined`] when they are undefined.
+    pub fn loo_errors(&self, method: LooMethod) -> Result<Mat<f64>> {
+        match &self.model {
+            SurrogateModel::Erbf(e) => e.loo_errors(method),
+            SurrogateModel::Rbf { interpolant, .. } => interpolant.loo_errors(method),
+        }
+    }
+
+    /// The training responses, `N x T`.
+    pub fn values(&self) -> MatRef<'_, f64> {
+        match &self.model {
+            SurrogateModel::Erbf(e) => e.values(),
+            SurrogateModel::Rbf { interpolant, .. } => interpolant.values(),
+        }
+    }
+}
+
+fn to_unit(space: &ParameterSpace, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
+    if points.ncols() != space.dim() {
+        return Err(ErbfError::DimensionMismatch {
+            what: "points: number of columns (parameters)".into(),
+            expected: space.dim(),
+            found: points.ncols(),
+        });
+    }
+    let p = space.parameters();
+    Ok(Mat::from_fn(points.nrows(), points.ncols(), |i, j| {
+        (points[(i, j)] - p[j].lower) / p[j].width()
+    }))
+}

@@ -1,0 +1,205 @@
+//! First-order indices from one existing sample (no pick-freeze design).
+
+use impactcal_core::Points;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::analysis::OutputView;
+use crate::error::{Result, SobolError};
+
+/// Options of [`given_data_first_order`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct GivenDataOptions {
+    /// Number of equal-count bins per parameter; default `round(n^(1/3))`, at least 2.
+    pub bins: Option<usize>,
+    /// Low-variance threshold, as in [`SobolOptions`](crate::SobolOptions) (default 1e-10).
+    pub low_variance_tolerance: f64,
+    /// Parameter names (default `x1, x2, ...`).
+    pub parameter_names: Option<Vec<String>>,
+    /// Output names (default `y1, y2, ...`).
+    pub output_names: Option<Vec<String>>,
+}
+
+impl Default for GivenDataOptions {
+    fn default() -> Self {
+        GivenDataOptions {
+            bins: None,
+            low_variance_tolerance: 1e-10,
+            parameter_names: None,
+            output_names: None,
+        }
+    }
+}
+
+/// First-order indices estimated from a given sample by the correlation ratio.
+///
+/// For parameter `i` the `n` runs are split by the rank of `x_i` into `M` bins of (almost)
+/// equal count; with bin means `ybar_m`, counts `n_m` and overall mean `ybar`,
+/// `SSB = sum_m n_m (ybar_m - ybar)^2`, `SST = sum_k (y_k - ybar)^2`, `SSW = SST - SSB`:
+///
+/// - `first_order_uncorrected = SSB / SST` (the binned correlation ratio, biased upward by
+///   about `(M - 1) / n` for an inactive parameter);
+/// - `first_order = (SSB - (M - 1) SSW / (n - M)) / SST`, the bias-corrected value (the
+///   epsilon-squared of one-way ANOVA), near zero for an inactive parameter and possibly
+///   slightly negative.
+///
+/// Binning also loses the variation of `E[Y|X_i]` inside a bin (for a linear effect a
+/// fraction `1/M^2` of `V_i`). Plischke, Borgonovo & Smith (2013) discuss the method. Only
+/// first-order indices can be had this way; totals and interactions need a pick-freeze
+/// design.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GivenDataIndices {
+    /// Parameter names.
+    pub parameters: Vec<String>,
+    /// Output names.
+    pub outputs: Vec<String>,
+    /// Number of runs.
+    pub n: usize,
+    /// Bins per parameter.
+    pub bins: usize,
+    /// `first_order[t][i]`: bias-corrected first-order index.
+    pub first_order: Vec<Vec<f64>>,
+    /// `first_order_uncorrected[t][i]`: the plain binned correlation ratio.
+    pub first_order_uncorrected: Vec<Vec<f64>>,
+    /// `max(S_i, 0) / sum_j max(S_j, 0)` from `first_order`: shares that sum to 1.
+    pub normalised_first_order_share: Vec<Vec<f64>>,
+    /// Output variance per column (divisor `n`).
+    pub variance: Vec<f64>,
+    /// Names of the columns with (near-)zero variance; their indices are NaN.
+    pub low_variance_outputs: Vec<String>,
+}
+
+/// Estimates first-order indices of every output column from runs `x` (one row per run, in
+/// any design: Halton, Latin hypercube, an existing ensemble) and their `outputs` (same
+/// rows). See [`GivenDataIndices`] for the estimator.
+///
+/// # Errors
+/// [`SobolError::Mismatch`] when the row counts differ or a name list has the wrong
+/// length; [`SobolError::InvalidOption`] when there are fewer than 2 runs per bin or fewer
+/// than 2 bins; [`SobolError::NonFiniteOutput`] for NaN or infinite outputs.
+pub fn given_data_first_order(
+    x: &Points,
+    outputs: OutputView<'_>,
+    options: &GivenDataOptions,
+) -> Result<GivenDataIndices> {
+    let (n, d, cols) = (x.n(), x.dim(), outputs.cols());
+    if outputs.rows() != n {
+        return Err(SobolError::Mismatch {
+            what: "output rows (one per run of the sample)".into(),
+            expected: n,
+            found: outputs.rows(),
+        });
+    }
+    let bins = options
+        .bins
+        .unwrap_or_else(|| ((n as f64).cbrt().round() as usize).max(2));
+    if bins < 2 || n < 2 * bins {
+        return Err(SobolError::InvalidOption(format!(
+            "{bins} bins need at least 2 bins and 2 runs per bin; the sample has {n} runs"
+        )));
+    }
+    for (r, row) in outputs.data().chunks_exact(cols).enumerate() {
+        if let Some(t) = row.iter().position(|v| !v.is_finite()) {
+            return Err(SobolError::NonFiniteOutput {
+                row: r,
+                column: t,
+                value: row[t],
+            });
+        }
+    }
+    if let Some(k) = x.as_slice().iter().position(|v| !v.is_finite()) {
+        return Err(SobolError::InvalidOption(format!(
+            "parameter value {} at run {}, parameter {} is not finite",
+            x.as_slice()[k],
+            k / d,
+            k % d
+        )));
+    }
+    let names = |given: &Option<Vec<String>>, prefix: &str, count: usize, what: &str| match given {
+        Some(v) if v.len() != count => Err(SobolError::Mismatch {
+            what: format!("number of {what} names"),
+            expected: count,
+            found: v.len(),
+        }),
+        Some(v) => Ok(v.clone()),
+        None => Ok((1..=count).map(|k| format!("{prefix}{k}")).collect()),
+    };
+    let parameters = names(&options.parameter_names, "x", d, "parameter")?;
+    let output_names = names(&options.output_names, "y", cols, "output")?;
+
+    let mut mean = vec![0.0; cols];
+    for row in outputs.data().chunks_exact(cols) {
+        mean.iter_mut().zip(row).for_each(|(m, v)| *m += v);
+    }
+    mean.iter_mut().for_each(|m| *m /= n as f64);
+    let mut sst = vec![0.0; cols];
+    for row in outputs.data().chunks_exact(cols) {
+        for ((s, v), m) in sst.iter_mut().zip(row).zip(&mean) {
+            *s += (v - m) * (v - m);
+        }
+    }
+    let vmax = sst.iter().fold(0.0_f64, |a, &b| a.max(b));
+    let low: Vec<bool> = sst
+        .iter()
+        .map(|&s| !(s > 0.0 && s > options.low_variance_tolerance * vmax))
+        .collect();
+
+    // ssb[i][t] for every parameter.
+    let ssb: Vec<Vec<f64>> = (0..d)
+        .into_par_iter()
+        .map(|i| {
+            let mut order: Vec<usize> = (0..n).collect();
+            order.sort_by(|&p, &q| x.row(p)[i].total_cmp(&x.row(q)[i]).then(p.cmp(&q)));
+            let mut sums = vec![0.0; bins * cols];
+            let mut counts = vec![0usize; bins];
+            for (rank, &r) in order.iter().enumerate() {
+                let m = rank * bins / n;
+                counts[m] += 1;
+                let s = &mut sums[m * cols..(m + 1) * cols];
+                s.iter_mut().zip(outputs.row(r)).for_each(|(a, v)| *a += v);
+            }
+            let mut out = vec![0.0; cols];
+            for (m, &c) in counts.iter().enumerate() {
+                let s = &sums[m * cols..(m + 1) * cols];
+                for t in 0..cols {
+                    let dev = s[t] / c as f64 - mean[t];
+                    out[t] += c as f64 * dev * dev;
+                }
+            }
+            out
+        })
+        .collect();
+
+    let factor = (bins - 1) as f64 / (n - bins) as f64;
+    let mut first_order = vec![vec![f64::NAN; d]; cols];
+    let mut uncorrected = vec![vec![f64::NAN; d]; cols];
+    for t in (0..cols).filter(|&t| !low[t]) {
+        for i in 0..d {
+            let b = ssb[i][t];
+            let within = sst[t] - b;
+            uncorrected[t][i] = b / sst[t];
+            first_order[t][i] = (b - factor * within) / sst[t];
+        }
+    }
+    let normalised_first_order_share = first_order
+        .iter()
+        .map(|row| {
+            let sum: f64 = row.iter().map(|s| s.max(0.0)).sum();
+            row.iter().map(|s| s.max(0.0) / sum).collect()
+        })
+        .collect();
+    Ok(GivenDataIndices {
+        parameters,
+        low_variance_outputs: (0..cols)
+            .filter(|&t| low[t])
+            .map(|t| output_names[t].clone())
+            .collect(),
+        outputs: output_names,
+        n,
+        bins,
+        first_order,
+        first_order_uncorrected: uncorrected,
+        normalised_first_order_share,
+        variance: sst.iter().map(|s| s / n as f64).collect(),
+    })
+}
