@@ -188,6 +188,10 @@ pub struct Simulation {
     chunks: Vec<ChunkSum>,
     /// Per-chunk partial sums of the node loops.
     node_sums: Vec<f64>,
+    /// Per-chunk kinetic energies and finiteness of the velocity update.
+    kick_sums: Vec<KickSum>,
+    /// A velocity of the last update is not finite.
+    v_bad: bool,
     /// `1 / m` per node, 0 where the node has no mass.
     inv_mass: Vec<f64>,
     /// `1 / I` per node, 0 where the node has no rotary inertia.
@@ -212,6 +216,15 @@ pub struct Simulation {
     wall_normal: f64,
     peak_wall: f64,
     started: bool,
+}
+
+/// Per-chunk results of the velocity update: translational and rotational kinetic energy,
+/// and whether a velocity is not finite.
+#[derive(Debug, Clone, Copy, Default)]
+struct KickSum {
+    kt: f64,
+    kr: f64,
+    bad: bool,
 }
 
 /// Per-chunk reductions of the element loop, combined in chunk order.
@@ -302,6 +315,8 @@ impl Simulation {
             faults: vec![None; ne],
             chunks: vec![ChunkSum::default(); ne.div_ceil(ELEMENT_CHUNK)],
             node_sums: vec![0.0; nn.div_ceil(NODE_CHUNK)],
+            kick_sums: vec![KickSum::default(); nn.div_ceil(NODE_CHUNK)],
+            v_bad: false,
             inv_mass: c
                 .mass
                 .iter()
@@ -607,24 +622,42 @@ impl Simulation {
             let e: f64 = chunked_sum(&self.v, &self.c.mass, |v, m| m * dot(*v, *v));
             self.energies.damping += self.damping * e * dt_v;
         }
+        // Velocity update, kinetic energy and the finiteness check in one pass over fixed
+        // node chunks, summed in chunk order.
         let half = 0.5 * dt_next;
         let (a, al) = (&self.a, &self.alpha);
+        let (mass, inertia) = (&self.c.mass, &self.c.inertia);
         self.v
-            .par_iter_mut()
-            .zip(self.w.par_iter_mut())
-            .zip(self.v_int.par_iter_mut().zip(self.w_int.par_iter_mut()))
+            .par_chunks_mut(NODE_CHUNK)
+            .zip(self.w.par_chunks_mut(NODE_CHUNK))
+            .zip(self.v_int.par_chunks_mut(NODE_CHUNK))
+            .zip(self.w_int.par_chunks_mut(NODE_CHUNK))
+            .zip(self.kick_sums.par_iter_mut())
             .enumerate()
-            .with_min_len(NODE_CHUNK)
-            .for_each(|(i, ((v, w), (vi, wi)))| {
-                for d in 0..3 {
-                    vi[d] = v[d] + h_prev * a[i][d];
-                    v[d] = vi[d] + half * a[i][d];
-                    wi[d] = w[d] + h_prev * al[i][d];
-                    w[d] = wi[d] + half * al[i][d];
+            .for_each(|(c, ((((v, w), vi), wi), sum))| {
+                let first = c * NODE_CHUNK;
+                let (mut kt, mut kr, mut bad) = (0.0, 0.0, false);
+                for j in 0..v.len() {
+                    let i = first + j;
+                    for d in 0..3 {
+                        vi[j][d] = v[j][d] + h_prev * a[i][d];
+                        v[j][d] = vi[j][d] + half * a[i][d];
+                        wi[j][d] = w[j][d] + h_prev * al[i][d];
+                        w[j][d] = wi[j][d] + half * al[i][d];
+                    }
+                    kt += 0.5 * mass[i] * dot(vi[j], vi[j]);
+                    kr += 0.5 * inertia[i] * dot(wi[j], wi[j]);
+                    bad |= v[j].iter().any(|x| !x.is_finite());
                 }
+                *sum = KickSum { kt, kr, bad };
             });
-        let ke_t = chunked_sum(&self.v_int, &self.c.mass, |v, m| 0.5 * m * dot(*v, *v));
-        let ke_r = chunked_sum(&self.w_int, &self.c.inertia, |w, i| 0.5 * i * dot(*w, *w));
+        let (mut ke_t, mut ke_r) = (0.0, 0.0);
+        self.v_bad = false;
+        for s in &self.kick_sums {
+            ke_t += s.kt;
+            ke_r += s.kr;
+            self.v_bad |= s.bad;
+        }
         self.energies.kinetic = ke_t + ke_r;
     }
 
@@ -752,9 +785,8 @@ impl Simulation {
                 .unwrap_or(0);
             return Err(self.unstable(k, "non-finite force or energy".into()));
         }
-        let bad = |v: &[f64; 3]| v.iter().any(|c| !c.is_finite());
-        if self.v.par_iter().with_min_len(NODE_CHUNK).any(bad)
-            && let Some(i) = self.v.iter().position(bad)
+        if self.v_bad
+            && let Some(i) = self.v.iter().position(|v| v.iter().any(|c| !c.is_finite()))
         {
             return Err(ShellError::Unstable {
                 time: self.time,
