@@ -588,12 +588,13 @@ impl Cors {
             if cors.should_restart(&plan, k) {
                 cors.restart_plan(&mut plan, k)?;
                 let mut used = vec![false; plan.design.len()];
-                for row in k..n.min(k + plan.design.len()) {
+                let end = n.min(k + plan.design.len());
+                for (u, e) in units[k..end].iter().zip(&mut cors.evaluations[k..end]) {
                     if let Some(j) = (0..plan.design.len())
-                        .find(|&j| !used[j] && distance(&units[row], &plan.design[j]) <= tol)
+                        .find(|&j| !used[j] && distance(u, &plan.design[j]) <= tol)
                     {
                         used[j] = true;
-                        cors.evaluations[row].origin = Origin::Design;
+                        e.origin = Origin::Design;
                     }
                 }
                 k = plan.cycle_origin;
