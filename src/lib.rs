@@ -12,6 +12,7 @@
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
 //! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
 //! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals |
+//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -51,6 +52,9 @@ pub mod prelude {
     };
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
+    };
+    pub use impactcal_shell::airframe::{
+        Airframe, AirframeModel, AirframeOptions, AirframeValues, MeshDensity, Preset,
     };
     pub use impactcal_shell::{ShellError, ShellModel, Simulation};
     pub use impactcal_sobol::{

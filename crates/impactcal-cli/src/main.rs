@@ -3,6 +3,7 @@
 //! Each subcommand lives in its own module with an `Args` struct (clap) and a `run`
 //! function; this file only registers them. Numerical work happens in the library.
 
+mod airframe;
 mod compare;
 mod error;
 mod expand;
@@ -52,6 +53,9 @@ enum Command {
     Sample(sample::Args),
     /// Sobol' sensitivity indices of every output column.
     Sobol(sobol::Args),
+    /// The built-in parametric helicopter airframe: write it as a keyword deck, list its
+    /// adjustable quantities and presets, draw its parts.
+    Airframe(airframe::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -65,6 +69,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Simulate(a) => simulate::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Sobol(a) => sobol::run(a),
+        Command::Airframe(a) => airframe::run(a),
     }
 }
 

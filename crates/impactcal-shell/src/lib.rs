@@ -71,6 +71,7 @@
 // `!(x > 0.0)` is used on purpose: it also rejects NaN.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod airframe;
 pub mod element;
 pub mod error;
 mod geometry;
