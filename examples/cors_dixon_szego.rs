@@ -3,13 +3,14 @@
 //!
 //! `cargo run --release --example cors_dixon_szego -- [--seeds 30] [--budget 300]
 //! [--functions branin,hartmann3] [--transform identity|log|shifted-log|median-cap]
-//! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]`
+//! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]
+//! [--restart-patience N | --no-restart]`
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::time::Instant;
 
-use impactcal::cors::{Cors, CorsOptions, SurrogateKernel, Transform, test_functions};
+use impactcal::cors::{Cors, CorsOptions, Restart, SurrogateKernel, Transform, test_functions};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -61,6 +62,17 @@ fn main() {
             if let Some(p) = &pattern {
                 options.pattern.clone_from(p);
             }
+            if let Some(h) = get("--local-region") {
+                options.local_region = Some(h.parse().unwrap());
+            }
+            if args.iter().any(|a| a == "--no-restart") {
+                options.restart = None;
+            } else if let Some(p) = get("--restart-patience") {
+                options.restart = Some(Restart {
+                    patience: Some(p.parse().unwrap()),
+                    ..Restart::default()
+                });
+            }
             let mut study = Cors::new(f.space().unwrap(), options).unwrap();
             let mut hit: Option<usize> = None;
             let mut best = f64::INFINITY;
@@ -86,9 +98,10 @@ fn main() {
                 adaptive.iter().sum::<f64>() / adaptive.len() as f64
             };
             println!(
-                "{{\"tool\":\"impactcal-cors\",\"function\":\"{name}\",\"seed\":{seed},\"evals_to_1pct\":{},\"best\":{best},\"evaluations\":{},\"overhead_s\":{mean}}}",
+                "{{\"tool\":\"impactcal-cors\",\"function\":\"{name}\",\"seed\":{seed},\"evals_to_1pct\":{},\"best\":{best},\"evaluations\":{},\"overhead_s\":{mean},\"restarts\":{}}}",
                 hit.map_or("null".to_string(), |h| h.to_string()),
-                study.evaluations().len()
+                study.evaluations().len(),
+                study.restarts()
             );
         }
     }

@@ -2,16 +2,10 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
-use std::process::{Command, Output};
+mod common;
+use common::impactcal;
 
 use impactcal::core::Histories;
-
-fn impactcal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_impactcal"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 #[test]
 fn list_and_presets() {

@@ -3,19 +3,14 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+use common::impactcal;
+
 use std::io::Write;
 use std::path::Path;
-use std::process::{Command, Output};
 
 use impactcal::core::{Table, TableOptions};
 use impactcal::cors::{Cors, CorsOptions, test_functions};
-
-fn impactcal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_impactcal"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 fn suggest(bounds: &Path, history: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
     let mut args = vec![

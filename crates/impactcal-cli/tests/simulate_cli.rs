@@ -2,30 +2,17 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{example_file, impactcal};
 
 use impactcal::core::Histories;
-
-fn deck(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/decks")
-        .join(name)
-}
-
-fn impactcal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_impactcal"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
 
 #[test]
 fn simulate_writes_histories_energies_and_a_summary() {
     let dir = tempfile::tempdir().unwrap();
     let h = dir.path().join("h.csv");
     let e = dir.path().join("e.csv");
-    let d = deck("strip_drop.k");
+    let d = example_file("decks", "strip_drop.k");
     let run = |threads: &str, q: &str| {
         let out = impactcal(&[
             "simulate",

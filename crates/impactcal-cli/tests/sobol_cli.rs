@@ -2,21 +2,16 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::needless_range_loop)]
 
 use std::path::Path;
-use std::process::Command;
 
 use serde_json::Value;
+
+mod common;
+use common::impactcal;
 
 const BOUNDS: &str = "name,lower,upper,nominal\n\
     x1,-3.141592653589793,3.141592653589793,0\n\
     x2,-3.141592653589793,3.141592653589793,0\n\
     x3,-3.141592653589793,3.141592653589793,0\n";
-
-fn impactcal(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_impactcal"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 fn read_rows(path: &Path) -> (String, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap();

@@ -14,14 +14,6 @@ pub fn squared_distance(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
-/// Clamps every coordinate to `[0, 1]`.
-#[inline]
-pub fn clip_unit(x: &mut [f64]) {
-    for v in x.iter_mut() {
-        *v = v.clamp(0.0, 1.0);
-    }
-}
-
 /// SplitMix64 finaliser: a bijective scrambling of 64 bits.
 pub fn mix(mut z: u64) -> u64 {
     z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);

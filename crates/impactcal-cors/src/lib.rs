@@ -45,5 +45,5 @@ pub mod test_functions;
 pub use error::{CorsError, Result};
 pub use optimizer::{Cors, Evaluation, Mode, Origin, Outcome, StopReason, Suggestion};
 pub use options::{
-    CorsOptions, DEFAULT_PATTERN, InitialDesign, Stopping, SurrogateKernel, Transform,
+    CorsOptions, DEFAULT_PATTERN, InitialDesign, Restart, Stopping, SurrogateKernel, Transform,
 };

@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 use crate::design::{affine_rank, find_near_duplicate, symmetric_design};
 use crate::error::{CorsError, Result};
 use crate::geometry::{distance, mix, stream};
-use crate::options::{CorsOptions, InitialDesign};
-use crate::subproblem::{Blockers, StepSettings, cors_step, maximin};
+use crate::options::{CorsOptions, InitialDesign, Restart};
+use crate::subproblem::{Blockers, Region, StepSettings, cors_step, maximin};
 use crate::surrogate::Surrogate;
 
 /// Tag of the saved state format.
@@ -82,15 +82,61 @@ pub enum Mode {
     Design,
 }
 
-/// The plan fixed at the first suggestion.
+/// The plan of the current run, fixed at the first suggestion and renewed at each restart.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct Plan {
     mode: Mode,
-    /// Design points in the unit box (kept even in existing mode, for the record).
+    /// Design points of the current run in the unit box (kept even in existing mode, for
+    /// the record).
     design: Vec<Vec<f64>>,
     /// Index in the history of the first point of the `beta` cycle: point `n` uses
     /// `pattern[(n - cycle_origin) mod k]`.
     cycle_origin: usize,
+    /// Index in the history of the first evaluation of the current run (0 before any
+    /// restart).
+    #[serde(default)]
+    run_start: usize,
+    /// Number of restarts so far.
+    #[serde(default)]
+    restarts: usize,
+}
+
+impl Plan {
+    /// Whether the current run stagnates after the first `upto` evaluations: `patience`
+    /// consecutive evaluations after its initial set without improving the run's best by
+    /// more than `min_improvement * |best|`.
+    fn stagnates(
+        &self,
+        evaluations: &[Evaluation],
+        upto: usize,
+        rule: &Restart,
+        dim: usize,
+    ) -> bool {
+        let patience = rule.patience_for(dim);
+        let mut best: Option<f64> = None;
+        let mut since = 0;
+        for (k, e) in evaluations
+            .iter()
+            .enumerate()
+            .take(upto)
+            .skip(self.run_start)
+        {
+            let improved = match (e.value, best) {
+                (Some(_), None) => true,
+                (Some(v), Some(b)) => v < b - rule.min_improvement * b.abs(),
+                (None, _) => false,
+            };
+            if let Some(v) = e.value {
+                best = Some(best.map_or(v, |b| b.min(v)));
+            }
+            if improved {
+                since = 0;
+            } else if k >= self.cycle_origin {
+                since += 1;
+            }
+        }
+        since >= patience
+    }
 }
 
 /// Why a study stopped.
@@ -275,12 +321,47 @@ impl Cors {
     }
 
     fn make_design(&self) -> Result<Vec<Vec<f64>>> {
+        self.make_run_design(0)
+    }
+
+    /// The design of run `run` (0 the initial one, `r` the one of the `r`-th restart).
+    fn make_run_design(&self, run: usize) -> Result<Vec<Vec<f64>>> {
         let d = self.space.dim();
-        symmetric_design(
-            self.options.design_size_for(d),
-            d,
-            mix(self.options.seed ^ 0xDE51_6E00_0000_0001),
-        )
+        let mut seed = mix(self.options.seed ^ 0xDE51_6E00_0000_0001);
+        if run > 0 {
+            seed = mix(seed ^ mix(run as u64 ^ 0x4E57_2A11_0000_0000));
+        }
+        symmetric_design(self.options.design_size_for(d), d, seed)
+    }
+
+    /// Starts a new run at history index `at`: a new design, a new cycle after it.
+    fn restart_plan(&self, plan: &mut Plan, at: usize) -> Result<()> {
+        plan.restarts += 1;
+        plan.design = self.make_run_design(plan.restarts)?;
+        plan.mode = Mode::Design;
+        plan.run_start = at;
+        plan.cycle_origin = at + plan.design.len();
+        Ok(())
+    }
+
+    /// Whether the restart rule fires for the next suggestion, given the first `upto`
+    /// evaluations.
+    fn should_restart(&self, plan: &Plan, upto: usize) -> bool {
+        self.options
+            .restart
+            .as_ref()
+            .is_some_and(|rule| plan.stagnates(&self.evaluations, upto, rule, self.space.dim()))
+    }
+
+    /// Number of restarts so far.
+    pub fn restarts(&self) -> usize {
+        self.plan.as_ref().map_or(0, |p| p.restarts)
+    }
+
+    /// Index in [`evaluations`](Self::evaluations) of the first evaluation of the current
+    /// run (0 before any restart).
+    pub fn run_start(&self) -> usize {
+        self.plan.as_ref().map_or(0, |p| p.run_start)
     }
 
     fn unit_to_space(&self, u: &[f64]) -> Result<Vec<f64>> {
@@ -494,11 +575,34 @@ impl Cors {
                 e.origin = Origin::Cors;
             }
         }
-        cors.plan = Some(Plan {
+        let mut plan = Plan {
             mode,
             design,
             cycle_origin,
-        });
+            run_start: 0,
+            restarts: 0,
+        };
+        // Replay the restart rule as the library's loop applied it before each suggestion.
+        let mut k = plan.cycle_origin;
+        while k < n {
+            if cors.should_restart(&plan, k) {
+                cors.restart_plan(&mut plan, k)?;
+                let mut used = vec![false; plan.design.len()];
+                let end = n.min(k + plan.design.len());
+                for (u, e) in units[k..end].iter().zip(&mut cors.evaluations[k..end]) {
+                    if let Some(j) = (0..plan.design.len())
+                        .find(|&j| !used[j] && distance(u, &plan.design[j]) <= tol)
+                    {
+                        used[j] = true;
+                        e.origin = Origin::Design;
+                    }
+                }
+                k = plan.cycle_origin;
+            } else {
+                k += 1;
+            }
+        }
+        cors.plan = Some(plan);
         Ok(cors)
     }
 
@@ -556,6 +660,8 @@ impl Cors {
             mode,
             design,
             cycle_origin,
+            run_start: 0,
+            restarts: 0,
         });
         Ok(())
     }
@@ -568,7 +674,7 @@ impl Cors {
         let tol = DUPLICATE_TOL * (d as f64).sqrt();
         let mut pts: Vec<Vec<f64>> = Vec::new();
         let mut vals: Vec<f64> = Vec::new();
-        for e in &self.evaluations {
+        for e in &self.evaluations[self.run_start()..] {
             let Some(v) = e.value else { continue };
             let u = self.space.to_unit(&e.x)?;
             match pts.iter().position(|p| distance(p, &u) <= tol) {
@@ -596,15 +702,18 @@ impl Cors {
             .map(|s| (s, best_x)))
     }
 
-    /// The points to keep away from: successes and pending points, and failures.
+    /// The points to keep away from: successes of the current run and pending points, and
+    /// failures of every run.
     fn blockers(&self) -> Result<Blockers> {
         let mut b = Blockers::new(self.space.dim());
-        for e in &self.evaluations {
-            let u = self.space.to_unit(&e.x)?;
+        let run_start = self.run_start();
+        for (k, e) in self.evaluations.iter().enumerate() {
             if e.is_success() {
-                b.ok.extend(u);
+                if k >= run_start {
+                    b.ok.extend(self.space.to_unit(&e.x)?);
+                }
             } else {
-                b.failed.extend(u);
+                b.failed.extend(self.space.to_unit(&e.x)?);
             }
         }
         for p in &self.pending {
@@ -636,14 +745,23 @@ impl Cors {
             return Ok(Vec::new());
         }
         self.ensure_plan()?;
-        let Some(plan) = self.plan.clone() else {
+        let Some(mut plan) = self.plan.clone() else {
             return Ok(Vec::new());
         };
+        let index = self.evaluations.len() + self.pending.len();
+        if index >= plan.cycle_origin && self.should_restart(&plan, self.evaluations.len()) {
+            self.restart_plan(&mut plan, index)?;
+            self.plan = Some(plan.clone());
+        }
         let d = self.space.dim();
         let mut out = Vec::with_capacity(q);
         if plan.mode == Mode::Design {
             let tol = MATCH_TOL * (d as f64).sqrt();
-            let mut seen = self.units(self.evaluations.iter().map(|e| e.x.as_slice()))?;
+            let mut seen = self.units(
+                self.evaluations[plan.run_start..]
+                    .iter()
+                    .map(|e| e.x.as_slice()),
+            )?;
             seen.extend(self.units(self.pending.iter().map(|p| p.x.as_slice()))?);
             for u in &plan.design {
                 if out.len() == q {
@@ -685,7 +803,12 @@ impl Cors {
                         local_candidates: self.options.local_candidates_per_dim * d,
                         polish_starts: self.options.polish_starts,
                     };
-                    let c = cors_step(surrogate, best, &blockers, &settings, &mut rng);
+                    let cycle = index.saturating_sub(plan.cycle_origin) / k;
+                    let region = match self.options.local_region {
+                        Some(half) if cycle % 2 == 1 => Region::around(best, half),
+                        _ => Region::unit(d),
+                    };
+                    let c = cors_step(surrogate, best, &blockers, &settings, &region, &mut rng);
                     Suggestion {
                         id: self.next_id,
                         x: self.unit_to_space(&c.x)?,

@@ -104,6 +104,49 @@ pub struct Stopping {
     pub min_improvement: f64,
 }
 
+/// The restart rule, in the spirit of CORS-RBF-Restart (Regis & Shoemaker, J. Global Optim.
+/// 37:113-135, 2007): when the current run stops making substantial progress, the study
+/// starts a new run from a fresh symmetric Latin hypercube design.
+///
+/// A run is the initial set (or a restart design) and the CORS points that follow it. The
+/// run *stagnates* once `patience` consecutive evaluations after its initial set have not
+/// improved the run's best value by more than `min_improvement * |best|`. The next
+/// suggestion then starts a new run: a new design of the same size (drawn from the seed and
+/// the restart count), then CORS points whose surrogate, distance constraints, maximin
+/// distance and `beta` cycle use the new run's evaluations only. Every evaluation stays in
+/// the history, the best over all runs is the study's result, and failed points keep their
+/// no-go radius across runs.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Restart {
+    /// Consecutive evaluations without substantial improvement that end a run; `None` is
+    /// [`Restart::default_patience`] of the dimension.
+    pub patience: Option<usize>,
+    /// Relative improvement of the run's best value that counts as substantial.
+    pub min_improvement: f64,
+}
+
+impl Default for Restart {
+    fn default() -> Self {
+        Restart {
+            patience: None,
+            min_improvement: 1e-3,
+        }
+    }
+}
+
+impl Restart {
+    /// The default patience in `dim` dimensions: `6 max(5, d)`, i.e. five cycles of the
+    /// default pattern in up to 5 dimensions.
+    pub fn default_patience(dim: usize) -> usize {
+        6 * dim.max(5)
+    }
+
+    /// The patience in `dim` dimensions.
+    pub fn patience_for(&self, dim: usize) -> usize {
+        self.patience.unwrap_or_else(|| Self::default_patience(dim))
+    }
+}
+
 /// Options of [`Cors`](crate::Cors).
 ///
 /// All distances are in the unit box `[0, 1]^d` of the parameter space. The defaults are
@@ -139,6 +182,14 @@ pub struct CorsOptions {
     pub failure_radius: f64,
     /// Stopping rules besides the budget.
     pub stopping: Stopping,
+    /// The restart rule (`None`, the default: a single run, as in the 2005 method).
+    pub restart: Option<Restart>,
+    /// Half-width (in the unit box) of the box around the run's best point that every
+    /// second cycle of the pattern searches: cycles 0, 2, 4... search the whole box,
+    /// cycles 1, 3, 5... the box `[x_best - h, x_best + h]` cut to the unit box, with
+    /// `Delta` the maximin distance within it. `None`: every cycle searches the whole box
+    /// (the 2005 method). Default 0.3.
+    pub local_region: Option<f64>,
     /// Seed of the design and of every candidate set.
     pub seed: u64,
 }
@@ -160,6 +211,8 @@ impl Default for CorsOptions {
             min_distance: 1e-3,
             failure_radius: 0.05,
             stopping: Stopping::default(),
+            restart: None,
+            local_region: Some(0.3),
             seed: 0,
         }
     }
@@ -184,7 +237,8 @@ impl CorsOptions {
     /// # Errors
     /// [`CorsError::InvalidOption`] for an empty pattern or a `beta` outside `[0, 1]`, a
     /// design smaller than `dim + 1`, no candidates, no polishing start, or a distance that
-    /// is negative or not finite, or a negative patience threshold.
+    /// is negative or not finite, a zero patience (stopping or restart) or a negative or
+    /// non-finite improvement threshold.
     pub fn validate(&self, dim: usize) -> Result<()> {
         let bad = |name: &'static str, value: String, message: &str| {
             Err(CorsError::InvalidOption {
@@ -243,6 +297,23 @@ impl CorsOptions {
         }
         if s.patience == Some(0) {
             return bad("stopping.patience", "0".into(), "must be positive");
+        }
+        if let Some(h) = self.local_region
+            && !(h.is_finite() && h > 0.0)
+        {
+            return bad("local_region", h.to_string(), "must be finite and positive");
+        }
+        if let Some(r) = &self.restart {
+            if r.patience == Some(0) {
+                return bad("restart.patience", "0".into(), "must be positive");
+            }
+            if !(r.min_improvement.is_finite() && r.min_improvement >= 0.0) {
+                return bad(
+                    "restart.min_improvement",
+                    r.min_improvement.to_string(),
+                    "must be finite and non-negative",
+                );
+            }
         }
         Ok(())
     }

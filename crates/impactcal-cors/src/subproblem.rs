@@ -24,7 +24,7 @@ use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
-use crate::geometry::{clip_unit, distance};
+use crate::geometry::distance;
 use crate::surrogate::Surrogate;
 
 /// Candidates per parallel task: small batches cost more in scheduling than they save.
@@ -70,6 +70,50 @@ impl Blockers {
     pub fn min_distance(&self, x: &[f64]) -> f64 {
         let (a, b) = self.min_distances(x);
         a.min(b)
+    }
+}
+
+/// The box a step searches: the unit box, or a sub-box of it around the best point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Region {
+    /// Lower corner.
+    pub lo: Vec<f64>,
+    /// Upper corner.
+    pub hi: Vec<f64>,
+}
+
+impl Region {
+    /// The unit box `[0, 1]^dim`.
+    pub fn unit(dim: usize) -> Self {
+        Region {
+            lo: vec![0.0; dim],
+            hi: vec![1.0; dim],
+        }
+    }
+
+    /// The box of half-width `half` around `centre`, cut to the unit box.
+    pub fn around(centre: &[f64], half: f64) -> Self {
+        Region {
+            lo: centre.iter().map(|c| (c - half).max(0.0)).collect(),
+            hi: centre.iter().map(|c| (c + half).min(1.0)).collect(),
+        }
+    }
+
+    /// Clamps `x` into the box.
+    pub fn clip(&self, x: &mut [f64]) {
+        for ((v, l), h) in x.iter_mut().zip(&self.lo).zip(&self.hi) {
+            *v = v.clamp(*l, *h);
+        }
+    }
+
+    /// Maps points of the unit box (row-major) affinely into the box.
+    fn map_unit(&self, pts: &mut [f64]) {
+        let dim = self.lo.len();
+        for p in pts.chunks_exact_mut(dim) {
+            for ((v, l), h) in p.iter_mut().zip(&self.lo).zip(&self.hi) {
+                *v = l + (h - l) * *v;
+            }
+        }
     }
 }
 
@@ -146,7 +190,7 @@ fn global_candidates(dim: usize, n: usize, rng: &mut impl Rng) -> Vec<f64> {
 
 /// Gaussian perturbations of `centre`, clipped to the box, with the standard deviation
 /// cycling through 0.1, 0.02, 0.004.
-fn local_candidates(centre: &[f64], n: usize, rng: &mut impl Rng) -> Vec<f64> {
+fn local_candidates(centre: &[f64], n: usize, region: &Region, rng: &mut impl Rng) -> Vec<f64> {
     const SIGMAS: [f64; 3] = [0.1, 0.02, 0.004];
     let mut out = Vec::with_capacity(n * centre.len());
     for k in 0..n {
@@ -158,21 +202,26 @@ fn local_candidates(centre: &[f64], n: usize, rng: &mut impl Rng) -> Vec<f64> {
                 c + sigma * z
             })
             .collect();
-        clip_unit(&mut x);
+        region.clip(&mut x);
         out.extend(x);
     }
     out
 }
 
 /// Maximises the distance to the nearest blocker from `x` by a compass search.
-fn refine_maximin(blockers: &Blockers, mut x: Vec<f64>, mut h: f64) -> (Vec<f64>, f64) {
+fn refine_maximin(
+    blockers: &Blockers,
+    region: &Region,
+    mut x: Vec<f64>,
+    mut h: f64,
+) -> (Vec<f64>, f64) {
     let mut best = blockers.min_distance(&x);
     while h > 1e-5 {
         let mut improved = false;
         for j in 0..x.len() {
             for sign in [1.0, -1.0] {
                 let mut y = x.clone();
-                y[j] = (y[j] + sign * h).clamp(0.0, 1.0);
+                y[j] = (y[j] + sign * h).clamp(region.lo[j], region.hi[j]);
                 let m = blockers.min_distance(&y);
                 if m > best {
                     best = m;
@@ -201,7 +250,7 @@ pub fn maximin(blockers: &Blockers, n: usize, rng: &mut impl Rng) -> (Vec<f64>, 
     let i = argmax(&dists);
     let start = cands[i * dim..(i + 1) * dim].to_vec();
     let h = 0.5 / (n.max(2) as f64).powf(1.0 / dim as f64);
-    refine_maximin(blockers, start, h)
+    refine_maximin(blockers, &Region::unit(dim), start, h)
 }
 
 fn argmax(v: &[f64]) -> usize {
@@ -221,12 +270,19 @@ pub fn cors_step(
     best: &[f64],
     blockers: &Blockers,
     settings: &StepSettings,
+    region: &Region,
     rng: &mut impl Rng,
 ) -> Choice {
     let dim = blockers.dim;
     let n_global = settings.candidates.max(1);
     let mut cands = global_candidates(dim, n_global, rng);
-    cands.extend(local_candidates(best, settings.local_candidates, rng));
+    region.map_unit(&mut cands);
+    cands.extend(local_candidates(
+        best,
+        settings.local_candidates,
+        region,
+        rng,
+    ));
     let screened: Vec<((f64, f64), f64)> = cands
         .par_chunks_exact(dim)
         .with_min_len(PAR_CHUNK)
@@ -239,7 +295,8 @@ pub fn cors_step(
         .collect();
     let i = argmax(&global_min);
     let h = 0.5 / (n_global.max(2) as f64).powf(1.0 / dim as f64);
-    let (maximin_x, delta) = refine_maximin(blockers, cands[i * dim..(i + 1) * dim].to_vec(), h);
+    let (maximin_x, delta) =
+        refine_maximin(blockers, region, cands[i * dim..(i + 1) * dim].to_vec(), h);
     let r = settings.beta * delta;
     let radii = Radii {
         ok: r.max(settings.floor),
@@ -263,7 +320,7 @@ pub fn cors_step(
     // A handful of short descents: cheaper in sequence than through the thread pool.
     let polished: Vec<(Vec<f64>, f64)> = starts
         .into_iter()
-        .map(|x0| polish(surrogate, blockers, radii, x0))
+        .map(|x0| polish(surrogate, blockers, region, radii, x0))
         .collect();
     let mut chosen: Option<(Vec<f64>, f64)> = None;
     for (x, f) in polished {
@@ -304,9 +361,9 @@ pub fn cors_step(
 }
 
 /// Moves `y` into the box and radially out of every ball it violates (a few passes).
-fn project(blockers: &Blockers, radii: Radii, y: &mut [f64]) {
+fn project(blockers: &Blockers, region: &Region, radii: Radii, y: &mut [f64]) {
     let dim = blockers.dim;
-    clip_unit(y);
+    region.clip(y);
     for _ in 0..4 {
         let mut moved = false;
         for (pts, r) in [(&blockers.ok, radii.ok), (&blockers.failed, radii.failed)] {
@@ -321,7 +378,7 @@ fn project(blockers: &Blockers, radii: Radii, y: &mut [f64]) {
                 }
             }
         }
-        clip_unit(y);
+        region.clip(y);
         if !moved {
             break;
         }
@@ -330,7 +387,13 @@ fn project(blockers: &Blockers, radii: Radii, y: &mut [f64]) {
 
 /// Projected-gradient descent of `s` from the feasible `x0`; returns the end point and its
 /// value. Every accepted iterate is feasible.
-fn polish(s: &Surrogate, blockers: &Blockers, radii: Radii, x0: Vec<f64>) -> (Vec<f64>, f64) {
+fn polish(
+    s: &Surrogate,
+    blockers: &Blockers,
+    region: &Region,
+    radii: Radii,
+    x0: Vec<f64>,
+) -> (Vec<f64>, f64) {
     const MAX_ITER: usize = 100;
     let dim = s.dim();
     let mut x = x0;
@@ -348,7 +411,7 @@ fn polish(s: &Surrogate, blockers: &Blockers, radii: Radii, x0: Vec<f64>) -> (Ve
             for ((yj, xj), gj) in y.iter_mut().zip(&x).zip(&grad) {
                 *yj = xj - step * gj / gnorm;
             }
-            project(blockers, radii, &mut y);
+            project(blockers, region, radii, &mut y);
             let descent: f64 = grad
                 .iter()
                 .zip(&x)

@@ -2,10 +2,10 @@
 //! copy of its coefficients.
 //!
 //! `s(x) = sum_i c_i phi(|x - x_i|) + a_0 + a^T x` in the unit box. The interpolant of
-//! `impactcal-erbf` solves the augmented system; its tail is affine, so `a_0` and `a` are
-//! recovered exactly (up to rounding) from `d + 1` predictions minus the kernel part. The
-//! copy evaluates value and gradient without allocation, which the candidate screening
-//! (thousands of points) and the local polish (hundreds of gradient steps) need.
+//! `impactcal-erbf` solves the augmented system and exposes its kernel weights, centres and
+//! tail coefficients in these coordinates. The copy evaluates value and gradient without
+//! allocation, which the candidate screening (thousands of points) and the local polish
+//! (hundreds of gradient steps) need.
 
 use faer::MatRef;
 use impactcal_erbf::{Kernel, RbfInterpolant, RbfOptions};
@@ -52,7 +52,8 @@ impl Surrogate {
     /// Copies the coefficients of a single-output interpolant with a linear tail.
     ///
     /// # Errors
-    /// Those of [`RbfInterpolant::predict`] (not expected for a fitted model).
+    /// [`impactcal_erbf::ErbfError::DimensionMismatch`] when the interpolant has no linear
+    /// tail or no output.
     pub fn from_interpolant(rbf: &RbfInterpolant) -> Result<Self> {
         let dim = rbf.dim();
         let n = rbf.n_samples();
@@ -62,27 +63,23 @@ impl Surrogate {
             centres.extend(pts.row(i).iter().copied());
         }
         let weights: Vec<f64> = rbf.kernel_weights().col(0).iter().copied().collect();
-        let mut s = Surrogate {
+        let tail = rbf.tail_coefficients();
+        if tail.nrows() != dim + 1 || tail.ncols() == 0 {
+            return Err(impactcal_erbf::ErbfError::DimensionMismatch {
+                what: "surrogate tail: linear terms".into(),
+                expected: dim + 1,
+                found: tail.nrows(),
+            }
+            .into());
+        }
+        Ok(Surrogate {
             kernel: rbf.options().kernel,
             dim,
             centres,
             weights,
-            a0: 0.0,
-            a: vec![0.0; dim],
-        };
-        // The tail is s(x) minus the kernel part, and it is affine: read it at the origin
-        // and the unit vectors.
-        let mut x = vec![0.0; dim];
-        let a0 = rbf.predict(&x)?[0] - s.kernel_part(&x);
-        let mut a = vec![0.0; dim];
-        for j in 0..dim {
-            x[j] = 1.0;
-            a[j] = rbf.predict(&x)?[0] - s.kernel_part(&x) - a0;
-            x[j] = 0.0;
-        }
-        s.a0 = a0;
-        s.a = a;
-        Ok(s)
+            a0: tail[(0, 0)],
+            a: (0..dim).map(|j| tail[(1 + j, 0)]).collect(),
+        })
     }
 
     /// Dimension `d`.

@@ -6,8 +6,8 @@
 use impactcal_core::{Parameter, ParameterSpace};
 use impactcal_cors::design::{affine_rank, symmetric_design};
 use impactcal_cors::{
-    Cors, CorsError, CorsOptions, InitialDesign, Mode, Origin, StopReason, Stopping, Transform,
-    test_functions,
+    Cors, CorsError, CorsOptions, InitialDesign, Mode, Origin, Restart, StopReason, Stopping,
+    Transform, test_functions,
 };
 
 fn unit_distance(space: &ParameterSpace, a: &[f64], b: &[f64]) -> f64 {
@@ -89,6 +89,91 @@ fn cors_points_respect_the_distance_constraint_and_cycle() {
 }
 
 #[test]
+fn every_second_cycle_searches_the_box_around_the_best() {
+    let f = test_functions::by_name("hartmann3").unwrap();
+    let space = f.space().unwrap();
+    let mut study = Cors::new(space.clone(), CorsOptions::with_seed(3)).unwrap();
+    let mut outside = [0usize; 3];
+    for n in 0..26 {
+        let s = study.suggest(1).unwrap().pop().unwrap();
+        if s.origin == Origin::Cors {
+            let best = space.to_unit(&study.best().unwrap().x).unwrap();
+            let u = space.to_unit(&s.x).unwrap();
+            let far = u
+                .iter()
+                .zip(&best)
+                .any(|(a, b)| (a - b).abs() > 0.3 + 1e-12);
+            if far {
+                outside[(n - 8) / 6] += 1;
+            }
+        }
+        study.tell(s.id, f.eval(&s.x)).unwrap();
+    }
+    // Cycle 1 stays within 0.3 of the best point in every coordinate; the whole-box cycles
+    // 0 and 2 leave that box (their first steps explore far away).
+    assert_eq!(outside[1], 0);
+    assert!(outside[0] > 0 && outside[2] > 0, "{outside:?}");
+}
+
+#[test]
+fn restarts_start_a_new_design_and_keep_the_history() {
+    let f = test_functions::by_name("shekel5").unwrap();
+    let options = CorsOptions {
+        restart: Some(Restart {
+            patience: Some(6),
+            min_improvement: 1e-3,
+        }),
+        ..CorsOptions::with_seed(4)
+    };
+    let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
+    whole.minimize(|x| f.eval(x), 70).unwrap();
+    assert_eq!(whole.evaluations().len(), 70);
+    assert!(whole.restarts() >= 1);
+    let start = whole.run_start();
+    assert!(start >= 16);
+    // The new run opens with its own design of 2 (d + 1) points.
+    assert!(
+        whole.evaluations()[start..(start + 10).min(70)]
+            .iter()
+            .all(|e| e.origin == Origin::Design)
+    );
+    let first_design: Vec<&Vec<f64>> = whole.evaluations()[..10].iter().map(|e| &e.x).collect();
+    assert!(!first_design.contains(&&whole.evaluations()[start].x));
+    // The best over every run is the study's best.
+    let best = whole
+        .evaluations()
+        .iter()
+        .filter_map(|e| e.value)
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(whole.best().unwrap().value, Some(best));
+
+    // Resume through JSON and rebuild from the history: the same sequence, restarts included.
+    let mut first = Cors::new(f.space().unwrap(), options.clone()).unwrap();
+    first.minimize(|x| f.eval(x), start + 3).unwrap();
+    let mut resumed = Cors::from_json(&first.to_json().unwrap(), "state").unwrap();
+    resumed.minimize(|x| f.eval(x), 70 - start - 3).unwrap();
+    assert_eq!(resumed.evaluations(), whole.evaluations());
+    let xs: Vec<Vec<f64>> = whole.evaluations().iter().map(|e| e.x.clone()).collect();
+    let fs: Vec<f64> = whole
+        .evaluations()
+        .iter()
+        .map(|e| e.value.unwrap())
+        .collect();
+    for n in [start - 1, start, start + 4, start + 12, 69] {
+        let mut rebuilt = Cors::from_history(
+            f.space().unwrap(),
+            options.clone(),
+            &xs[..n],
+            &fs[..n],
+            None,
+        )
+        .unwrap();
+        let next = rebuilt.suggest(1).unwrap().pop().unwrap();
+        assert_eq!(next.x, xs[n], "after {n} rows");
+    }
+}
+
+#[test]
 fn warm_start_replaces_the_design_and_improves() {
     // The source study: 50 existing runs, then 60 more.
     let f = test_functions::by_name("hartmann6").unwrap();
@@ -104,7 +189,12 @@ fn warm_start_replaces_the_design_and_improves() {
     .to_rows();
     let values: Vec<f64> = existing.iter().map(|x| f.eval(x)).collect();
     let best_existing = values.iter().copied().fold(f64::INFINITY, f64::min);
-    let mut study = Cors::new(space, CorsOptions::with_seed(2)).unwrap();
+    // The source study's method: the 2005 pattern over the whole box in every cycle.
+    let options = CorsOptions {
+        local_region: None,
+        ..CorsOptions::with_seed(2)
+    };
+    let mut study = Cors::new(space, options).unwrap();
     study.warm_start(&existing, &values).unwrap();
     let out = study.minimize(|x| f.eval(x), 60).unwrap();
     assert_eq!(study.mode(), Some(Mode::Existing));
@@ -394,6 +484,24 @@ fn options_are_validated() {
         },
         CorsOptions {
             polish_starts: 0,
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            local_region: Some(0.0),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            restart: Some(Restart {
+                patience: Some(0),
+                ..Restart::default()
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            restart: Some(Restart {
+                min_improvement: f64::NAN,
+                ..Restart::default()
+            }),
             ..CorsOptions::default()
         },
     ];

@@ -372,9 +372,48 @@ impl RbfInterpolant {
         self.values.as_ref()
     }
 
-    /// The kernel weights `c`, `N x T`.
+    /// The kernel weights `c`, `N x T` (row `i` belongs to row `i` of
+    /// [`points`](Self::points)); with [`tail_coefficients`](Self::tail_coefficients) they
+    /// give the interpolant explicitly.
     pub fn kernel_weights(&self) -> MatRef<'_, f64> {
         self.coef.as_ref().subrows(0, self.n_samples())
+    }
+
+    /// The coefficients of the polynomial tail in the original coordinates, a `q x T`
+    /// matrix: row 0 is the constant term and, for a linear tail, row `1 + j` the
+    /// coefficient of `x_j`, so that
+    ///
+    /// ```text
+    /// s_t(x) = sum_i W_it phi(|x - x_i|) + A_0t + sum_j A_(1+j)t x_j
+    /// ```
+    ///
+    /// with `W` the [`kernel_weights`](Self::kernel_weights) and `x_i` the rows of
+    /// [`points`](Self::points). `q` is 0 without a tail, 1 for a constant one, `d + 1` for
+    /// a linear one. (Internally the tail is solved in centred, scaled and weighted
+    /// coordinates; this converts it back.)
+    pub fn tail_coefficients(&self) -> Mat<f64> {
+        let n_pts = self.n_samples();
+        let d = self.dim();
+        let t = self.n_outputs();
+        let q = self.options.degree.terms(d);
+        let w = self.tail_weight;
+        let mut a = Mat::<f64>::zeros(q, t);
+        for c in 0..t {
+            match self.options.degree {
+                PolyDegree::None => {}
+                PolyDegree::Constant => a[(0, c)] = w * self.coef[(n_pts, c)],
+                PolyDegree::Linear => {
+                    let mut constant = w * self.coef[(n_pts, c)];
+                    for j in 0..d {
+                        let b = w * self.coef[(n_pts + 1 + j, c)] / self.scale;
+                        a[(1 + j, c)] = b;
+                        constant -= b * self.shift[j];
+                    }
+                    a[(0, c)] = constant;
+                }
+            }
+        }
+        a
     }
 
     /// Smallest over largest pivot magnitude of the LU factorisation: a cheap indicator of

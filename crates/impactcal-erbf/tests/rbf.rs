@@ -71,6 +71,52 @@ fn linear_tail_reproduces_affine_functions() {
     }
 }
 
+#[test]
+fn explicit_coefficients_give_the_interpolant() {
+    // An affine function: the tail is the function itself, in the original coordinates.
+    let x = Mat::from_fn(30, 2, |i, j| 10.0 * random_points(30, 2, 7)[(i, j)] - 3.0);
+    let affine = |p: &[f64]| 1.5 - 2.0 * p[0] + 0.5 * p[1];
+    let f = eval(x.as_ref(), affine);
+    let s = RbfInterpolant::fit(x.as_ref(), f.as_ref(), RbfOptions::cubic()).unwrap();
+    let a = s.tail_coefficients();
+    assert_eq!((a.nrows(), a.ncols()), (3, 1));
+    assert_relative_eq!(a[(0, 0)], 1.5, epsilon = 1e-8);
+    assert_relative_eq!(a[(1, 0)], -2.0, epsilon = 1e-8);
+    assert_relative_eq!(a[(2, 0)], 0.5, epsilon = 1e-8);
+    // Any data, every tail: weights, centres and tail reproduce the predictions.
+    let x = random_points(35, 3, 8);
+    let f = Mat::from_fn(35, 2, |i, c| {
+        let p: Vec<f64> = x.row(i).iter().copied().collect();
+        smooth(&p) * (1.0 + c as f64)
+    });
+    for opts in all_options() {
+        let s = RbfInterpolant::fit(x.as_ref(), f.as_ref(), opts).unwrap();
+        let a = s.tail_coefficients();
+        assert_eq!(a.nrows(), opts.degree.terms(3));
+        let q = random_points(20, 3, 9);
+        let p = s.predict_batch(q.as_ref()).unwrap();
+        for i in 0..20 {
+            for c in 0..2 {
+                let mut v = 0.0;
+                for k in 0..35 {
+                    let r = (0..3)
+                        .map(|j| (q[(i, j)] - x[(k, j)]).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    v += s.kernel_weights()[(k, c)] * opts.kernel.value(r);
+                }
+                if a.nrows() > 0 {
+                    v += a[(0, c)];
+                }
+                for j in 0..a.nrows().saturating_sub(1) {
+                    v += a[(1 + j, c)] * q[(i, j)];
+                }
+                assert_relative_eq!(v, p[(i, c)], epsilon = 1e-9, max_relative = 1e-9);
+            }
+        }
+    }
+}
+
 /// Natural cubic spline through (t_k, y_k), evaluated at `x`: the independent truth for a
 /// 1-D cubic RBF with a linear tail, which is that spline.
 fn natural_spline(t: &[f64], y: &[f64], x: f64) -> f64 {
