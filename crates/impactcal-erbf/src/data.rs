@@ -181,6 +181,18 @@ pub(crate) fn reject_duplicates(points: MatRef<'_, f64>, tol: f64) -> Result<()>
 }
 
 /// A copy of `m` without row `k`.
+/// Stacks per-sample rows of `t` values (as computed in parallel, each possibly failed) into
+/// an `n x t` matrix, returning the error of the lowest sample that failed.
+pub(crate) fn collect_rows(rows: Vec<Result<Vec<f64>>>, t: usize) -> Result<Mat<f64>> {
+    let mut e = Mat::<f64>::zeros(rows.len(), t);
+    for (k, row) in rows.into_iter().enumerate() {
+        for (c, v) in row?.into_iter().enumerate() {
+            e[(k, c)] = v;
+        }
+    }
+    Ok(e)
+}
+
 pub(crate) fn without_row(m: MatRef<'_, f64>, k: usize) -> Mat<f64> {
     Mat::from_fn(m.nrows() - 1, m.ncols(), |i, j| {
         m[(if i < k { i } else { i + 1 }, j)]

@@ -34,7 +34,9 @@ use impactcal_core::ParameterSpace;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::data::{StoredMat, check_queries, check_training, reject_duplicates, without_row};
+use crate::data::{
+    StoredMat, check_queries, check_training, collect_rows, reject_duplicates, without_row,
+};
 use crate::error::{ErbfError, Result};
 use crate::loo::LooMethod;
 use crate::nrbf::{LeftRight, dphi_l, dphi_r};
@@ -441,13 +443,7 @@ impl Erbf {
                     .collect())
             })
             .collect();
-        let mut e = Mat::<f64>::zeros(n, t);
-        for (k, row) in rows.into_iter().enumerate() {
-            for (c, v) in row?.into_iter().enumerate() {
-                e[(k, c)] = v;
-            }
-        }
-        Ok(e)
+        collect_rows(rows, t)
     }
 
     /// `max_k |f(x_k) - F_k| / max |F|` over all outputs: the reproduction error of the

@@ -28,8 +28,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::data::{
-    StoredMat, check_queries, check_training, find_duplicate, mat_from_rows, stack_rows,
-    without_row,
+    StoredMat, check_queries, check_training, collect_rows, find_duplicate, mat_from_rows,
+    stack_rows, without_row,
 };
 use crate::error::{ErbfError, Result};
 use crate::kernel::{Kernel, PolyDegree};
@@ -582,13 +582,7 @@ impl RbfInterpolant {
                         Ok((0..t).map(|c| self.values[(k, c)] - p[c]).collect())
                     })
                     .collect();
-                let mut e = Mat::<f64>::zeros(n_pts, t);
-                for (k, row) in rows.into_iter().enumerate() {
-                    for (c, v) in row?.into_iter().enumerate() {
-                        e[(k, c)] = v;
-                    }
-                }
-                Ok(e)
+                collect_rows(rows, t)
             }
         }
     }
