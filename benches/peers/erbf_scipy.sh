@@ -11,8 +11,8 @@ REPS="${1:-5}"
 VENV=benches/peers/.venv
 if [ ! -x "$VENV/bin/python" ]; then
     python3 -m venv "$VENV"
-    "$VENV/bin/pip" install --quiet numpy scipy
 fi
+"$VENV/bin/pip" install --quiet numpy scipy
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-target}"

@@ -40,7 +40,8 @@ def ensure_venv() -> None:
         return
     if not python.exists():
         venv.create(VENV, with_pip=True)
-        subprocess.run([str(python), "-m", "pip", "install", "-q", "SALib==1.6.0", "scipy", "numpy"], check=True)
+    # The venv is shared by all peer scripts: install SALib even when it already exists.
+    subprocess.run([str(python), "-m", "pip", "install", "-q", "SALib==1.6.0", "scipy", "numpy"], check=True)
     sys.exit(subprocess.run([str(python), __file__, *sys.argv[1:]]).returncode)
 
 
