@@ -5,35 +5,11 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use faer::Mat;
-use impactcal::core::{Parameter, ParameterSpace};
-use impactcal::erbf::testfns::latin_hypercube;
 use impactcal::erbf::{Erbf, ErbfOptions, RbfInterpolant, RbfOptions};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
-const N: usize = 150;
-const M: usize = 10;
-const T: usize = 10_000;
-
-fn data() -> (ParameterSpace, Mat<f64>, Mat<f64>, Mat<f64>) {
-    let space = ParameterSpace::new(
-        (0..M)
-            .map(|j| Parameter::new(format!("p{j}"), 0.0, 1.0, 0.5).unwrap())
-            .collect(),
-    )
-    .unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(42);
-    let x = latin_hypercube(N, M, &mut rng);
-    let f = Mat::from_fn(N, T, |i, t| {
-        let s: f64 = (0..M)
-            .map(|j| (3.0 * x[(i, j)] + 1e-3 * (t * (j + 1)) as f64).sin())
-            .sum();
-        s * (-2e-4 * t as f64).exp()
-    });
-    let q = Mat::from_fn(1000, M, |_, _| rng.random::<f64>());
-    (space, x, f, q)
-}
+#[path = "common/surrogate_data.rs"]
+mod surrogate_data;
+use surrogate_data::surrogate_data as data;
 
 fn bench(c: &mut Criterion) {
     let (space, x, f, q) = data();

@@ -10,17 +10,13 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-use faer::{Mat, MatRef};
-use impactcal::core::{Parameter, ParameterSpace};
-use impactcal::erbf::testfns::latin_hypercube;
+use faer::MatRef;
 use impactcal::erbf::{Erbf, ErbfOptions, Kernel, RbfInterpolant, RbfOptions};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
-const N: usize = 150;
-const M: usize = 10;
-const T: usize = 10_000;
-const Q: usize = 1000;
+#[path = "../benches/common/surrogate_data.rs"]
+mod surrogate_data;
+use surrogate_data::{M, T, surrogate_data};
+
 /// Output columns written for the agreement check.
 const CHECK: usize = 8;
 
@@ -57,21 +53,7 @@ fn main() {
     let reps: usize = std::env::args().nth(2).map_or(5, |s| s.parse().unwrap());
     let dir = Path::new(&dir);
     std::fs::create_dir_all(dir).unwrap();
-    let space = ParameterSpace::new(
-        (0..M)
-            .map(|j| Parameter::new(format!("p{j}"), 0.0, 1.0, 0.5).unwrap())
-            .collect(),
-    )
-    .unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(42);
-    let x = latin_hypercube(N, M, &mut rng);
-    let f = Mat::from_fn(N, T, |i, t| {
-        let s: f64 = (0..M)
-            .map(|j| (3.0 * x[(i, j)] + 1e-3 * (t * (j + 1)) as f64).sin())
-            .sum();
-        s * (-2e-4 * t as f64).exp()
-    });
-    let q = Mat::from_fn(Q, M, |_, _| rng.random::<f64>());
+    let (space, x, f, q) = surrogate_data();
     write_bin(&dir.join("points.bin"), x.as_ref(), M);
     write_bin(&dir.join("values.bin"), f.as_ref(), T);
     write_bin(&dir.join("queries.bin"), q.as_ref(), M);
