@@ -104,6 +104,16 @@ impl Fields<'_, '_> {
         self.f.get(i).copied().filter(|s| !s.is_empty())
     }
 
+    /// Three consecutive real fields from `first` (a vector such as VX, VY, VZ), each
+    /// defaulting to 0.
+    fn real3(&self, first: usize, names: [&str; 3]) -> Result<[f64; 3]> {
+        Ok([
+            self.real(first, names[0], 0.0)?,
+            self.real(first + 1, names[1], 0.0)?,
+            self.real(first + 2, names[2], 0.0)?,
+        ])
+    }
+
     fn real(&self, i: usize, name: &str, default: f64) -> Result<f64> {
         match self.raw(i) {
             None => Ok(default),
@@ -249,11 +259,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                 for c in &cards {
                     let f = card(c, &[8, 16, 16, 16, 8, 8]);
                     let id = f.id(0, "NID")?;
-                    let x = [
-                        f.real(1, "X", 0.0)?,
-                        f.real(2, "Y", 0.0)?,
-                        f.real(3, "Z", 0.0)?,
-                    ];
+                    let x = f.real3(1, ["X", "Y", "Z"])?;
                     if f.int(4, "TC", 0)? != 0 || f.int(5, "RC", 0)? != 0 {
                         return Err(ctx.err(
                             c.line,
@@ -440,17 +446,9 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     } else {
                         VelocityTarget::NodeSet(nsid)
                     },
-                    [
-                        g.real(0, "VX", 0.0)?,
-                        g.real(1, "VY", 0.0)?,
-                        g.real(2, "VZ", 0.0)?,
-                    ],
+                    g.real3(0, ["VX", "VY", "VZ"])?,
                 );
-                iv.rotation = [
-                    g.real(3, "VXR", 0.0)?,
-                    g.real(4, "VYR", 0.0)?,
-                    g.real(5, "VZR", 0.0)?,
-                ];
+                iv.rotation = g.real3(3, ["VXR", "VYR", "VZR"])?;
                 model.initial_velocities.push(iv);
             }
             "*INITIAL_VELOCITY_GENERATION" => {
@@ -473,25 +471,11 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     f.must_be_zero(6, "IVATN")?;
                     f.must_be_zero(7, "ICID")?;
                     let g = card(&pair[1], W10);
-                    let mut iv = InitialVelocity::translation(
-                        target,
-                        [
-                            f.real(3, "VX", 0.0)?,
-                            f.real(4, "VY", 0.0)?,
-                            f.real(5, "VZ", 0.0)?,
-                        ],
-                    );
+                    let mut iv =
+                        InitialVelocity::translation(target, f.real3(3, ["VX", "VY", "VZ"])?);
                     iv.omega = f.real(2, "OMEGA", 0.0)?;
-                    iv.centre = [
-                        g.real(0, "XC", 0.0)?,
-                        g.real(1, "YC", 0.0)?,
-                        g.real(2, "ZC", 0.0)?,
-                    ];
-                    iv.axis = [
-                        g.real(3, "NX", 0.0)?,
-                        g.real(4, "NY", 0.0)?,
-                        g.real(5, "NZ", 0.0)?,
-                    ];
+                    iv.centre = g.real3(0, ["XC", "YC", "ZC"])?;
+                    iv.axis = g.real3(3, ["NX", "NY", "NZ"])?;
                     model.initial_velocities.push(iv);
                 }
             }
@@ -500,17 +484,9 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     let f = card(c, W10);
                     let mut iv = InitialVelocity::translation(
                         VelocityTarget::Node(f.id(0, "NID")?),
-                        [
-                            f.real(1, "VX", 0.0)?,
-                            f.real(2, "VY", 0.0)?,
-                            f.real(3, "VZ", 0.0)?,
-                        ],
+                        f.real3(1, ["VX", "VY", "VZ"])?,
                     );
-                    iv.rotation = [
-                        f.real(4, "VXR", 0.0)?,
-                        f.real(5, "VYR", 0.0)?,
-                        f.real(6, "VZR", 0.0)?,
-                    ];
+                    iv.rotation = f.real3(4, ["VXR", "VYR", "VZR"])?;
                     model.initial_velocities.push(iv);
                 }
             }
@@ -561,16 +537,8 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                         ));
                     }
                     let g = card(&pair[1], W10);
-                    let point = [
-                        g.real(0, "XT", 0.0)?,
-                        g.real(1, "YT", 0.0)?,
-                        g.real(2, "ZT", 0.0)?,
-                    ];
-                    let head = [
-                        g.real(3, "XH", 0.0)?,
-                        g.real(4, "YH", 0.0)?,
-                        g.real(5, "ZH", 0.0)?,
-                    ];
+                    let point = g.real3(0, ["XT", "YT", "ZT"])?;
+                    let head = g.real3(3, ["XH", "YH", "ZH"])?;
                     let fric = g.real(6, "FRIC", 0.0)?;
                     let friction = if fric == 1.0 {
                         f64::INFINITY
