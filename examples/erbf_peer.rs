@@ -17,6 +17,10 @@ use impactcal::erbf::{Erbf, ErbfOptions, Kernel, RbfInterpolant, RbfOptions};
 mod surrogate_data;
 use surrogate_data::{M, T, surrogate_data};
 
+/// Untimed calls before the timed ones, so that both sides are measured warm (allocator
+/// and page mappings settled).
+const WARM_UP: usize = 2;
+
 /// Output columns written for the agreement check.
 const CHECK: usize = 8;
 
@@ -34,13 +38,20 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// Median time of `reps` calls after `WARM_UP` untimed ones (the same on the scipy side).
 fn time<R>(reps: usize, mut f: impl FnMut() -> R) -> (f64, R) {
     let mut times = Vec::new();
+    for _ in 0..WARM_UP {
+        std::hint::black_box(f());
+    }
     let mut last = None;
     for _ in 0..reps {
         let t0 = Instant::now();
         let r = f();
         times.push(t0.elapsed().as_secs_f64());
+        if std::env::var_os("ERBF_PEER_VERBOSE").is_some() {
+            eprintln!("{:.4}", times[times.len() - 1]);
+        }
         last = Some(r);
     }
     (median(times), last.unwrap())

@@ -33,7 +33,9 @@ for line in open(f"{work}/ours.txt"):
     _, name, value = line.split()
     ours[name] = float(value)
 
-def timed(fn):
+def timed(fn, warm_up=2):
+    for _ in range(warm_up):
+        fn()
     ts, out = [], None
     for _ in range(reps):
         t0 = time.perf_counter()
@@ -53,7 +55,7 @@ def agreement(name, theirs):
     return np.max(np.abs(mine - ref)) / np.max(np.abs(ref))
 
 print(f"scipy {scipy.__version__}, numpy {np.__version__}; N={N}, n_p={M}, T={T}, {Q} queries, "
-      f"median of {reps}")
+      f"median of {reps} after 2 warm-up calls")
 print(f"{'case':<34} {'ours [s]':>10} {'scipy [s]':>10} {'scipy/ours':>10}")
 rows = [
     ("ERBF fit + 1000 predict vs scipy Gaussian", ours["erbf_fit"] + ours["erbf_predict_1000"], fit_g + pred_g),

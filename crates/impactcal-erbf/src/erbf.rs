@@ -19,11 +19,16 @@
 //! The system is under-determined; the fit takes its minimum-norm solution
 //! `c = A^T (A A^T)^{-1} F` without forming `A A^T`: a Householder QR factorisation
 //! `A^T = Q_1 R` (`Q_1` is `M x N` with orthonormal columns, `R` is `N x N` upper
-//! triangular) gives `c = Q_1 Z` with `R^T Z = F`. One factorisation serves all `T`
-//! columns, and the solution is linear in `F`. A prediction is
-//! `f(x) = (Q_1^T b(x))^T Z`, costing `O(M N + N T)` per point, which for time histories
-//! (`T >> N`) is far below the `O(M T)` of `b(x)^T c`; when `T <= N` the model stores `c`
-//! and uses the cheaper direct product.
+//! triangular; computed by a two-block TSQR) gives `c = Q_1 Z` with `R^T Z = F`. One
+//! factorisation serves all `T` columns, and the solution is linear in `F`.
+//!
+//! A prediction is `f(x) = (Q_1^T b(x))^T Z = (R^{-1} Q_1^T b(x))^T F`. For time histories
+//! (`T >> N`) the model keeps `Q_1`, `R` and `F` and never forms `c` (`M x T`) or `Z`: per
+//! query it computes `w = Q_1^T b(x)` from prefix sums of the rows of `Q_1` tabulated at
+//! fit time, which the piecewise-linear N-RBFs allow (about `N^2 + 2 gamma m N^2` operations instead of the `M N` of the
+//! direct product), solves `R v = w` (`N^2 / 2`), and takes `v^T F` (`N T`). The fit costs
+//! one QR of `A^T` and no work proportional to `T` beyond copying `F`. When `T` is so
+//! small that `b(x)^T c` is cheaper, the model stores `c` instead.
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
@@ -34,13 +39,16 @@ use impactcal_core::ParameterSpace;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::buffer;
 use crate::data::{
     StoredMat, check_queries, check_training, collect_rows, reject_duplicates, without_row,
 };
 use crate::error::{ErbfError, Result};
 use crate::loo::LooMethod;
 use crate::nrbf::{LeftRight, dphi_l, dphi_r};
+use crate::projection::Projection;
 use crate::rbf::{condition_number, relative_max_error};
+use crate::thin_qr::{ThinQr, thin_qr};
 
 /// Multipliers of the three basis families. The minimum-norm solution is not invariant
 /// to them (rescaling a family changes how much of the data it carries), so they are an
@@ -162,9 +170,13 @@ pub struct Erbf {
     mean: Vec<f64>,
     lower: Vec<f64>,
     width: Vec<f64>,
-    q1: Mat<f64>,
+    /// `Q_1^T` and the tables that evaluate `Q_1^T b(x)` quickly.
+    projection: Projection,
     r: Mat<f64>,
-    z: Mat<f64>,
+    /// The responses less their column means, kept only when outputs are centred.
+    centred: Option<Mat<f64>>,
+    /// `c = Q_1 Z` (`M x T`), kept when `T` is so small that `b(x)^T c` is the cheaper
+    /// prediction (see [`direct_is_cheaper`]).
     coef: Option<Mat<f64>>,
     r_ratio: f64,
 }
@@ -173,7 +185,9 @@ impl Erbf {
     /// Fits the model to samples `points` (`N x m`, raw parameter values, one sample per
     /// row, columns in the order of `space`) and responses `values` (`N x T`).
     ///
-    /// Cost: `O(N^2 m)` to build `A`, `O(M N^2)` to factorise, `O(N^2 T)` to solve.
+    /// Cost: `O(N^2 m)` to build `A`, `O(M N^2)` to factorise, `O(m N^2)` for the
+    /// prediction tables, and a copy of `values`; `O(N^2 T)` more only when `T` is small
+    /// enough that the coefficients `c` are stored.
     ///
     /// # Errors
     /// - [`ErbfError::InvalidOption`] for invalid options;
@@ -206,24 +220,32 @@ impl Erbf {
         } else {
             vec![0.0; t]
         };
-        let f = Mat::from_fn(values.nrows(), t, |i, c| values[(i, c)] - mean[c]);
-        let factor = Factor::new(unit.as_ref(), &options)?;
-        let mut z = f;
-        solve_lower_triangular_in_place(factor.r.transpose(), z.as_mut(), par());
-        let n = unit.nrows();
-        let coef = (t <= n).then(|| &factor.q1 * &z);
+        let centred = options.center_outputs.then(|| {
+            let mut f = buffer::copy(values);
+            for (col, &m) in f.col_iter_mut().zip(&mean) {
+                col.iter_mut().for_each(|v| *v -= m);
+            }
+            f
+        });
+        let factor = Factor::new(unit.as_ref(), &options, true)?;
+        let coef = direct_is_cheaper(unit.nrows(), unit.ncols(), t, options.gamma).then(|| {
+            let mut z = centred.as_ref().map_or(values, |f| f.as_ref()).to_owned();
+            solve_lower_triangular_in_place(factor.r.transpose(), z.as_mut(), par());
+            &factor.q1 * &z
+        });
+        let projection = Projection::new(factor.q1, unit.as_ref(), &options);
         Ok(Erbf {
             space: space.clone(),
             options,
             points: points.to_owned(),
             unit,
-            values: values.to_owned(),
+            values: buffer::copy(values),
             mean,
             lower,
             width,
-            q1: factor.q1,
+            projection,
             r: factor.r,
-            z,
+            centred,
             coef,
             r_ratio: factor.ratio,
         })
@@ -292,13 +314,27 @@ impl Erbf {
             .to_owned()
     }
 
-    /// The coefficients `c = Q_1 Z` (`M x T`), formed on demand (`O(M N T)` time and
-    /// `M T` memory; large for long histories).
+    /// The coefficients `c = Q_1 Z` (`M x T`) with `R^T Z = F`, formed on demand
+    /// (`O(M N T)` time and `M T` memory; large for long histories).
     pub fn coefficients(&self) -> Mat<f64> {
         match &self.coef {
             Some(c) => c.clone(),
-            None => &self.q1 * &self.z,
+            None => self.projection.q1() * self.z(),
         }
+    }
+
+    /// `Z = R^{-T} F` (`N x T`), formed on demand.
+    fn z(&self) -> Mat<f64> {
+        let mut z = self.responses().to_owned();
+        solve_lower_triangular_in_place(self.r.transpose(), z.as_mut(), par());
+        z
+    }
+
+    /// The responses the model interpolates: `F`, less the column means when centred.
+    fn responses(&self) -> MatRef<'_, f64> {
+        self.centred
+            .as_ref()
+            .map_or(self.values.as_ref(), |f| f.as_ref())
     }
 
     /// `min |R_ii| / max |R_ii|` of the factorisation `A^T = Q_1 R`: a cheap conditioning
@@ -331,8 +367,13 @@ impl Erbf {
         Ok(out.row(0).iter().copied().collect())
     }
 
-    /// Predictions at the rows of `points` (`Q x m`, raw): a `Q x T` matrix. Basis vectors
-    /// are built in parallel and the products run in blocks of queries; the result does not
+    /// Predictions at the rows of `points` (`Q x m`, raw): a `Q x T` matrix.
+    ///
+    /// The queries are processed in fixed chunks of 64, in parallel: for each chunk the
+    /// projected basis `W = Q_1^T B` (`N x 64`) is evaluated from the fit's tables and
+    /// `V = R^{-1} W` solved; one product `V^T F` then gives all `T` outputs. Cost about
+    /// `Q (N^2 (1 + 2 gamma m) + N T)`; memory `Q N` besides the result. When the model
+    /// stores `c` (few outputs) each chunk multiplies `B^T c` directly. The result does not
     /// depend on the number of threads.
     ///
     /// # Errors
@@ -340,17 +381,52 @@ impl Erbf {
     pub fn predict_batch(&self, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
         check_queries(points, self.dim())?;
         let q = points.nrows();
-        let mut out = Mat::<f64>::zeros(q, self.n_outputs());
-        let mut start = 0;
-        while start < q {
-            let len = BLOCK.min(q - start);
-            let block = points.subrows(start, len);
-            let unit = Mat::from_fn(len, self.dim(), |i, j| {
-                (block[(i, j)] - self.lower[j]) / self.width[j]
-            });
-            let bt = basis_matrix_t(unit.as_ref(), self.unit.as_ref(), &self.options);
-            self.apply(bt.as_ref(), out.as_mut().subrows_mut(start, len));
-            start += len;
+        let m = self.dim();
+        let unit: Vec<f64> = (0..q)
+            .flat_map(|i| (0..m).map(move |j| (points[(i, j)] - self.lower[j]) / self.width[j]))
+            .collect();
+        let mut out = buffer::zeros(q, self.n_outputs());
+        match &self.coef {
+            Some(c) => {
+                let centres = row_major(self.unit.as_ref());
+                out.par_row_chunks_mut(CHUNK)
+                    .enumerate()
+                    .for_each(|(k, mut rows)| {
+                        let len = rows.nrows();
+                        let u = &unit[k * CHUNK * m..(k * CHUNK + len) * m];
+                        let mut bt = Mat::<f64>::zeros(self.n_basis(), len);
+                        fill_basis(u, &centres, m, &self.options, bt.as_mut());
+                        matmul(
+                            rows.as_mut(),
+                            Accum::Replace,
+                            bt.transpose(),
+                            c.as_ref(),
+                            1.0,
+                            Par::Seq,
+                        );
+                    });
+            }
+            None => {
+                // V = R^{-1} Q_1^T B chunk by chunk, then out = V^T F: the same as
+                // B^T Q_1 Z with Z = R^{-T} F, without forming Z (N x T).
+                let mut v = Mat::<f64>::zeros(self.n_samples(), q);
+                v.par_col_chunks_mut(CHUNK)
+                    .enumerate()
+                    .for_each(|(k, mut cols)| {
+                        let len = cols.ncols();
+                        let u = &unit[k * CHUNK * m..(k * CHUNK + len) * m];
+                        self.projection.project(u, cols.as_mut());
+                        solve_upper_triangular_in_place(self.r.as_ref(), cols, Par::Seq);
+                    });
+                matmul(
+                    out.as_mut(),
+                    Accum::Replace,
+                    v.transpose(),
+                    self.responses(),
+                    1.0,
+                    par(),
+                );
+            }
         }
         for c in 0..self.n_outputs() {
             let m = self.mean[c];
@@ -410,12 +486,12 @@ impl Erbf {
             LooMethod::Closed => false,
             LooMethod::Auto => n <= 200,
         };
-        let f = Mat::from_fn(n, t, |i, c| self.values[(i, c)] - self.mean[c]);
+        let f = self.responses();
         if !exact {
             // alpha = G^{-1} F = R^{-1} Z; (G^{-1})_kk = |row k of R^{-1}|^2.
             let mut rinv = Mat::<f64>::identity(n, n);
             solve_upper_triangular_in_place(self.r.as_ref(), rinv.as_mut(), par());
-            let mut alpha = self.z.clone();
+            let mut alpha = self.z();
             solve_upper_triangular_in_place(self.r.as_ref(), alpha.as_mut(), par());
             return Ok(Mat::from_fn(n, t, |k, c| {
                 let h: f64 = rinv.row(k).iter().map(|v| v * v).sum();
@@ -427,7 +503,7 @@ impl Erbf {
             .map(|k| {
                 let undefined = |message: String| ErbfError::LooUndefined { sample: k, message };
                 let unit = without_row(self.unit.as_ref(), k);
-                let factor = Factor::new(unit.as_ref(), &self.options)
+                let factor = Factor::new(unit.as_ref(), &self.options, false)
                     .map_err(|e| undefined(e.to_string()))?;
                 let uk = Mat::from_fn(1, self.dim(), |_, j| self.unit[(k, j)]);
                 let b = basis_matrix_t(uk.as_ref(), unit.as_ref(), &self.options);
@@ -455,17 +531,19 @@ impl Erbf {
         }
     }
 
-    /// `out = B^T Q_1 Z` (or `B^T c`) for a block of basis vectors `B` (`M x Q`).
+    /// `out = B^T c` for a block of basis vectors `B` (`M x Q`), through the stored `c` or
+    /// as `(R^{-1} Q_1^T B)^T F`.
     fn apply(&self, bt: MatRef<'_, f64>, out: faer::MatMut<'_, f64>) {
         match &self.coef {
             Some(c) => matmul(out, Accum::Replace, bt.transpose(), c.as_ref(), 1.0, par()),
             None => {
-                let w = self.q1.transpose() * bt;
+                let mut v = self.projection.q1().transpose() * bt;
+                solve_upper_triangular_in_place(self.r.as_ref(), v.as_mut(), Par::Seq);
                 matmul(
                     out,
                     Accum::Replace,
-                    w.transpose(),
-                    self.z.as_ref(),
+                    v.transpose(),
+                    self.responses(),
                     1.0,
                     par(),
                 );
@@ -474,8 +552,18 @@ impl Erbf {
     }
 }
 
-/// Query rows per block of batch prediction.
-const BLOCK: usize = 1024;
+/// Whether predicting `T` outputs as `b(x)^T c` (`M (T + 1)` operations per query) is
+/// cheaper than through the projection, `w = Q_1^T b(x)` then `w^T Z` (about
+/// `N^2 + m N (2 gamma N + 4) + N T`).
+fn direct_is_cheaper(n: usize, m: usize, t: usize, gamma: f64) -> bool {
+    let (n, m, t) = (n as f64, m as f64, t as f64);
+    let direct = n * (3.0 * m + 1.0) * (t + 1.0);
+    let projected = n * n + m * n * ((2.0 * gamma).min(1.0) * n + 4.0) + n * t;
+    direct <= projected
+}
+
+/// Queries per chunk of batch prediction (fixed, so results do not depend on threads).
+const CHUNK: usize = 64;
 
 fn par() -> Par {
     faer::get_global_parallelism()
@@ -489,12 +577,11 @@ struct Factor {
 }
 
 impl Factor {
-    fn new(unit: MatRef<'_, f64>, options: &ErbfOptions) -> Result<Self> {
-        let at = basis_matrix_t(unit, unit, options);
-        let qr = at.qr();
+    /// Factorises `A^T` for the scaled samples `unit` (see [`crate::thin_qr`]);
+    /// `parallel` lets the two halves of the rows run side by side.
+    fn new(unit: MatRef<'_, f64>, options: &ErbfOptions, parallel: bool) -> Result<Self> {
         let n = unit.nrows();
-        let r = qr.thin_R().to_owned();
-        let q1 = qr.compute_thin_Q();
+        let ThinQr { q1, r } = thin_qr(basis_matrix_t(unit, unit, options), parallel);
         let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
         for i in 0..n {
             lo = lo.min(r[(i, i)].abs());
@@ -510,46 +597,65 @@ impl Factor {
 }
 
 /// The basis vectors of the queries `u` (`Q x m`, scaled) with respect to the centres
-/// `centres` (`N x m`, scaled), as the columns of an `M x Q` matrix.
-fn basis_matrix_t(u: MatRef<'_, f64>, centres: MatRef<'_, f64>, o: &ErbfOptions) -> Mat<f64> {
-    let n = centres.nrows();
+/// `centres` (`N x m`, scaled), as the columns of an `M x Q` matrix (built in parallel).
+pub(crate) fn basis_matrix_t(
+    u: MatRef<'_, f64>,
+    centres: MatRef<'_, f64>,
+    o: &ErbfOptions,
+) -> Mat<f64> {
     let m = centres.ncols();
-    // Centres row-major, so that the inner loop reads contiguous memory.
-    let c: Vec<f64> = (0..n)
-        .flat_map(|i| (0..m).map(move |j| centres[(i, j)]))
-        .collect();
+    let c = row_major(centres);
+    let q = u.nrows();
+    let u = row_major(u);
+    let mut bt = buffer::zeros(centres.nrows() * (3 * m + 1), q);
+    bt.par_col_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(k, cols)| {
+            let len = cols.ncols();
+            fill_basis(&u[k * CHUNK * m..(k * CHUNK + len) * m], &c, m, o, cols);
+        });
+    bt
+}
+
+/// The entries of `a` (`r x m`) row by row.
+fn row_major(a: MatRef<'_, f64>) -> Vec<f64> {
+    (0..a.nrows())
+        .flat_map(|i| (0..a.ncols()).map(move |j| a[(i, j)]))
+        .collect()
+}
+
+/// Writes into the columns of `out` (`M x Q`) the basis vectors of the scaled queries `u`
+/// (row-major, `Q x m`) with respect to the scaled centres `c` (row-major, `N x m`):
+/// radial values first, then per centre and input `{phi_L, phi_R, xi}`, each family times
+/// its weight.
+fn fill_basis(u: &[f64], c: &[f64], m: usize, o: &ErbfOptions, mut out: faer::MatMut<'_, f64>) {
     let lr = LeftRight::new(o.order as i32, o.gamma);
     let inv2rc2 = 0.5 / (o.rc * o.rc);
     let w = o.weights;
-    let mut bt = Mat::<f64>::zeros(n * (3 * m + 1), u.nrows());
-    bt.par_col_chunks_mut(1)
-        .enumerate()
-        .for_each(|(q, mut col)| {
-            let x: Vec<f64> = (0..m).map(|j| u[(q, j)]).collect();
-            let Some(col) = col.as_mut().col_mut(0).try_as_col_major_mut() else {
-                return;
-            };
-            let col = col.as_slice_mut();
-            let (radial, rest) = col.split_at_mut(n);
-            for (i, (r, out)) in radial
-                .iter_mut()
-                .zip(rest.chunks_exact_mut(3 * m))
-                .enumerate()
-            {
-                let ci = &c[i * m..(i + 1) * m];
-                let mut d2 = 0.0;
-                for ((&xj, &cj), o3) in x.iter().zip(ci).zip(out.chunks_exact_mut(3)) {
-                    let xi = xj - cj;
-                    d2 += xi * xi;
-                    let (l, rr) = lr.values(xi);
-                    o3[0] = w.left_right * l;
-                    o3[1] = w.left_right * rr;
-                    o3[2] = w.beta * xi;
-                }
-                *r = w.radial * (-d2 * inv2rc2).exp();
+    let n = c.len() / m.max(1);
+    for (q, x) in u.chunks_exact(m.max(1)).enumerate() {
+        let Some(col) = out.as_mut().col_mut(q).try_as_col_major_mut() else {
+            continue;
+        };
+        let col = col.as_slice_mut();
+        let (radial, rest) = col.split_at_mut(n);
+        for ((r, out3m), ci) in radial
+            .iter_mut()
+            .zip(rest.chunks_exact_mut(3 * m))
+            .zip(c.chunks_exact(m))
+        {
+            let mut d2 = 0.0;
+            for ((&xj, &cj), o3) in x.iter().zip(ci).zip(out3m.chunks_exact_mut(3)) {
+                let xi = xj - cj;
+                d2 += xi * xi;
+                let (l, rr) = lr.values(xi);
+                o3[0] = w.left_right * l;
+                o3[1] = w.left_right * rr;
+                o3[2] = w.beta * xi;
             }
-        });
-    bt
+            *r = w.radial * (-d2 * inv2rc2).exp();
+        }
+    }
 }
 
 /// Derivatives of the basis vector at the scaled point `u`: an `M x m` matrix whose column

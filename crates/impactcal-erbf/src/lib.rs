@@ -56,6 +56,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod buffer;
 pub mod data;
 pub mod erbf;
 pub mod error;
@@ -63,9 +64,11 @@ pub mod kernel;
 pub mod loo;
 pub mod metrics;
 pub mod nrbf;
+mod projection;
 pub mod rbf;
 pub mod surrogate;
 pub mod testfns;
+mod thin_qr;
 
 pub use data::StoredMat;
 pub use erbf::{Erbf, ErbfOptions, FamilyWeights};

@@ -21,8 +21,6 @@
 pub struct LeftRight {
     n: i32,
     gamma: f64,
-    /// `gamma^n`, the value at `+-gamma`.
-    edge: f64,
     /// `n gamma^(n-1)`, the magnitude of the slope beyond `+-gamma`.
     slope: f64,
 }
@@ -33,7 +31,6 @@ impl LeftRight {
         LeftRight {
             n,
             gamma,
-            edge: gamma.powi(n),
             slope: f64::from(n) * gamma.powi(n - 1),
         }
     }
@@ -41,19 +38,19 @@ impl LeftRight {
     /// `(phi_L(xi), phi_R(xi))` for an even order (at most one of them is non-zero).
     #[inline]
     pub fn values(&self, xi: f64) -> (f64, f64) {
+        // Branch-free, as the offsets of random queries have random signs and regions:
+        // |xi|^n inside the half-width, the tangent line beyond, written as
+        // min(|xi|, gamma)^n + slope max(|xi| - gamma, 0); then split by sign.
         let a = xi.abs();
-        let v = if a >= self.gamma {
-            self.edge + self.slope * (a - self.gamma)
-        } else {
-            even_power(a, self.n)
-        };
-        if xi < 0.0 { (v, 0.0) } else { (0.0, v) }
+        let v = even_power(a.min(self.gamma), self.n) + self.slope * (a - self.gamma).max(0.0);
+        let left = v * f64::from(u8::from(xi < 0.0));
+        (left, v - left)
     }
 }
 
 /// `x^n` by repeated squaring.
 #[inline]
-fn even_power(x: f64, n: i32) -> f64 {
+pub(crate) fn even_power(x: f64, n: i32) -> f64 {
     match n {
         2 => x * x,
         4 => {

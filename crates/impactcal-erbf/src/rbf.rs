@@ -22,11 +22,18 @@
 //! interpolant, and keeps the pivots balanced.
 
 use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::{DenseSolveCore, PartialPivLu, Solve};
-use faer::{Accum, Mat, MatRef};
+use faer::linalg::solvers::{DenseSolveCore, PartialPivLu};
+use std::sync::OnceLock;
+
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_unit_lower_triangular_in_place,
+    solve_unit_upper_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{Accum, Mat, MatRef, Par};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::buffer;
 use crate::data::{
     StoredMat, check_queries, check_training, collect_rows, find_duplicate, mat_from_rows,
     stack_rows, without_row,
@@ -140,7 +147,9 @@ pub struct RbfInterpolant {
     tail_weight: f64,
     system: Mat<f64>,
     lu: PartialPivLu<f64>,
-    coef: Mat<f64>,
+    /// The coefficients `[c; a]` (`n x T`): solved at fit time when `T <= n`, on first
+    /// use otherwise (see [`predict_batch`](Self::predict_batch)).
+    coef: OnceLock<Mat<f64>>,
     pivot_ratio: f64,
 }
 
@@ -148,8 +157,12 @@ impl RbfInterpolant {
     /// Fits the interpolant to `points` (`N x d`, one sample per row) and `values`
     /// (`N x T`, one output per column).
     ///
-    /// Cost: `O(N^2 d)` to assemble, `O(n^3)` to factorise (`n = N + ` tail terms),
-    /// `O(n^2 T)` to solve.
+    /// Cost: `O(N^2 d)` to assemble, `O(n^3)` to factorise (`n = N + ` tail terms), and
+    /// `O(n^2 T)` to solve for the coefficients when `T <= n`; for longer outputs the
+    /// coefficients are not formed (see [`predict_batch`](Self::predict_batch)) and are
+    /// solved for only if [`kernel_weights`](Self::kernel_weights),
+    /// [`tail_coefficients`](Self::tail_coefficients) or the closed-form leave-one-out
+    /// errors ask for them.
     ///
     /// # Errors
     /// - [`ErbfError::NoSamples`] for `N = 0`;
@@ -259,11 +272,10 @@ impl RbfInterpolant {
                 threshold,
             });
         }
-        let mut coef = Mat::<f64>::zeros(n, values.ncols());
-        coef.as_mut()
-            .submatrix_mut(0, 0, n_pts, values.ncols())
-            .copy_from(values.as_ref());
-        lu.solve_in_place(coef.as_mut());
+        let coef = OnceLock::new();
+        if values.ncols() <= n {
+            let _ = coef.set(lu_solve(&lu, values.as_ref(), n));
+        }
         Ok(RbfInterpolant {
             options,
             points,
@@ -376,7 +388,7 @@ impl RbfInterpolant {
     /// [`points`](Self::points)); with [`tail_coefficients`](Self::tail_coefficients) they
     /// give the interpolant explicitly.
     pub fn kernel_weights(&self) -> MatRef<'_, f64> {
-        self.coef.as_ref().subrows(0, self.n_samples())
+        self.coef().as_ref().subrows(0, self.n_samples())
     }
 
     /// The coefficients of the polynomial tail in the original coordinates, a `q x T`
@@ -398,14 +410,15 @@ impl RbfInterpolant {
         let q = self.options.degree.terms(d);
         let w = self.tail_weight;
         let mut a = Mat::<f64>::zeros(q, t);
+        let coef = self.coef();
         for c in 0..t {
             match self.options.degree {
                 PolyDegree::None => {}
-                PolyDegree::Constant => a[(0, c)] = w * self.coef[(n_pts, c)],
+                PolyDegree::Constant => a[(0, c)] = w * coef[(n_pts, c)],
                 PolyDegree::Linear => {
-                    let mut constant = w * self.coef[(n_pts, c)];
+                    let mut constant = w * coef[(n_pts, c)];
                     for j in 0..d {
-                        let b = w * self.coef[(n_pts + 1 + j, c)] / self.scale;
+                        let b = w * coef[(n_pts + 1 + j, c)] / self.scale;
                         a[(1 + j, c)] = b;
                         constant -= b * self.shift[j];
                     }
@@ -447,17 +460,24 @@ impl RbfInterpolant {
         Ok(out.row(0).iter().copied().collect())
     }
 
-    /// Predictions at the rows of `points` (`Q x d`): a `Q x T` matrix. Basis rows are
-    /// built in parallel and multiplied by the coefficients in blocks; the result does not
-    /// depend on the number of threads.
+    /// Predictions at the rows of `points` (`Q x d`): a `Q x T` matrix.
+    ///
+    /// With `B` the `Q x n` basis rows of the queries and `S` the system matrix, the
+    /// prediction is `B S^{-1} [F; 0]`. For few outputs (`T <= n`) it is `B [c; a]` with the
+    /// coefficients solved at fit time. For long histories (`T > n`) the same product is
+    /// taken the other way round, `(S^{-T} B^T)^T [F; 0]`: a solve with `Q` right-hand
+    /// sides instead of `T`, then one `Q x N x T` product with the training values, so the
+    /// coefficients (`n x T`) are never formed. Basis rows are built in parallel and the
+    /// queries processed in blocks of 4096; the result does not depend on the number of
+    /// threads.
     ///
     /// # Errors
     /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for bad points.
     pub fn predict_batch(&self, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
         check_queries(points, self.dim())?;
-        let n = self.coef.nrows();
+        let n = self.system.nrows();
         let t = self.n_outputs();
-        let mut out = Mat::<f64>::zeros(points.nrows(), t);
+        let mut out = buffer::zeros(points.nrows(), t);
         let par = faer::get_global_parallelism();
         let mut start = 0;
         while start < points.nrows() {
@@ -475,17 +495,40 @@ impl RbfInterpolant {
                         col[(k, 0)] = v;
                     }
                 });
+            let (lhs, rhs) = self.apply_operands(basis_t);
             matmul(
                 out.as_mut().subrows_mut(start, len),
                 Accum::Replace,
-                basis_t.transpose(),
-                self.coef.as_ref(),
+                lhs.transpose(),
+                rhs,
                 1.0,
                 par,
             );
             start += len;
         }
         Ok(out)
+    }
+
+    /// For basis columns `basis_t` (`n x k`), the operands `(L, R)` with
+    /// `basis_t^T S^{-1} [F; 0] = L^T R`: `(basis_t, [c; a])` when the coefficients are
+    /// kept, else `(V, F)` with `V` the first `N` rows of `S^{-T} basis_t`.
+    fn apply_operands(&self, basis_t: Mat<f64>) -> (Mat<f64>, MatRef<'_, f64>) {
+        if self.n_outputs() <= self.system.nrows() {
+            return (basis_t, self.coef().as_ref());
+        }
+        let n_pts = self.n_samples();
+        let mut z = basis_t;
+        // S = P^T L U, so S^T v = b is U^T L^T P v = b.
+        solve_lower_triangular_in_place(self.lu.U().transpose(), z.as_mut(), Par::Seq);
+        solve_unit_upper_triangular_in_place(self.lu.L().transpose(), z.as_mut(), Par::Seq);
+        let (forward, _) = self.lu.P().arrays();
+        let mut v = Mat::<f64>::zeros(n_pts, z.ncols());
+        for (i, &p) in forward.iter().enumerate() {
+            if p < n_pts {
+                v.row_mut(p).copy_from(z.row(i));
+            }
+        }
+        (v, self.values.as_ref())
     }
 
     /// The gradient of every output at `x`: a `T x d` matrix whose row `t` is
@@ -500,7 +543,7 @@ impl RbfInterpolant {
         check_queries(MatRef::from_row_major_slice(x, 1, x.len()), self.dim())?;
         let n_pts = self.n_samples();
         let d = self.dim();
-        let n = self.coef.nrows();
+        let n = self.system.nrows();
         // db[(k, j)] = d basis_k / d x_j.
         let mut db = Mat::<f64>::zeros(n, d);
         for i in 0..n_pts {
@@ -516,7 +559,8 @@ impl RbfInterpolant {
                 db[(n_pts + 1 + j, j)] = self.tail_weight / self.scale;
             }
         }
-        Ok(self.coef.transpose() * db)
+        let (lhs, rhs) = self.apply_operands(db);
+        Ok(rhs.transpose() * lhs)
     }
 
     /// Value and gradient of output 0 at `x`: convenient for single-objective optimisers.
@@ -546,6 +590,7 @@ impl RbfInterpolant {
         match method {
             LooMethod::Closed | LooMethod::Auto => {
                 let inv = self.lu.inverse();
+                let coef = self.coef();
                 let hmax = (0..n_pts).map(|k| inv[(k, k)].abs()).fold(0.0, f64::max);
                 let mut e = Mat::<f64>::zeros(n_pts, t);
                 for k in 0..n_pts {
@@ -559,7 +604,7 @@ impl RbfInterpolant {
                         });
                     }
                     for c in 0..t {
-                        e[(k, c)] = self.coef[(k, c)] / h;
+                        e[(k, c)] = coef[(k, c)] / h;
                     }
                 }
                 Ok(e)
@@ -597,6 +642,12 @@ impl RbfInterpolant {
         }
     }
 
+    /// The coefficients `[c; a]`, solving for them on first use.
+    fn coef(&self) -> &Mat<f64> {
+        self.coef
+            .get_or_init(|| lu_solve(&self.lu, self.values.as_ref(), self.system.nrows()))
+    }
+
     /// Writes the basis row at `x` into `out` (length `n`): kernel values, then the tail.
     fn basis_row(&self, x: &[f64], out: &mut [f64]) {
         let n_pts = self.n_samples();
@@ -615,8 +666,35 @@ impl RbfInterpolant {
     }
 }
 
-/// Query rows per block of batch prediction.
-const BLOCK: usize = 1024;
+/// Query rows per block of batch prediction (bounds the basis matrix to `n x 4096`).
+const BLOCK: usize = 4096;
+
+/// Solves `S X = [F; 0]` for the `n x n` system `S` factorised as `P S = L U`, where `F`
+/// (`N x T`) fills the first `N` rows of the right-hand side: the permutation is applied
+/// while gathering `F` (in parallel over columns), then the two triangular solves run on
+/// all columns at once. Equal, bit for bit, to faer's `solve_in_place`, whose
+/// row permutation of a wide right-hand side is several times slower.
+fn lu_solve(lu: &PartialPivLu<f64>, f: MatRef<'_, f64>, n: usize) -> Mat<f64> {
+    let (forward, _) = lu.P().arrays();
+    let n_pts = f.nrows();
+    let mut x = Mat::<f64>::zeros(n, f.ncols());
+    x.par_col_chunks_mut(64)
+        .enumerate()
+        .for_each(|(k, mut cols)| {
+            for j in 0..cols.ncols() {
+                let src = f.col(k * 64 + j);
+                for (i, &p) in forward.iter().enumerate() {
+                    if p < n_pts {
+                        cols[(i, j)] = src[p];
+                    }
+                }
+            }
+        });
+    let par = faer::get_global_parallelism();
+    solve_unit_lower_triangular_in_place(lu.L(), x.as_mut(), par);
+    solve_upper_triangular_in_place(lu.U(), x.as_mut(), par);
+    x
+}
 
 /// The serialised form of an [`RbfInterpolant`]: options and training data.
 #[derive(Debug, Clone, Serialize, Deserialize)]

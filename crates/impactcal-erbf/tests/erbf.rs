@@ -179,6 +179,8 @@ fn columns_fitted_together_equal_columns_fitted_alone_and_superpose() {
     let all = Erbf::fit(&space, x.as_ref(), f.as_ref(), opts).unwrap();
     let q = to_raw(&space, random_unit(25, 3, 5).as_ref());
     let p_all = all.predict_batch(q.as_ref()).unwrap();
+    let x0 = row(q.as_ref(), 0);
+    let g_all = all.predict_gradient(&x0).unwrap();
     for t in [0, 7, 33, 59] {
         let one = Erbf::fit(&space, x.as_ref(), f.as_ref().subcols(t, 1), opts).unwrap();
         let p = one.predict_batch(q.as_ref()).unwrap();
@@ -188,6 +190,15 @@ fn columns_fitted_together_equal_columns_fitted_alone_and_superpose() {
                 p[(i, 0)],
                 epsilon = 1e-12,
                 max_relative = 1e-12
+            );
+        }
+        let g = one.predict_gradient(&x0).unwrap();
+        for j in 0..3 {
+            assert_relative_eq!(
+                g_all[(t, j)],
+                g[(0, j)],
+                epsilon = 1e-10,
+                max_relative = 1e-10
             );
         }
     }

@@ -50,6 +50,55 @@ fn reproduces_training_values_for_every_kernel() {
     }
 }
 
+/// More outputs than system rows (`T > n`) switches prediction to the transposed solve;
+/// each column must still equal the interpolant of that column alone, values and gradients.
+#[test]
+fn long_outputs_predict_as_their_columns_fitted_alone() {
+    let x = random_points(30, 3, 11);
+    let q = random_points(12, 3, 12);
+    let f = Mat::from_fn(30, 80, |i, t| {
+        let p: Vec<f64> = x.row(i).iter().copied().collect();
+        smooth(&p) * (0.05 * t as f64).cos() + t as f64 * p[2]
+    });
+    for opts in all_options() {
+        let all = RbfInterpolant::fit(x.as_ref(), f.as_ref(), opts).unwrap();
+        let p_all = all.predict_batch(q.as_ref()).unwrap();
+        let q0: Vec<f64> = q.row(0).iter().copied().collect();
+        let g_all = all.predict_gradient(&q0).unwrap();
+        for t in [0, 41, 79] {
+            let one = RbfInterpolant::fit(x.as_ref(), f.as_ref().subcols(t, 1), opts).unwrap();
+            let p = one.predict_batch(q.as_ref()).unwrap();
+            for i in 0..12 {
+                assert_relative_eq!(
+                    p_all[(i, t)],
+                    p[(i, 0)],
+                    epsilon = 1e-10,
+                    max_relative = 1e-10
+                );
+            }
+            let g = one.predict_gradient(&q0).unwrap();
+            for j in 0..3 {
+                assert_relative_eq!(
+                    g_all[(t, j)],
+                    g[(0, j)],
+                    epsilon = 1e-9,
+                    max_relative = 1e-9
+                );
+            }
+            let w = one.kernel_weights();
+            for i in 0..30 {
+                assert_relative_eq!(
+                    all.kernel_weights()[(i, t)],
+                    w[(i, 0)],
+                    epsilon = 1e-9,
+                    max_relative = 1e-9
+                );
+            }
+        }
+        assert!(all.training_residual() < 1e-10, "{opts:?}");
+    }
+}
+
 #[test]
 fn linear_tail_reproduces_affine_functions() {
     let x = random_points(25, 3, 2);
