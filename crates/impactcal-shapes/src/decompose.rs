@@ -1,6 +1,8 @@
 //! The impact-shape decomposition `Y = sum_i sigma_i phi_i g_i^T` (source paper Eq. 4.2).
 
-use faer::{Mat, MatRef};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::svd::{ComputeSvdVectors, svd, svd_scratch};
+use faer::{Col, Mat, MatRef};
 use impactcal_core::Histories;
 
 use crate::checks::{finite_nonempty, numerical_rank};
@@ -148,14 +150,8 @@ impl ImpactShapes {
                 (u, s, v, ContributionBasis::ComputedOnly)
             }
             None => {
-                let svd = y.thin_svd().map_err(|_| ShapesError::NoConvergence)?;
-                let s: Vec<f64> = svd.S().column_vector().iter().copied().collect();
-                (
-                    svd.U().to_owned(),
-                    s,
-                    svd.V().to_owned(),
-                    ContributionBasis::AllSingularValues,
-                )
+                let (u, s, v) = thin_svd(y)?;
+                (u, s, v, ContributionBasis::AllSingularValues)
             }
         };
         let rank = numerical_rank(&sigma_all, m, l);
@@ -195,8 +191,8 @@ impl ImpactShapes {
         .max(1);
         let sigma = sigma_all[..keep].to_vec();
         fix_signs(&mut u, &mut v, keep);
-        let u = u.subcols(0, keep).to_owned();
-        let v = v.subcols(0, keep).to_owned();
+        u.truncate(m, keep);
+        v.truncate(l, keep);
         Ok(ImpactShapes {
             labels: (0..m).map(|i| i.to_string()).collect(),
             start: 0.0,
@@ -339,6 +335,40 @@ fn validate_truncation(t: Truncation) -> Result<()> {
 
 /// Makes the largest-magnitude entry of each of the first `n` columns of `u` positive,
 /// flipping the matching column of `v`.
+/// The thin SVD `y = U diag(s) V^T` (`U` is `m x k`, `V` is `l x k`, `k = min(m, l)`,
+/// `s` non-increasing), computed by faer straight into the returned matrices so that no
+/// copy of the factors is made.
+///
+/// # Errors
+/// [`ShapesError::NoConvergence`] when the iteration does not converge.
+fn thin_svd(y: MatRef<'_, f64>) -> Result<(Mat<f64>, Vec<f64>, Mat<f64>)> {
+    let (m, l) = y.shape();
+    let k = m.min(l);
+    let par = faer::get_global_parallelism();
+    let mut u = Mat::<f64>::zeros(m, k);
+    let mut v = Mat::<f64>::zeros(l, k);
+    let mut s = Col::<f64>::zeros(k);
+    let thin = ComputeSvdVectors::Thin;
+    svd(
+        y,
+        s.as_diagonal_mut(),
+        Some(u.as_mut()),
+        Some(v.as_mut()),
+        par,
+        MemStack::new(&mut MemBuffer::new(svd_scratch::<f64>(
+            m,
+            l,
+            thin,
+            thin,
+            par,
+            Default::default(),
+        ))),
+        Default::default(),
+    )
+    .map_err(|_| ShapesError::NoConvergence)?;
+    Ok((u, s.iter().copied().collect(), v))
+}
+
 pub(crate) fn fix_signs(u: &mut Mat<f64>, v: &mut Mat<f64>, n: usize) {
     for j in 0..n {
         let mut best = 0.0f64;
