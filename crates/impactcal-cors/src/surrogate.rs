@@ -20,6 +20,9 @@ pub struct Surrogate {
     dim: usize,
     /// Centres, row-major `N x d`.
     centres: Vec<f64>,
+    /// The same centres coordinate by coordinate (`d x N`), for evaluating many distances
+    /// at once.
+    columns: Vec<f64>,
     weights: Vec<f64>,
     a0: f64,
     a: Vec<f64>,
@@ -72,10 +75,14 @@ impl Surrogate {
             }
             .into());
         }
+        let columns = (0..dim)
+            .flat_map(|j| (0..n).map(move |i| pts[(i, j)]))
+            .collect();
         Ok(Surrogate {
             kernel: rbf.options().kernel,
             dim,
             centres,
+            columns,
             weights,
             a0: tail[(0, 0)],
             a: (0..dim).map(|j| tail[(1 + j, 0)]).collect(),
@@ -87,15 +94,38 @@ impl Surrogate {
         self.dim
     }
 
+    /// `sum_i c_i phi(|x - x_i|)`. The squared distances of a block of centres are formed
+    /// coordinate by coordinate, which vectorises across centres; every distance and the
+    /// sum over centres keep the order of operations of the plain loop.
     fn kernel_part(&self, x: &[f64]) -> f64 {
-        self.centres
-            .chunks_exact(self.dim)
-            .zip(&self.weights)
-            .map(|(c, w)| {
-                let r = crate::geometry::distance(x, c);
-                w * self.kernel.value(r)
-            })
-            .sum()
+        match self.kernel {
+            Kernel::Cubic => self.weighted_sum(x, |r| r * r * r),
+            kernel => self.weighted_sum(x, |r| kernel.value(r)),
+        }
+    }
+
+    /// `sum_i c_i phi(|x - x_i|)` for a kernel `phi` known at compile time.
+    #[inline]
+    fn weighted_sum(&self, x: &[f64], phi: impl Fn(f64) -> f64) -> f64 {
+        const BLOCK: usize = 64;
+        let n = self.weights.len();
+        let mut d2 = [0.0; BLOCK];
+        let mut sum = -0.0;
+        for start in (0..n).step_by(BLOCK) {
+            let len = BLOCK.min(n - start);
+            let d2 = &mut d2[..len];
+            d2.fill(0.0);
+            for (j, &xj) in x.iter().enumerate() {
+                let col = &self.columns[j * n + start..j * n + start + len];
+                for (d, &c) in d2.iter_mut().zip(col) {
+                    *d += (xj - c) * (xj - c);
+                }
+            }
+            for (d, w) in d2.iter().zip(&self.weights[start..start + len]) {
+                sum += w * phi(d.sqrt());
+            }
+        }
+        sum
     }
 
     /// `s(x)`.

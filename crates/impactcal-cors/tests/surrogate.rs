@@ -42,3 +42,28 @@ proptest! {
         }
     }
 }
+
+/// More centres than one evaluation block (64) and a remainder block.
+#[test]
+fn value_matches_erbf_with_many_centres() {
+    let pts: Vec<Vec<f64>> = (0..150)
+        .map(|i| {
+            let t = i as f64;
+            vec![
+                (2f64.sqrt() * t).fract(),
+                (3f64.sqrt() * t + 0.2).fract(),
+                (5f64.sqrt() * t + 0.7).fract(),
+            ]
+        })
+        .collect();
+    let vals: Vec<f64> = pts
+        .iter()
+        .map(|p| (3.0 * p[0]).sin() + p[1] * p[2])
+        .collect();
+    let rbf = RbfInterpolant::fit_rows(&pts, &vals, RbfOptions::cubic()).unwrap();
+    let s = Surrogate::fit(&pts, &vals, SurrogateKernel::Cubic).unwrap();
+    for q in [[0.5, 0.5, 0.5], [0.01, 0.99, 0.3], [0.9, 0.1, 0.75]] {
+        let v = rbf.predict(&q).unwrap()[0];
+        assert!((s.value(&q) - v).abs() < 1e-9, "{} vs {v}", s.value(&q));
+    }
+}
