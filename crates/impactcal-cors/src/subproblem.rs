@@ -24,7 +24,7 @@ use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
-use crate::geometry::distance;
+use crate::geometry::{Columns, distance};
 use crate::surrogate::Surrogate;
 
 /// Candidates per parallel task: small batches cost more in scheduling than they save.
@@ -70,47 +70,6 @@ impl Blockers {
     pub fn min_distance(&self, x: &[f64]) -> f64 {
         let (a, b) = self.min_distances(x);
         a.min(b)
-    }
-}
-
-/// Points stored coordinate by coordinate (`dim x n`), for the many nearest-distance
-/// queries of a candidate screening: the squared distances to a block of points are
-/// formed one coordinate at a time, which vectorises across points. Each distance keeps
-/// the order of operations of [`crate::geometry::squared_distance`] and a minimum does not
-/// depend on order, so the results equal [`Blockers::min_distances`].
-struct Columns {
-    n: usize,
-    cols: Vec<f64>,
-}
-
-impl Columns {
-    fn new(pts: &[f64], dim: usize) -> Self {
-        let n = pts.len() / dim.max(1);
-        let cols = (0..dim)
-            .flat_map(|j| pts.chunks_exact(dim).map(move |p| p[j]))
-            .collect();
-        Columns { n, cols }
-    }
-
-    /// Distance from `x` to the nearest point; infinite for none.
-    fn min_distance(&self, x: &[f64]) -> f64 {
-        const BLOCK: usize = 64;
-        let n = self.n;
-        let mut d2 = [0.0; BLOCK];
-        let mut min = f64::INFINITY;
-        for start in (0..n).step_by(BLOCK) {
-            let len = BLOCK.min(n - start);
-            let d2 = &mut d2[..len];
-            d2.fill(0.0);
-            for (j, &xj) in x.iter().enumerate() {
-                let col = &self.cols[j * n + start..j * n + start + len];
-                for (d, &c) in d2.iter_mut().zip(col) {
-                    *d += (xj - c) * (xj - c);
-                }
-            }
-            min = d2.iter().copied().fold(min, f64::min);
-        }
-        min.sqrt()
     }
 }
 

@@ -11,6 +11,7 @@ use faer::MatRef;
 use impactcal_erbf::{Kernel, RbfInterpolant, RbfOptions};
 
 use crate::error::Result;
+use crate::geometry::Columns;
 use crate::options::SurrogateKernel;
 
 /// A fitted cubic or thin-plate RBF with a linear tail on the unit box.
@@ -20,9 +21,8 @@ pub struct Surrogate {
     dim: usize,
     /// Centres, row-major `N x d`.
     centres: Vec<f64>,
-    /// The same centres coordinate by coordinate (`d x N`), for evaluating many distances
-    /// at once.
-    columns: Vec<f64>,
+    /// The same centres coordinate by coordinate, for evaluating many distances at once.
+    columns: Columns,
     weights: Vec<f64>,
     a0: f64,
     a: Vec<f64>,
@@ -75,9 +75,7 @@ impl Surrogate {
             }
             .into());
         }
-        let columns = (0..dim)
-            .flat_map(|j| (0..n).map(move |i| pts[(i, j)]))
-            .collect();
+        let columns = Columns::new(&centres, dim);
         Ok(Surrogate {
             kernel: rbf.options().kernel,
             dim,
@@ -107,24 +105,12 @@ impl Surrogate {
     /// `sum_i c_i phi(|x - x_i|)` for a kernel `phi` known at compile time.
     #[inline]
     fn weighted_sum(&self, x: &[f64], phi: impl Fn(f64) -> f64) -> f64 {
-        const BLOCK: usize = 64;
-        let n = self.weights.len();
-        let mut d2 = [0.0; BLOCK];
         let mut sum = -0.0;
-        for start in (0..n).step_by(BLOCK) {
-            let len = BLOCK.min(n - start);
-            let d2 = &mut d2[..len];
-            d2.fill(0.0);
-            for (j, &xj) in x.iter().enumerate() {
-                let col = &self.columns[j * n + start..j * n + start + len];
-                for (d, &c) in d2.iter_mut().zip(col) {
-                    *d += (xj - c) * (xj - c);
-                }
-            }
-            for (d, w) in d2.iter().zip(&self.weights[start..start + len]) {
+        self.columns.for_each_block(x, |start, d2| {
+            for (d, w) in d2.iter().zip(&self.weights[start..]) {
                 sum += w * phi(d.sqrt());
             }
-        }
+        });
         sum
     }
 
