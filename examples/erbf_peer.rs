@@ -2,7 +2,8 @@
 //! input (N = 150, n_p = 10, T = 10^4, 1000 queries) as little-endian f64 files, times our
 //! fits and predictions, and writes a slice of our predictions for the agreement check.
 //!
-//! `cargo run --release --example erbf_peer -- <dir> [reps]`
+//! `cargo run --release --example erbf_peer -- <dir> [reps]` (set `ERBF_PEER_VERBOSE=1` to
+//! print every timed call to stderr).
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
