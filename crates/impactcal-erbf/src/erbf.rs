@@ -607,12 +607,14 @@ pub(crate) fn basis_matrix_t(
     let c = row_major(centres);
     let q = u.nrows();
     let u = row_major(u);
+    // Small chunks: the matrix of a fit has only N columns to share between threads.
+    const COLUMNS: usize = 16;
     let mut bt = buffer::zeros(centres.nrows() * (3 * m + 1), q);
-    bt.par_col_chunks_mut(CHUNK)
+    bt.par_col_chunks_mut(COLUMNS)
         .enumerate()
         .for_each(|(k, cols)| {
             let len = cols.ncols();
-            fill_basis(&u[k * CHUNK * m..(k * CHUNK + len) * m], &c, m, o, cols);
+            fill_basis(&u[k * COLUMNS * m..(k * COLUMNS + len) * m], &c, m, o, cols);
         });
     bt
 }

@@ -24,6 +24,7 @@
 use faer::linalg::matmul::matmul;
 use faer::reborrow::ReborrowMut;
 use faer::{Accum, ColMut, Mat, MatMut, MatRef, Par};
+use rayon::prelude::*;
 
 use crate::buffer;
 use crate::erbf::ErbfOptions;
@@ -94,45 +95,49 @@ impl Projection {
         let layout = Layout { n };
         let mut sorted = vec![0.0; m * n];
         let mut tables = buffer::zeros_vec(m * layout.block());
-        for (j, block) in tables.chunks_exact_mut(layout.block().max(1)).enumerate() {
-            let mut perm: Vec<usize> = (0..n).collect();
-            perm.sort_by(|&a, &b| unit[(a, j)].total_cmp(&unit[(b, j)]));
-            let cs = &mut sorted[j * n..(j + 1) * n];
-            for (s, &i) in perm.iter().enumerate() {
-                let c = unit[(i, j)];
-                cs[s] = c;
-                let row = n + 3 * (i * m + j);
-                let (l, r, b) = (q1.row(row), q1.row(row + 1), q1.row(row + 2));
-                let at = layout.rows_l(s);
-                block[at..at + n]
-                    .iter_mut()
-                    .zip(l.iter())
-                    .for_each(|(t, v)| *t = *v);
-                let at = layout.rows_r(s);
-                block[at..at + n]
-                    .iter_mut()
-                    .zip(r.iter())
-                    .for_each(|(t, v)| *t = *v);
-                let at = layout.beta();
-                let (b0, b1) = block[at..at + 2 * n].split_at_mut(n);
-                for ((t0, t1), v) in b0.iter_mut().zip(b1.iter_mut()).zip(b.iter()) {
-                    *t0 += v;
-                    *t1 += v * c;
+        // One input per task: the blocks are independent.
+        tables
+            .par_chunks_exact_mut(layout.block().max(1))
+            .zip(sorted.par_chunks_exact_mut(n.max(1)))
+            .enumerate()
+            .for_each(|(j, (block, cs))| {
+                let mut perm: Vec<usize> = (0..n).collect();
+                perm.sort_by(|&a, &b| unit[(a, j)].total_cmp(&unit[(b, j)]));
+                for (s, &i) in perm.iter().enumerate() {
+                    let c = unit[(i, j)];
+                    cs[s] = c;
+                    let row = n + 3 * (i * m + j);
+                    let (l, r, b) = (q1.row(row), q1.row(row + 1), q1.row(row + 2));
+                    let at = layout.rows_l(s);
+                    block[at..at + n]
+                        .iter_mut()
+                        .zip(l.iter())
+                        .for_each(|(t, v)| *t = *v);
+                    let at = layout.rows_r(s);
+                    block[at..at + n]
+                        .iter_mut()
+                        .zip(r.iter())
+                        .for_each(|(t, v)| *t = *v);
+                    let at = layout.beta();
+                    let (b0, b1) = block[at..at + 2 * n].split_at_mut(n);
+                    for ((t0, t1), v) in b0.iter_mut().zip(b1.iter_mut()).zip(b.iter()) {
+                        *t0 += v;
+                        *t1 += v * c;
+                    }
                 }
-            }
-            for s in 0..n {
-                let (done, next) = block.split_at_mut(layout.prefix(s + 1));
-                let (rows, last) = done.split_at(layout.prefix(s));
-                let row = &rows[layout.rows_r(s)..layout.rows_r(s) + n];
-                accumulate(last, row, cs[s], &mut next[..2 * n]);
-            }
-            for s in (0..n).rev() {
-                let (head, done) = block.split_at_mut(layout.suffix(s + 1));
-                let (rows, next) = head.split_at_mut(layout.suffix(s));
-                let row = &rows[layout.rows_l(s)..layout.rows_l(s) + n];
-                accumulate(done, row, cs[s], next);
-            }
-        }
+                for s in 0..n {
+                    let (done, next) = block.split_at_mut(layout.prefix(s + 1));
+                    let (rows, last) = done.split_at(layout.prefix(s));
+                    let row = &rows[layout.rows_r(s)..layout.rows_r(s) + n];
+                    accumulate(last, row, cs[s], &mut next[..2 * n]);
+                }
+                for s in (0..n).rev() {
+                    let (head, done) = block.split_at_mut(layout.suffix(s + 1));
+                    let (rows, next) = head.split_at_mut(layout.suffix(s));
+                    let row = &rows[layout.rows_l(s)..layout.rows_l(s) + n];
+                    accumulate(done, row, cs[s], next);
+                }
+            });
         let centres = (0..n)
             .flat_map(|i| (0..m).map(move |j| unit[(i, j)]))
             .collect();
