@@ -49,6 +49,11 @@ pub struct Args {
     /// Refine the greedy result by determinant-raising swaps.
     #[arg(long)]
     pub swaps: bool,
+    /// Noise standard deviation per candidate DOF: CSV with header `label,sigma`, one row
+    /// per candidate label; quieter DOFs then count more (each shape row is divided by its
+    /// sigma).
+    #[arg(long)]
+    pub noise: Option<PathBuf>,
     /// Write the JSON here instead of stdout.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -86,8 +91,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .swap_refinement(args.swaps);
     opts.keep = args.keep.iter().map(|s| s.trim().to_string()).collect();
     opts.exclude = args.exclude.iter().map(|s| s.trim().to_string()).collect();
+    let noise = args
+        .noise
+        .as_ref()
+        .map(|path| CandidateShapes::read_csv(path).map(|t| (path, t)))
+        .transpose()
+        .map_err(sensors_error)?;
+    let with_noise = |opts: PlacementOptions, labels: &[String]| match &noise {
+        Some((path, table)) => opts
+            .noise_by_label(labels, table)
+            .map_err(|e| in_file(path, e)),
+        None => Ok(opts),
+    };
     let (placement, candidates, shapes) = if let Some(path) = &args.shape_matrix {
         let c = CandidateShapes::read_csv(path).map_err(sensors_error)?;
+        let opts = with_noise(opts, c.labels())?;
         let p = place(&c, &opts).map_err(|e| in_file(path, e))?;
         (p, c.candidates(), c.shapes_count())
     } else {
@@ -96,6 +114,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .iter()
             .map(Histories::read_csv)
             .collect::<Result<Vec<_>, _>>()?;
+        let labels = runs
+            .first()
+            .map(|r| r.labels().to_vec())
+            .unwrap_or_default();
+        let opts = with_noise(opts, &labels)?;
         let r = place_from_histories(&runs, &options(args.shapes, args.contribution), &opts)
             .map_err(|e| in_file(&args.histories[0], e))?;
         (r.placement, r.shapes.channels(), r.shapes.len())

@@ -140,3 +140,132 @@ fn bad_input_exits_2_naming_file_row_and_column() {
     let out = impactcal(&["place", "--sensors", "3"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+fn selected(v: &serde_json::Value) -> Vec<String> {
+    serde_json::from_value(v["selected"].clone()).unwrap()
+}
+
+/// `--noise` prewhitens: the selection equals that of the shape matrix whose rows are
+/// divided by their sigma; equal sigmas change nothing; a very noisy DOF is avoided.
+#[test]
+fn noise_levels_weight_the_candidates() {
+    let dir = tempfile::tempdir().unwrap();
+    let shapes = example("chain_shapes.csv");
+    let text = std::fs::read_to_string(&shapes).unwrap();
+    let sigma = |label: &str| match label {
+        "10.x" => 20.0,
+        "3.x" => 4.0,
+        "7.x" => 0.5,
+        _ => 1.0,
+    };
+    let mut noise = String::from("label,sigma\n");
+    let mut weighted = String::new();
+    for (i, line) in text.lines().enumerate() {
+        if i == 0 {
+            weighted.push_str(line);
+            weighted.push('\n');
+            continue;
+        }
+        let mut fields = line.split(',');
+        let label = fields.next().unwrap();
+        noise.push_str(&format!("{label},{}\n", sigma(label)));
+        let row: Vec<String> = fields
+            .map(|v| (v.parse::<f64>().unwrap() / sigma(label)).to_string())
+            .collect();
+        weighted.push_str(&format!("{label},{}\n", row.join(",")));
+    }
+    let noise_path = dir.path().join("noise.csv");
+    let weighted_path = dir.path().join("weighted.csv");
+    std::fs::write(&noise_path, &noise).unwrap();
+    std::fs::write(&weighted_path, &weighted).unwrap();
+    let run = |extra: &[&str], matrix: &std::path::Path| {
+        let mut args = vec!["place", "--shape-matrix", matrix.to_str().unwrap()];
+        args.extend_from_slice(&["--sensors", "3"]);
+        args.extend_from_slice(extra);
+        json(&impactcal(&args))
+    };
+    let plain = run(&[], &shapes);
+    let noisy = run(&["--noise", noise_path.to_str().unwrap()], &shapes);
+    let prewhitened = run(&[], &weighted_path);
+    assert_eq!(selected(&noisy), selected(&prewhitened));
+    assert_ne!(selected(&noisy), selected(&plain));
+    assert!(selected(&plain).contains(&"10.x".to_string()));
+    assert!(!selected(&noisy).contains(&"10.x".to_string()));
+
+    let equal: String = std::iter::once("label,sigma\n".to_string())
+        .chain((1..=10).map(|i| format!("{i}.x,2.5\n")))
+        .collect();
+    let equal_path = dir.path().join("equal.csv");
+    std::fs::write(&equal_path, equal).unwrap();
+    let same = run(&["--noise", equal_path.to_str().unwrap()], &shapes);
+    assert_eq!(selected(&same), selected(&plain));
+}
+
+#[test]
+fn bad_noise_tables_exit_2_naming_the_label() {
+    let dir = tempfile::tempdir().unwrap();
+    let shapes = example("chain_shapes.csv");
+    let cases = [
+        (
+            "missing.csv",
+            "label,sigma\n1.x,1\n2.x,1\n",
+            "no noise level for candidate `3.x`",
+        ),
+        (
+            "unknown.csv",
+            "label,sigma\n1.x,1\n11.x,1\n",
+            "`11.x`, which is not a candidate",
+        ),
+        ("two.csv", "label,a,b\n1.x,1,2\n", "one value column"),
+        (
+            "negative.csv",
+            "label,sigma\n1.x,-1\n2.x,1\n3.x,1\n4.x,1\n5.x,1\n6.x,1\n7.x,1\n8.x,1\n9.x,1\n10.x,1\n",
+            "1.x",
+        ),
+        ("text.csv", "label,sigma\n1.x,loud\n", "row 2"),
+    ];
+    for (name, text, expected) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = impactcal(&[
+            "place",
+            "--shape-matrix",
+            shapes.to_str().unwrap(),
+            "--sensors",
+            "3",
+            "--noise",
+            path.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(expected), "{name}: {err}");
+    }
+}
+
+/// With histories the noise table is matched to the channel labels; equal levels change
+/// nothing.
+#[test]
+fn noise_levels_apply_to_history_channels() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = example("analysis.csv");
+    let header = std::fs::read_to_string(&input).unwrap();
+    let labels: Vec<&str> = header.lines().next().unwrap().split(',').skip(1).collect();
+    let noise: String = std::iter::once("label,sigma\n".to_string())
+        .chain(labels.iter().map(|l| format!("{},3\n", l.trim())))
+        .collect();
+    let path = dir.path().join("noise.csv");
+    std::fs::write(&path, noise).unwrap();
+    let args = [
+        "place",
+        "--histories",
+        input.to_str().unwrap(),
+        "--shapes",
+        "3",
+        "--sensors",
+        "4",
+    ];
+    let plain = json(&impactcal(&args));
+    let mut with = args.to_vec();
+    with.extend_from_slice(&["--noise", path.to_str().unwrap()]);
+    assert_eq!(selected(&json(&impactcal(&with))), selected(&plain));
+}

@@ -1,5 +1,7 @@
 //! Placement options.
 
+use crate::candidates::CandidateShapes;
+use crate::error::{Result, SensorsError};
 use serde::{Deserialize, Serialize};
 
 /// How the sensor set is built.
@@ -108,6 +110,43 @@ impl PlacementOptions {
     pub fn noise(mut self, sigma: Vec<f64>) -> Self {
         self.noise = Some(sigma);
         self
+    }
+
+    /// Noise standard deviations given by label, as read from a `label,sigma` table (see
+    /// [`CandidateShapes::read_csv`]), put in the order of the candidates `labels`.
+    ///
+    /// # Errors
+    /// [`SensorsError::InvalidOption`] when the table has not exactly one value column,
+    /// names a label that is not a candidate (a typo would otherwise go unnoticed), or
+    /// lacks a level for a candidate; the message names the label.
+    pub fn noise_by_label(self, labels: &[String], table: &CandidateShapes) -> Result<Self> {
+        if table.shapes_count() != 1 {
+            return Err(SensorsError::InvalidOption(format!(
+                "a noise table has one value column (label,sigma); found {}",
+                table.shapes_count()
+            )));
+        }
+        if let Some(unknown) = table
+            .labels()
+            .iter()
+            .find(|l| !labels.iter().any(|c| c == *l))
+        {
+            return Err(SensorsError::InvalidOption(format!(
+                "noise level for `{unknown}`, which is not a candidate"
+            )));
+        }
+        let sigma = labels
+            .iter()
+            .map(|l| {
+                table
+                    .index_of(l)
+                    .map(|i| table.shapes()[(i, 0)])
+                    .ok_or_else(|| {
+                        SensorsError::InvalidOption(format!("no noise level for candidate `{l}`"))
+                    })
+            })
+            .collect::<Result<Vec<f64>>>()?;
+        Ok(self.noise(sigma))
     }
 
     /// Turns the swap refinement on or off.
