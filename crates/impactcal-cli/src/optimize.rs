@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
 use impactcal::core::{ParameterSpace, Table, TableOptions};
-use impactcal::cors::{Cors, CorsOptions, InitialDesign, SurrogateKernel, Transform};
+use impactcal::cors::{Cors, CorsOptions, InitialDesign, Restart, SurrogateKernel, Transform};
 
 use crate::error::CliError;
 use crate::output::writer;
@@ -82,6 +82,21 @@ struct SuggestArgs {
     /// the search-pattern cycle starts after them (default 0).
     #[arg(long)]
     initial_rows: Option<usize>,
+    /// Half-width, in the unit box, of the box around the best point that every second
+    /// cycle of the search pattern searches (default 0.3).
+    #[arg(long, conflicts_with = "global_only")]
+    local_half_width: Option<f64>,
+    /// Search the whole box in every cycle (the 2005 method, no local cycles).
+    #[arg(long)]
+    global_only: bool,
+    /// Restart with a new design after this many evaluations without substantial
+    /// improvement (off by default; `--restart` uses a patience that grows with the
+    /// dimension).
+    #[arg(long)]
+    restart_patience: Option<usize>,
+    /// Turn the restart rule on with its default patience.
+    #[arg(long)]
+    restart: bool,
     /// Write the points here instead of stdout.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -169,6 +184,21 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
         design_size: args.design_size,
         ..CorsOptions::with_seed(args.seed)
     };
+    let options = CorsOptions {
+        local_region: if args.global_only {
+            None
+        } else {
+            args.local_half_width.or(options.local_region)
+        },
+        restart: (args.restart || args.restart_patience.is_some()).then(|| Restart {
+            patience: args.restart_patience,
+            ..Restart::default()
+        }),
+        ..options
+    };
+    options
+        .validate(space.dim())
+        .map_err(|e| CliError::input(format!("option: {e}")))?;
     let history = args.history.display().to_string();
     let mut study = Cors::from_history(space.clone(), options, &points, &values, args.initial_rows)
         .map_err(|e| CliError::input(format!("{history}: {e}")))?;

@@ -10,7 +10,7 @@ use std::io::Write;
 use std::path::Path;
 
 use impactcal::core::{Table, TableOptions};
-use impactcal::cors::{Cors, CorsOptions, test_functions};
+use impactcal::cors::{Cors, CorsOptions, Restart, test_functions};
 
 fn suggest(bounds: &Path, history: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
     let mut args = vec![
@@ -78,6 +78,71 @@ fn shell_loop_reproduces_the_library_loop() {
     assert_eq!(cli_points, lib_points);
 }
 
+/// The search options of the command (local half-width, global-only, restart) give the
+/// same points as the library with the same options.
+#[test]
+fn search_options_reproduce_the_library_loop() {
+    let f = test_functions::by_name("branin").unwrap();
+    let cases: [(&[&str], CorsOptions); 3] = [
+        (
+            &["--local-half-width", "0.15"],
+            CorsOptions {
+                local_region: Some(0.15),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--global-only"],
+            CorsOptions {
+                local_region: None,
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--restart-patience", "4"],
+            CorsOptions {
+                restart: Some(Restart {
+                    patience: Some(4),
+                    ..Restart::default()
+                }),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+    ];
+    for (flags, options) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let bounds = branin_bounds(dir.path());
+        let history = dir.path().join("history.csv");
+        let n = 24;
+        let mut extra = vec!["--seed", "3"];
+        extra.extend_from_slice(flags);
+        let mut cli_points = Vec::new();
+        for _ in 0..n {
+            let x = suggest(&bounds, &history, &extra).pop().unwrap();
+            append(&history, &x, f.eval(&x));
+            cli_points.push(x);
+        }
+        let mut study = Cors::new(f.space().unwrap(), options).unwrap();
+        study.minimize(|x| f.eval(x), n).unwrap();
+        let lib: Vec<Vec<f64>> = study.evaluations().iter().map(|e| e.x.clone()).collect();
+        assert_eq!(cli_points, lib, "{flags:?}");
+    }
+    // The flags change the search (else the test above could not fail).
+    let run = |flags: &[&str]| {
+        let dir = tempfile::tempdir().unwrap();
+        let bounds = branin_bounds(dir.path());
+        let history = dir.path().join("history.csv");
+        let mut extra = vec!["--seed", "3"];
+        extra.extend_from_slice(flags);
+        for _ in 0..12 {
+            let x = suggest(&bounds, &history, &extra).pop().unwrap();
+            append(&history, &x, f.eval(&x));
+        }
+        suggest(&bounds, &history, &extra)
+    };
+    assert_ne!(run(&[]), run(&["--global-only"]));
+}
+
 #[test]
 fn batch_failures_and_empty_history() {
     let f = test_functions::by_name("branin").unwrap();
@@ -141,4 +206,33 @@ fn bad_history_is_an_input_error() {
         err.contains("history row 1") && err.contains("outside"),
         "{err}"
     );
+}
+
+#[test]
+fn bad_search_options_are_input_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let bounds = branin_bounds(dir.path());
+    let history = dir.path().join("history.csv");
+    for (flags, expected) in [
+        (&["--local-half-width", "0"][..], "local_region"),
+        (&["--restart-patience", "0"][..], "patience"),
+        (
+            &["--local-half-width", "0.2", "--global-only"][..],
+            "cannot be used",
+        ),
+    ] {
+        let mut args = vec![
+            "optimize",
+            "suggest",
+            "--bounds",
+            bounds.to_str().unwrap(),
+            "--history",
+            history.to_str().unwrap(),
+        ];
+        args.extend_from_slice(flags);
+        let out = impactcal(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flags:?}: {err}");
+        assert!(err.contains(expected), "{flags:?}: {err}");
+    }
 }
