@@ -12,7 +12,8 @@ use std::path::Path;
 use impactcal::core::{Table, TableOptions};
 use impactcal::cors::{Cors, CorsOptions, Restart, test_functions};
 
-fn suggest(bounds: &Path, history: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
+/// Runs `impactcal optimize suggest` on the files with extra arguments.
+fn run_suggest(bounds: &Path, history: &Path, extra: &[&str]) -> std::process::Output {
     let mut args = vec![
         "optimize",
         "suggest",
@@ -22,7 +23,11 @@ fn suggest(bounds: &Path, history: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
         history.to_str().unwrap(),
     ];
     args.extend_from_slice(extra);
-    let out = impactcal(&args);
+    impactcal(&args)
+}
+
+fn suggest(bounds: &Path, history: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
+    let out = run_suggest(bounds, history, extra);
     assert!(
         out.status.success(),
         "failed: {}",
@@ -221,16 +226,7 @@ fn bad_search_options_are_input_errors() {
             "cannot be used",
         ),
     ] {
-        let mut args = vec![
-            "optimize",
-            "suggest",
-            "--bounds",
-            bounds.to_str().unwrap(),
-            "--history",
-            history.to_str().unwrap(),
-        ];
-        args.extend_from_slice(flags);
-        let out = impactcal(&args);
+        let out = run_suggest(&bounds, &history, flags);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{flags:?}: {err}");
         assert!(err.contains(expected), "{flags:?}: {err}");
