@@ -510,3 +510,20 @@ fn oscillator_time_histories() {
     // More samples, better surrogate.
     assert!(raae[1] < raae[0], "RAAE {raae:?}");
 }
+
+/// One and two samples with a long output (the tabulated projection path) still reproduce
+/// the training data and predict finite values everywhere.
+#[test]
+fn tiny_designs_with_long_outputs() {
+    let space = raw_space(3);
+    for n in [1, 2] {
+        let u = random_unit(n, 3, 21);
+        let x = to_raw(&space, u.as_ref());
+        let f = Mat::from_fn(n, 50, |i, t| (i + 1) as f64 * (0.1 * t as f64).sin() + 2.0);
+        let model = Erbf::fit(&space, x.as_ref(), f.as_ref(), ErbfOptions::default()).unwrap();
+        assert!(model.training_residual() < 1e-10, "N = {n}");
+        let q = to_raw(&space, random_unit(7, 3, 22).as_ref());
+        let p = model.predict_batch(q.as_ref()).unwrap();
+        assert!(p.col_iter().all(|c| c.iter().all(|v| v.is_finite())));
+    }
+}
