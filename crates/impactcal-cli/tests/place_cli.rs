@@ -141,6 +141,19 @@ fn bad_input_exits_2_naming_file_row_and_column() {
     assert_eq!(out.status.code(), Some(2));
 }
 
+/// Runs `impactcal place` on a shape matrix for `sensors` sensors with extra arguments.
+fn place_matrix(matrix: &std::path::Path, sensors: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "place",
+        "--shape-matrix",
+        matrix.to_str().unwrap(),
+        "--sensors",
+        sensors,
+    ];
+    args.extend_from_slice(extra);
+    impactcal(&args)
+}
+
 fn selected(v: &serde_json::Value) -> Vec<String> {
     serde_json::from_value(v["selected"].clone()).unwrap()
 }
@@ -178,12 +191,7 @@ fn noise_levels_weight_the_candidates() {
     let weighted_path = dir.path().join("weighted.csv");
     std::fs::write(&noise_path, &noise).unwrap();
     std::fs::write(&weighted_path, &weighted).unwrap();
-    let run = |extra: &[&str], matrix: &std::path::Path| {
-        let mut args = vec!["place", "--shape-matrix", matrix.to_str().unwrap()];
-        args.extend_from_slice(&["--sensors", "3"]);
-        args.extend_from_slice(extra);
-        json(&impactcal(&args))
-    };
+    let run = |extra: &[&str], matrix: &std::path::Path| json(&place_matrix(matrix, "3", extra));
     let plain = run(&[], &shapes);
     let noisy = run(&["--noise", noise_path.to_str().unwrap()], &shapes);
     let prewhitened = run(&[], &weighted_path);
@@ -227,15 +235,7 @@ fn bad_noise_tables_exit_2_naming_the_label() {
     for (name, text, expected) in cases {
         let path = dir.path().join(name);
         std::fs::write(&path, text).unwrap();
-        let out = impactcal(&[
-            "place",
-            "--shape-matrix",
-            shapes.to_str().unwrap(),
-            "--sensors",
-            "3",
-            "--noise",
-            path.to_str().unwrap(),
-        ]);
+        let out = place_matrix(&shapes, "3", &["--noise", path.to_str().unwrap()]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{name}: {err}");
         assert!(err.contains(expected), "{name}: {err}");
