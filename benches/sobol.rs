@@ -3,8 +3,11 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use impactcal::core::sampling::{Method, seeded_rng, symmetric_latin_hypercube, unit_sample};
+use faer::MatRef;
+use impactcal::core::points::to_rows;
+use impactcal::core::test_functions;
 use impactcal::core::{Parameter, ParameterSpace};
-use impactcal::sobol::{OutputView, SaltelliDesign, SobolOptions, analyze, test_functions};
+use impactcal::sobol::{SaltelliDesign, SobolOptions, analyze};
 use std::hint::black_box;
 
 fn sampling(c: &mut Criterion) {
@@ -36,9 +39,9 @@ fn design_outputs(n: usize, d: usize, cols: usize, second: bool) -> (SaltelliDes
     let a: Vec<f64> = (0..d)
         .map(|i| [0.0, 0.5, 3.0, 9.0][i.min(3)] + i as f64)
         .collect();
-    let mut y = Vec::with_capacity(design.points.n() * cols);
-    for x in design.points.rows() {
-        let g = test_functions::g_function(x, &a);
+    let mut y = Vec::with_capacity(design.points.nrows() * cols);
+    for x in to_rows(design.points.as_ref()) {
+        let g = test_functions::g_function(&x, &a);
         y.extend((0..cols).map(|t| g * (1.0 + t as f64 / cols as f64) + x[0] * t as f64));
     }
     (design, y)
@@ -48,7 +51,7 @@ fn indices(c: &mut Criterion) {
     let mut g = c.benchmark_group("sobol_analyze");
     g.sample_size(10);
     let (design, y) = design_outputs(4096, 6, 256, false);
-    let view = OutputView::new(&y, design.points.n(), 256).unwrap();
+    let view = MatRef::from_row_major_slice(&y, design.points.nrows(), 256);
     for resamples in [0, 100] {
         let options = SobolOptions {
             bootstrap: resamples,
@@ -59,7 +62,7 @@ fn indices(c: &mut Criterion) {
         });
     }
     let (design, y) = design_outputs(4096, 6, 64, true);
-    let view = OutputView::new(&y, design.points.n(), 64).unwrap();
+    let view = MatRef::from_row_major_slice(&y, design.points.nrows(), 64);
     g.bench_function("N 4096, d 6, T 64, second order, B 0", |b| {
         b.iter(|| analyze(&design.layout, view, &SobolOptions::default()).unwrap())
     });

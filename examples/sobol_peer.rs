@@ -11,7 +11,9 @@ use std::time::Instant;
 
 use impactcal::core::sampling::Method;
 use impactcal::core::{Parameter, ParameterSpace};
-use impactcal::sobol::{OutputView, SaltelliDesign, SobolOptions, analyze};
+use faer::MatRef;
+use impactcal::core::points::to_rows;
+use impactcal::sobol::{SaltelliDesign, SobolOptions, analyze};
 
 /// The output of run `x` at column `t` of `cols`: a G-function whose weights drift with t,
 /// identical to `outputs()` in benches/peers/sobol_salib.py.
@@ -53,9 +55,12 @@ fn main() {
     )
     .unwrap();
     let design = SaltelliDesign::generate(&space, n, Method::Sobol, second == 1, 0).unwrap();
-    let rows = design.points.n();
+    let rows = design.points.nrows();
     let mut y = vec![0.0; rows * cols];
-    for (x, out) in design.points.rows().zip(y.chunks_exact_mut(cols)) {
+    for (x, out) in to_rows(design.points.as_ref())
+        .iter()
+        .zip(y.chunks_exact_mut(cols))
+    {
         fill_row(x, cols, out);
     }
     let options = SobolOptions {
@@ -69,7 +74,7 @@ fn main() {
         let start = Instant::now();
         let s = analyze(
             &design.layout,
-            OutputView::new(&y, rows, cols).unwrap(),
+            MatRef::from_row_major_slice(&y, rows, cols),
             &options,
         )
         .unwrap();

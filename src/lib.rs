@@ -58,6 +58,6 @@ pub mod prelude {
     };
     pub use impactcal_shell::{ShellError, ShellModel, Simulation};
     pub use impactcal_sobol::{
-        DesignLayout, OutputView, SaltelliDesign, SobolError, SobolIndices, SobolOptions,
+        DesignLayout, SaltelliDesign, SobolError, SobolIndices, SobolOptions,
     };
 }

@@ -1,6 +1,38 @@
-//! The error type of `impactcal-core`.
+//! The error type of `impactcal-core`, and the kinds of error shared by every crate.
+//!
+//! The method crates do not define their own variants for faults that are the same on every
+//! path (a wrong length, a NaN, an option out of range, an empty input, a file that cannot be
+//! read): they wrap [`CoreError`], so that a wrong-length input is
+//! [`CoreError::DimensionMismatch`] whichever crate finds it. Every error of the workspace
+//! says its [`ErrorKind`], which is what a program (the `impactcal` command among them)
+//! needs to decide between "fix your input" and "something failed".
 
 use std::error::Error as StdError;
+use std::fmt;
+
+/// What kind of fault an error is, for deciding what to do about it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum ErrorKind {
+    /// The input is wrong (a malformed file, a wrong length, NaN, an impossible option, a
+    /// request the data cannot support): the user can fix it.
+    BadInput,
+    /// A computation failed on valid input (a factorisation that did not converge, a
+    /// singular system, a model run that failed).
+    Numerical,
+    /// The operating system could not read or write a file.
+    Io,
+}
+
+impl fmt::Display for ErrorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ErrorKind::BadInput => "bad input",
+            ErrorKind::Numerical => "numerical failure",
+            ErrorKind::Io => "I/O error",
+        })
+    }
+}
 
 /// Everything that can go wrong in the shared types: reading files, validating parameter
 /// spaces and histories, and running a [`Model`](crate::Model).
@@ -67,6 +99,35 @@ pub enum CoreError {
         /// The offending value.
         value: f64,
     },
+    /// An option or setting outside its admissible range.
+    #[error("option `{name}` = {value}: {message}")]
+    InvalidOption {
+        /// The option, as the user knows it (for example `gamma` or `stopping.patience`).
+        name: String,
+        /// The value given, as text.
+        value: String,
+        /// What is required.
+        message: String,
+    },
+    /// An input with nothing in it where at least one item is needed.
+    #[error("{what} is empty")]
+    Empty {
+        /// The input (for example `training set (N = 0)`).
+        what: String,
+    },
+    /// The header of a table does not hold the columns a reader needs: columns missing, or
+    /// columns it does not know what to do with.
+    #[error("{file}: {}", columns_message(missing, unexpected, expected))]
+    Columns {
+        /// The file.
+        file: String,
+        /// Columns required but absent.
+        missing: Vec<String>,
+        /// Columns present but not expected.
+        unexpected: Vec<String>,
+        /// Every column the reader expects, in order.
+        expected: Vec<String>,
+    },
     /// A channel label that is not present.
     #[error("no channel labelled `{label}` (available: {available})")]
     UnknownLabel {
@@ -91,6 +152,57 @@ impl CoreError {
     pub fn simulation(err: impl StdError + Send + Sync + 'static) -> Self {
         CoreError::Simulation(Box::new(err))
     }
+
+    /// An [`InvalidOption`](CoreError::InvalidOption) error.
+    pub fn invalid_option(
+        name: impl Into<String>,
+        value: impl fmt::Display,
+        message: impl Into<String>,
+    ) -> Self {
+        CoreError::InvalidOption {
+            name: name.into(),
+            value: value.to_string(),
+            message: message.into(),
+        }
+    }
+
+    /// What kind of fault this is: [`ErrorKind::Io`] for [`CoreError::Io`],
+    /// [`ErrorKind::Numerical`] for a failed model run ([`CoreError::Simulation`]), and
+    /// [`ErrorKind::BadInput`] for everything else.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            CoreError::Io { .. } => ErrorKind::Io,
+            CoreError::Simulation(_) => ErrorKind::Numerical,
+            _ => ErrorKind::BadInput,
+        }
+    }
+}
+
+/// The message of [`CoreError::Columns`]: the missing columns, then the unexpected ones.
+fn columns_message(missing: &[String], unexpected: &[String], expected: &[String]) -> String {
+    let list = |names: &[String]| {
+        names
+            .iter()
+            .map(|n| format!("`{n}`"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut parts = Vec::new();
+    match missing.len() {
+        0 => {}
+        1 => parts.push(format!("no column {}", list(missing))),
+        _ => parts.push(format!("no columns {}", list(missing))),
+    }
+    match unexpected.len() {
+        0 => {}
+        1 => parts.push(format!("unexpected column {}", list(unexpected))),
+        _ => parts.push(format!("unexpected columns {}", list(unexpected))),
+    }
+    format!(
+        "{} (the header must name exactly these columns, in any order: {})",
+        parts.join("; "),
+        expected.join(", ")
+    )
 }
 
 /// Checks that every value is finite, naming `what` and the first offending index.
@@ -102,5 +214,84 @@ pub fn check_finite(what: &str, values: &[f64]) -> Result<()> {
             location: format!("index {i}"),
             value: values[i],
         }),
+    }
+}
+
+/// Checks that every entry of a matrix is finite, naming `what` and the first offending
+/// entry (column by column) as `row r, column c (0-based)`.
+///
+/// # Errors
+/// [`CoreError::NonFinite`].
+pub fn check_finite_mat(what: &str, m: faer::MatRef<'_, f64>) -> Result<()> {
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            let value = m[(i, j)];
+            if !value.is_finite() {
+                return Err(CoreError::NonFinite {
+                    what: what.to_string(),
+                    location: format!("row {i}, column {j} (0-based)"),
+                    value,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A configuration checked once into a form that only valid values can take (the
+/// `ParamGuard` pattern of linfa).
+///
+/// An options struct with public fields implements it with `Checked` its validated newtype;
+/// the validated type implements it too (checking nothing), so a function that takes
+/// `impl ParamGuard<Checked = V>` accepts either and works only with `V`.
+pub trait ParamGuard {
+    /// The checked form.
+    type Checked;
+
+    /// Checks the configuration without consuming it.
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] naming the first option out of range.
+    fn check_ref(&self) -> Result<()>;
+
+    /// Checks the configuration and returns its checked form.
+    ///
+    /// # Errors
+    /// As [`check_ref`](Self::check_ref).
+    fn check(self) -> Result<Self::Checked>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_and_column_messages() {
+        let io = CoreError::Io {
+            path: "a.csv".into(),
+            source: std::io::Error::from(std::io::ErrorKind::NotFound),
+        };
+        assert_eq!(io.kind(), ErrorKind::Io);
+        assert_eq!(
+            CoreError::invalid_option("gamma", -1.0, "must be positive").kind(),
+            ErrorKind::BadInput
+        );
+        let e = CoreError::Columns {
+            file: "p.csv".into(),
+            missing: vec!["b".into()],
+            unexpected: vec!["c".into(), "d".into()],
+            expected: vec!["a".into(), "b".into()],
+        };
+        assert_eq!(
+            e.to_string(),
+            "p.csv: no column `b`; unexpected columns `c`, `d` (the header must name exactly \
+             these columns, in any order: a, b)"
+        );
+        let m = faer::Mat::from_fn(2, 2, |i, j| if (i, j) == (1, 1) { f64::NAN } else { 1.0 });
+        let e = check_finite_mat("points", m.as_ref()).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "points: non-finite value NaN at row 1, column 1 (0-based)"
+        );
     }
 }

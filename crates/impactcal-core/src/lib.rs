@@ -2,14 +2,18 @@
 //!
 //! - [`Histories`]: channels x samples on a uniform time base, with labels, read from and
 //!   written to wide CSV (`time,<label>,...`).
-//! - [`ParameterSpace`] and [`Parameter`]: named bounded parameters, the unit-cube map, and
-//!   bounds files `name,lower,upper,nominal[,unit]`.
+//! - [`points`]: the one form of a point set, an `n x d` faer matrix with one point per row,
+//!   and its conversions from and to rows.
+//! - [`ParameterSpace`] and [`Parameter`]: named bounded parameters, the unit-cube map of
+//!   single points and of whole matrices, and bounds files `name,lower,upper,nominal[,unit]`.
 //! - [`Model`]: a parameter vector in, histories out, with parallel batch evaluation.
 //! - [`sampling`]: Halton (plain and scrambled), Sobol' (Joe-Kuo, optionally Owen-scrambled),
 //!   Latin hypercube and symmetric Latin hypercube samples, seeded, mapped onto a space.
 //! - [`Table`]: the numeric CSV reader every file of the project goes through, reporting the
 //!   file, row and column of the first fault.
-//! - [`CoreError`]: the typed error of all of the above.
+//! - [`CoreError`]: the typed error of all of the above, and the kinds of fault shared by
+//!   every crate ([`ErrorKind`]); [`ParamGuard`], how options are checked into a valid form.
+//! - [`test_functions`]: standard test functions with their published constants.
 //!
 //! ```
 //! use impactcal_core::{Histories, Parameter, ParameterSpace};
@@ -29,13 +33,16 @@
 pub mod error;
 pub mod histories;
 pub mod model;
+pub mod points;
 pub mod sampling;
 pub mod space;
 pub mod table;
+pub mod test_functions;
 
-pub use error::{CoreError, Result, check_finite};
+pub use error::{CoreError, ErrorKind, ParamGuard, Result, check_finite, check_finite_mat};
 pub use histories::Histories;
 pub use model::{BatchResults, Model, RunFailure};
-pub use sampling::{Method as SamplingMethod, Points};
+pub use points::PointRows;
+pub use sampling::Method as SamplingMethod;
 pub use space::{Parameter, ParameterSpace};
-pub use table::{Table, TableOptions, read_text};
+pub use table::{Samples, Table, TableOptions, read_samples, read_text};

@@ -4,6 +4,7 @@ use rayon::prelude::*;
 
 use crate::error::{CoreError, Result};
 use crate::histories::Histories;
+use crate::points::PointRows;
 use crate::space::ParameterSpace;
 
 /// A simulation model: a parameter space and a map from a point of it to time histories.
@@ -22,16 +23,21 @@ pub trait Model: Sync {
     /// Whatever the model reports; wrap foreign errors with [`CoreError::simulation`].
     fn simulate(&self, params: &[f64]) -> Result<Histories>;
 
-    /// Runs the model at every point, in parallel with rayon, and returns the outcomes in
+    /// Runs the model at every point (one per row of an `n x dim` matrix, or, for
+    /// convenience, a slice of rows), in parallel with rayon, and returns the outcomes in
     /// input order. A failed run (wrong length, non-finite coordinate or an error from
     /// `simulate`) is reported with its index and does not stop or lose the others.
-    fn simulate_batch(&self, points: &[Vec<f64>]) -> BatchResults {
-        let runs = points
-            .par_iter()
-            .enumerate()
-            .map(|(index, point)| {
-                check_point(self.space(), point)
-                    .and_then(|()| self.simulate(point))
+    fn simulate_batch<'p>(&self, points: impl Into<PointRows<'p>>) -> BatchResults
+    where
+        Self: Sized,
+    {
+        let points = points.into();
+        let runs = (0..points.len())
+            .into_par_iter()
+            .map(|index| {
+                let point = points.point(index);
+                check_point(self.space(), &point)
+                    .and_then(|()| self.simulate(&point))
                     .map_err(|error| RunFailure { index, error })
             })
             .collect();
@@ -149,5 +155,11 @@ mod tests {
             assert_eq!(h, &expect);
         }
         assert_eq!(out.into_all().unwrap_err().index, 7);
+        // The same points as a matrix give the same runs.
+        let good: Vec<Vec<f64>> = (0..6).map(|i| vec![1.0 + i as f64 * 0.1, 2.0]).collect();
+        let x = crate::points::from_rows(&good, "points").unwrap();
+        let by_rows = m.simulate_batch(&good).into_all().unwrap();
+        let by_matrix = m.simulate_batch(x.as_ref()).into_all().unwrap();
+        assert_eq!(by_rows, by_matrix);
     }
 }

@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use faer::{Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
@@ -93,8 +94,11 @@ impl Parameter {
 
 /// An ordered set of named parameters: the design space of a study.
 ///
-/// Points are slices of length [`dim`](Self::dim) in the order of the parameters. The unit
-/// cube map is affine per coordinate, `u_i = (x_i - lower_i) / (upper_i - lower_i)`.
+/// A point is a slice of length [`dim`](Self::dim) in the order of the parameters; a set of
+/// points is an `n x dim` matrix, one point per row. The unit-cube map is affine per
+/// coordinate: with `l_j` and `h_j` the lower and upper bounds of parameter `j`, the unit
+/// coordinate of `x_j` is `u_j = (x_j - l_j) / (h_j - l_j)`, and back
+/// `x_j = l_j + u_j (h_j - l_j)`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "Vec<Parameter>", into = "Vec<Parameter>")]
 pub struct ParameterSpace {
@@ -183,8 +187,9 @@ impl ParameterSpace {
                 .all(|(p, &v)| v >= p.lower && v <= p.upper)
     }
 
-    /// Maps a point of the box to the unit cube: `u_i = (x_i - l_i) / (u_i - l_i)`.
-    /// Points outside the box map outside `[0, 1]` (no clamping).
+    /// Maps a point of the box to the unit cube: `u_j = (x_j - l_j) / (h_j - l_j)` with `l_j`
+    /// and `h_j` the bounds of parameter `j`. Points outside the box map outside `[0, 1]`
+    /// (no clamping).
     ///
     /// # Errors
     /// [`CoreError::DimensionMismatch`] for a wrong length, [`CoreError::NonFinite`] for
@@ -199,7 +204,7 @@ impl ParameterSpace {
             .collect())
     }
 
-    /// Maps a point of the unit cube to the box: `x_i = l_i + u_i (u_i - l_i)`.
+    /// Maps a point of the unit cube to the box: `x_j = l_j + u_j (h_j - l_j)`.
     ///
     /// # Errors
     /// As [`to_unit`](Self::to_unit).
@@ -211,6 +216,55 @@ impl ParameterSpace {
             .zip(u)
             .map(|(p, &v)| p.lower + v * p.width())
             .collect())
+    }
+
+    /// Maps every point (row) of `x`, an `n x dim` matrix in the box's units, to the unit
+    /// cube: entry `(i, j)` becomes `(x_ij - l_j) / (h_j - l_j)`. Points outside the box
+    /// map outside `[0, 1]` (no clamping). Bit for bit the same as [`to_unit`](Self::to_unit)
+    /// row by row.
+    ///
+    /// # Errors
+    /// [`CoreError::DimensionMismatch`] when `x` has not `dim` columns;
+    /// [`CoreError::NonFinite`] naming the row and parameter of a NaN or infinite entry.
+    pub fn to_unit_matrix(&self, x: MatRef<'_, f64>) -> Result<Mat<f64>> {
+        self.check_matrix("points", x)?;
+        let p = &self.parameters;
+        Ok(Mat::from_fn(x.nrows(), x.ncols(), |i, j| {
+            (x[(i, j)] - p[j].lower) / p[j].width()
+        }))
+    }
+
+    /// Maps every point (row) of `u`, an `n x dim` matrix of unit-cube coordinates, to the
+    /// box: entry `(i, j)` becomes `l_j + u_ij (h_j - l_j)`.
+    ///
+    /// # Errors
+    /// As [`to_unit_matrix`](Self::to_unit_matrix).
+    pub fn from_unit_matrix(&self, u: MatRef<'_, f64>) -> Result<Mat<f64>> {
+        self.check_matrix("unit-cube points", u)?;
+        let p = &self.parameters;
+        Ok(Mat::from_fn(u.nrows(), u.ncols(), |i, j| {
+            p[j].lower + u[(i, j)] * p[j].width()
+        }))
+    }
+
+    fn check_matrix(&self, what: &str, x: MatRef<'_, f64>) -> Result<()> {
+        if x.ncols() != self.dim() {
+            return Err(CoreError::DimensionMismatch {
+                what: format!("{what}: number of columns (parameters)"),
+                expected: self.dim(),
+                found: x.ncols(),
+            });
+        }
+        for j in 0..x.ncols() {
+            if let Some(i) = x.col(j).iter().position(|v| !v.is_finite()) {
+                return Err(CoreError::NonFinite {
+                    what: what.to_string(),
+                    location: format!("row {i} (0-based), parameter `{}`", self.parameters[j].name),
+                    value: x[(i, j)],
+                });
+            }
+        }
+        Ok(())
     }
 
     fn check_point(&self, what: &str, x: &[f64]) -> Result<()> {
@@ -429,6 +483,31 @@ mod tests {
         assert_eq!(back, s);
         let bad = json.replace("\"upper\":3.0", "\"upper\":-2.0");
         assert!(serde_json::from_str::<ParameterSpace>(&bad).is_err());
+    }
+
+    #[test]
+    fn matrix_maps_equal_the_point_maps() {
+        let s = space();
+        let x = faer::Mat::from_fn(5, 2, |i, j| [-1.0, 10.0][j] + 0.37 * (i * (j + 2)) as f64);
+        let u = s.to_unit_matrix(x.as_ref()).unwrap();
+        for i in 0..5 {
+            let row: Vec<f64> = x.row(i).iter().copied().collect();
+            let expected = s.to_unit(&row).unwrap();
+            let got: Vec<f64> = u.row(i).iter().copied().collect();
+            assert_eq!(got, expected);
+            let back: Vec<f64> = s.from_unit_matrix(u.as_ref()).unwrap().row(i).iter().copied().collect();
+            assert_eq!(back, s.from_unit(&expected).unwrap());
+        }
+        assert!(matches!(
+            s.to_unit_matrix(faer::Mat::<f64>::zeros(2, 3).as_ref()),
+            Err(CoreError::DimensionMismatch { expected: 2, found: 3, .. })
+        ));
+        let mut bad = x.clone();
+        bad[(3, 1)] = f64::NAN;
+        match s.to_unit_matrix(bad.as_ref()).unwrap_err() {
+            CoreError::NonFinite { location, .. } => assert!(location.contains("`b`")),
+            e => panic!("unexpected {e}"),
+        }
     }
 
     proptest! {

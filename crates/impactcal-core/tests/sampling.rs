@@ -5,7 +5,9 @@ use impactcal_core::sampling::{
     Halton, Method, SamplingWarning, Sobol, latin_hypercube, sample, seeded_rng,
     symmetric_latin_hypercube, unit_sample,
 };
-use impactcal_core::{Parameter, ParameterSpace, Points};
+use faer::Mat;
+use impactcal_core::points::{column, row, to_rows};
+use impactcal_core::{Parameter, ParameterSpace};
 use proptest::prelude::*;
 
 /// scipy.stats.qmc.Sobol(d=2048, scramble=False): selected dimensions, points 0..64 and
@@ -27,7 +29,7 @@ fn plain_sobol_equals_scipy() {
         let expected: Vec<f64> = fields
             .map(|v| v.parse::<f64>().unwrap() / 4_294_967_296.0)
             .collect();
-        assert_eq!(block.column(dim), expected, "dimension {dim}");
+        assert_eq!(column(block.as_ref(), dim), expected, "dimension {dim}");
         checked += 1;
     }
     assert_eq!(checked, 16);
@@ -37,8 +39,9 @@ fn plain_sobol_equals_scipy() {
 #[test]
 fn plain_halton_equals_scipy() {
     let p = Halton::new(12).unwrap().points(0, 8);
+    let p = p.as_ref();
     assert_eq!(
-        p.column(0),
+        column(p, 0),
         [0.0, 0.5, 0.25, 0.75, 0.125, 0.625, 0.375, 0.875]
     );
     let third = 1.0 / 3.0;
@@ -52,10 +55,10 @@ fn plain_halton_equals_scipy() {
         2.0 / 9.0,
         5.0 / 9.0,
     ];
-    for (x, e) in p.column(1).iter().zip(expected) {
+    for (x, e) in column(p, 1).iter().zip(expected) {
         assert!((x - e).abs() < 1e-15);
     }
-    for (i, x) in p.column(11).iter().enumerate() {
+    for (i, x) in column(p, 11).iter().enumerate() {
         assert!((x - i as f64 / 37.0).abs() < 1e-15);
     }
 }
@@ -72,8 +75,8 @@ fn correlation(x: &[f64], y: &[f64]) -> f64 {
     sxy / (sxx * syy).sqrt()
 }
 
-fn max_abs_correlation(p: &Points) -> f64 {
-    let cols: Vec<Vec<f64>> = (0..p.dim()).map(|j| p.column(j)).collect();
+fn max_abs_correlation(p: &Mat<f64>) -> f64 {
+    let cols: Vec<Vec<f64>> = (0..p.ncols()).map(|j| column(p.as_ref(), j)).collect();
     let mut worst: f64 = 0.0;
     for i in 0..cols.len() {
         for j in i + 1..cols.len() {
@@ -88,7 +91,7 @@ fn max_abs_correlation(p: &Points) -> f64 {
 #[test]
 fn scrambling_removes_halton_correlation() {
     let plain = unit_sample(Method::Halton, 50, 12, 0).unwrap().points;
-    let pair = correlation(&plain.column(9), &plain.column(10));
+    let pair = correlation(&column(plain.as_ref(), 9), &column(plain.as_ref(), 10));
     assert!(pair > 0.7, "plain Halton corr(29, 31) = {pair}");
     assert!(max_abs_correlation(&plain) > 0.7);
     // 20 dimensions: bases 67 and 71 are almost collinear in the first 50 points.
@@ -98,7 +101,7 @@ fn scrambling_removes_halton_correlation() {
         let s = unit_sample(Method::ScrambledHalton, 50, 12, seed)
             .unwrap()
             .points;
-        let pair = correlation(&s.column(9), &s.column(10)).abs();
+        let pair = correlation(&column(s.as_ref(), 9), &column(s.as_ref(), 10)).abs();
         assert!(pair < 0.45, "seed {seed}: scrambled corr(29, 31) = {pair}");
         let s20 = unit_sample(Method::ScrambledHalton, 50, 20, seed)
             .unwrap()
@@ -107,15 +110,15 @@ fn scrambling_removes_halton_correlation() {
     }
 }
 
-fn assert_latin(p: &Points) {
-    for j in 0..p.dim() {
-        let mut cells: Vec<usize> = p
-            .column(j)
+fn assert_latin(p: &Mat<f64>) {
+    let n = p.nrows();
+    for j in 0..p.ncols() {
+        let mut cells: Vec<usize> = column(p.as_ref(), j)
             .iter()
-            .map(|x| (x * p.n() as f64) as usize)
+            .map(|x| (x * n as f64) as usize)
             .collect();
         cells.sort_unstable();
-        assert_eq!(cells, (0..p.n()).collect::<Vec<_>>(), "dimension {j}");
+        assert_eq!(cells, (0..n).collect::<Vec<_>>(), "dimension {j}");
     }
 }
 
@@ -127,10 +130,10 @@ proptest! {
         assert_latin(&s);
         for i in 0..n {
             for j in 0..dim {
-                let mirrored = 1.0 - s.row(n - 1 - i)[j];
-                prop_assert!((s.row(i)[j] - mirrored).abs() < 1e-12);
+                let mirrored = 1.0 - row(s.as_ref(), n - 1 - i)[j];
+                prop_assert!((row(s.as_ref(), i)[j] - mirrored).abs() < 1e-12);
                 // Cell centres.
-                let k = s.row(i)[j] * n as f64 - 0.5;
+                let k = row(s.as_ref(), i)[j] * n as f64 - 0.5;
                 prop_assert!((k - k.round()).abs() < 1e-9);
             }
         }
@@ -148,8 +151,8 @@ proptest! {
             Parameter::new("c", 0.0, 1.0, 0.5).unwrap(),
         ]).unwrap();
         let s = sample(&space, method, n, seed).unwrap();
-        prop_assert_eq!(s.points.n(), n);
-        prop_assert!(s.points.rows().all(|x| space.contains(x) && x[1] < 10.5));
+        prop_assert_eq!(s.points.nrows(), n);
+        prop_assert!(to_rows(s.points.as_ref()).iter().all(|x| space.contains(x) && x[1] < 10.5));
         prop_assert_eq!(&s, &sample(&space, method, n, seed).unwrap());
         let sobol = matches!(method, Method::Sobol | Method::ScrambledSobol);
         prop_assert_eq!(s.warnings.len(), usize::from(sobol && !n.is_power_of_two()));
@@ -200,7 +203,7 @@ fn scrambled_sobol_integrates_accurately() {
             .unwrap()
             .points;
         let mean = p
-            .rows()
+            .row_iter()
             .map(|x| x.iter().map(|v| 0.5 + v).product::<f64>())
             .sum::<f64>()
             / 4096.0;

@@ -21,7 +21,7 @@ pub fn symmetric_design(n: usize, dim: usize, seed: u64) -> Result<Vec<Vec<f64>>
     let mut rng = seeded_rng(seed);
     let mut best: Option<(bool, f64, Vec<Vec<f64>>)> = None;
     for _ in 0..DESIGN_TRIES {
-        let pts = symmetric_latin_hypercube(n, dim, &mut rng)?.to_rows();
+        let pts = impactcal_core::points::to_rows(symmetric_latin_hypercube(n, dim, &mut rng)?.as_ref());
         let spans = affine_rank(&pts) == dim + 1;
         let sep = min_pairwise_distance(&pts);
         let better = match &best {

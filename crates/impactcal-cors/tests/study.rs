@@ -178,15 +178,17 @@ fn warm_start_replaces_the_design_and_improves() {
     // The source study: 50 existing runs, then 60 more.
     let f = test_functions::by_name("hartmann6").unwrap();
     let space = f.space().unwrap();
-    let existing = impactcal_core::sampling::sample(
-        &space,
-        impactcal_core::SamplingMethod::LatinHypercube,
-        50,
-        11,
-    )
-    .unwrap()
-    .points
-    .to_rows();
+    let existing = impactcal_core::points::to_rows(
+        impactcal_core::sampling::sample(
+            &space,
+            impactcal_core::SamplingMethod::LatinHypercube,
+            50,
+            11,
+        )
+        .unwrap()
+        .points
+        .as_ref(),
+    );
     let values: Vec<f64> = existing.iter().map(|x| f.eval(x)).collect();
     let best_existing = values.iter().copied().fold(f64::INFINITY, f64::min);
     // The source study's method: the 2005 pattern over the whole box in every cycle.

@@ -1,74 +1,20 @@
 //! Sobol' indices of every output column of a Saltelli design, in one pass.
 
+use faer::MatRef;
 use rand::Rng;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::accumulate::{self, Plan, Weights};
 use crate::design::DesignLayout;
-use crate::error::{Result, SobolError};
+use crate::error::{Result, SobolError, invalid_option, mismatch};
 use crate::estimators::{
     FirstOrderEstimator, ParamMoments, SharedMoments, TotalEstimator, first_order,
     needs_full_moments, total,
 };
-use crate::kernel::{self, Plan, Weights};
 use crate::stats::{percentile_sorted, sample_sd};
-
-/// A borrowed row-major matrix of model outputs: one row per model run (in the design's
-/// row order), one column per output (a time step, a channel, a scalar metric).
-#[derive(Debug, Clone, Copy)]
-pub struct OutputView<'a> {
-    data: &'a [f64],
-    rows: usize,
-    cols: usize,
-}
-
-impl<'a> OutputView<'a> {
-    /// Wraps `data` as `rows x cols`, row-major.
-    ///
-    /// # Errors
-    /// [`SobolError::Mismatch`] when `data.len() != rows * cols` or `cols == 0`.
-    pub fn new(data: &'a [f64], rows: usize, cols: usize) -> Result<Self> {
-        if cols == 0 || rows.checked_mul(cols) != Some(data.len()) {
-            return Err(SobolError::Mismatch {
-                what: format!("output data length for {rows} rows x {cols} columns"),
-                expected: rows.saturating_mul(cols.max(1)),
-                found: data.len(),
-            });
-        }
-        Ok(OutputView { data, rows, cols })
-    }
-
-    /// A single output column (a scalar output per run).
-    pub fn column(data: &'a [f64]) -> Self {
-        OutputView {
-            data,
-            rows: data.len(),
-            cols: 1,
-        }
-    }
-
-    /// Rows (model runs).
-    pub fn rows(&self) -> usize {
-        self.rows
-    }
-
-    /// Columns (outputs).
-    pub fn cols(&self) -> usize {
-        self.cols
-    }
-
-    /// The row-major data.
-    pub fn data(&self) -> &'a [f64] {
-        self.data
-    }
-
-    /// Row `r`. Panics when out of range.
-    pub fn row(&self, r: usize) -> &'a [f64] {
-        &self.data[r * self.cols..(r + 1) * self.cols]
-    }
-}
 
 /// How to estimate: estimators, bootstrap, the low-variance threshold and names.
 #[derive(Debug, Clone, PartialEq)]
@@ -227,76 +173,81 @@ impl Estimates {
     }
 }
 
-fn validate(layout: &DesignLayout, outputs: &OutputView<'_>, o: &SobolOptions) -> Result<()> {
-    if outputs.rows() != layout.rows() {
+fn validate(layout: &DesignLayout, outputs: MatRef<'_, f64>, o: &SobolOptions) -> Result<()> {
+    if outputs.nrows() != layout.rows() {
         return Err(SobolError::RowCount {
-            rows: outputs.rows(),
+            rows: outputs.nrows(),
             d: layout.d(),
             detail: format!(
                 "the design has {} rows ({} base rows x {}); the outputs have {}",
                 layout.rows(),
                 layout.n(),
                 layout.stride(),
-                outputs.rows()
+                outputs.nrows()
             ),
         });
     }
+    if outputs.ncols() == 0 {
+        return Err(mismatch("output columns, at least", 1, 0));
+    }
     if !(o.confidence > 0.0 && o.confidence < 1.0) {
-        return Err(SobolError::InvalidOption(format!(
-            "the confidence level must lie in (0, 1); {} given",
-            o.confidence
-        )));
+        return Err(invalid_option(
+            "confidence",
+            o.confidence,
+            "the confidence level must lie in (0, 1)",
+        ));
     }
     if o.bootstrap == 1 {
-        return Err(SobolError::InvalidOption(
-            "a bootstrap needs at least 2 resamples (or 0 for none)".into(),
+        return Err(invalid_option(
+            "bootstrap",
+            o.bootstrap,
+            "a bootstrap needs at least 2 resamples (or 0 for none)",
         ));
     }
     if !(o.low_variance_tolerance >= 0.0 && o.low_variance_tolerance.is_finite()) {
-        return Err(SobolError::InvalidOption(format!(
-            "the low-variance tolerance must be finite and non-negative; {} given",
-            o.low_variance_tolerance
-        )));
+        return Err(invalid_option(
+            "low_variance_tolerance",
+            o.low_variance_tolerance,
+            "the low-variance tolerance must be finite and non-negative",
+        ));
     }
     if let Some(names) = &o.parameter_names
         && names.len() != layout.d()
     {
-        return Err(SobolError::Mismatch {
-            what: "number of parameter names".into(),
-            expected: layout.d(),
-            found: names.len(),
-        });
+        return Err(mismatch(
+            "number of parameter names",
+            layout.d(),
+            names.len(),
+        ));
     }
     if let Some(names) = &o.output_names
-        && names.len() != outputs.cols()
+        && names.len() != outputs.ncols()
     {
-        return Err(SobolError::Mismatch {
-            what: "number of output names".into(),
-            expected: outputs.cols(),
-            found: names.len(),
-        });
+        return Err(mismatch(
+            "number of output names",
+            outputs.ncols(),
+            names.len(),
+        ));
     }
     Ok(())
 }
 
 /// Column means over all rows (the centring of SALib), checking that every value is finite.
-fn column_means(outputs: &OutputView<'_>) -> Result<Vec<f64>> {
+/// Rows are summed in order within chunks of [`CHUNK`] rows, and the chunk sums in order, so
+/// the result does not depend on the number of threads.
+fn column_means(outputs: MatRef<'_, f64>) -> Result<Vec<f64>> {
     const CHUNK: usize = 2048;
-    let cols = outputs.cols();
-    let partial: Vec<std::result::Result<Vec<f64>, SobolError>> = outputs
-        .data()
-        .par_chunks(CHUNK * cols)
-        .enumerate()
-        .map(|(c, block)| {
+    let cols = outputs.ncols();
+    let rows = outputs.nrows();
+    let partial: Vec<std::result::Result<Vec<f64>, SobolError>> = (0..rows.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
             let mut sums = vec![0.0; cols];
-            for (r, row) in block.chunks_exact(cols).enumerate() {
-                for (t, (s, &v)) in sums.iter_mut().zip(row).enumerate() {
+            for r in c * CHUNK..rows.min((c + 1) * CHUNK) {
+                let row = outputs.row(r);
+                for (t, (s, &v)) in sums.iter_mut().zip(row.iter()).enumerate() {
                     if !v.is_finite() {
-                        return Err(SobolError::NonFiniteOutput {
-                            row: c * CHUNK + r,
-                            column: t,
-                            value: v,
-                        });
+                        return Err(non_finite_output(r, t, v));
                     }
                     *s += v;
                 }
@@ -310,9 +261,19 @@ fn column_means(outputs: &OutputView<'_>) -> Result<Vec<f64>> {
             *m += s;
         }
     }
-    let rows = outputs.rows() as f64;
+    let rows = rows as f64;
     means.iter_mut().for_each(|m| *m /= rows);
     Ok(means)
+}
+
+/// The error of a NaN or infinite model output at `row`, `column` (0-based).
+pub(crate) fn non_finite_output(row: usize, column: usize, value: f64) -> SobolError {
+    impactcal_core::CoreError::NonFinite {
+        what: "model outputs".into(),
+        location: format!("row {row}, column {column} (0-based)"),
+        value,
+    }
+    .into()
 }
 
 /// Multinomial resampling counts of the base rows, resample `g` from its own ChaCha8
@@ -345,6 +306,11 @@ fn resample_weights(n: usize, resamples: usize, seed: u64) -> Weights {
 /// Estimates first-order, total and (when the layout has them) second-order Sobol' indices
 /// of every output column, with bootstrap intervals when `options.bootstrap > 0`.
 ///
+/// `outputs` is `layout.rows() x T`: one row per model run, in the design's row order, one
+/// column per output (a time step, a channel, a scalar metric). Any faer view is accepted;
+/// a row-major one (for example `MatRef::from_row_major_slice` over a CSV's rows) is read in
+/// place, and so is a single column (`ColRef::from_slice(&y).as_mat()`).
+///
 /// The outputs are centred by their column means over all rows first (as SALib does; the
 /// estimators that multiply outputs are otherwise sensitive to large offsets). One pass over
 /// the data accumulates, per column and parameter, the sums that every estimator needs; the
@@ -354,18 +320,21 @@ fn resample_weights(n: usize, resamples: usize, seed: u64) -> Weights {
 /// `O((B + 1) T (d + P))`; the outputs are never copied.
 ///
 /// # Errors
-/// [`SobolError::RowCount`] when the outputs do not have `layout.rows()` rows;
-/// [`SobolError::NonFiniteOutput`] for NaN or infinite outputs (first in row order);
-/// [`SobolError::InvalidOption`] for a confidence outside (0, 1), one bootstrap resample,
-/// or a negative tolerance; [`SobolError::Mismatch`] for name lists of the wrong length.
+/// [`SobolError::RowCount`] when the outputs do not have `layout.rows()` rows; and, under
+/// [`SobolError::Core`]: [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for
+/// NaN or infinite outputs (the first in row order, naming row and column),
+/// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a confidence
+/// outside (0, 1), one bootstrap resample, or a negative tolerance,
+/// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) for no
+/// output column or name lists of the wrong length.
 pub fn analyze(
     layout: &DesignLayout,
-    outputs: OutputView<'_>,
+    outputs: MatRef<'_, f64>,
     options: &SobolOptions,
 ) -> Result<SobolIndices> {
-    validate(layout, &outputs, options)?;
-    let (d, n, cols) = (layout.d(), layout.n(), outputs.cols());
-    let centre = column_means(&outputs)?;
+    validate(layout, outputs, options)?;
+    let (d, n, cols) = (layout.d(), layout.n(), outputs.ncols());
+    let centre = column_means(outputs)?;
     let pairs: Vec<(usize, usize)> = if layout.second_order() {
         (0..d)
             .flat_map(|i| (i + 1..d).map(move |k| (i, k)))
@@ -379,7 +348,7 @@ pub fn analyze(
         pairs,
     };
     let weights = resample_weights(n, options.bootstrap, options.seed);
-    let items = kernel::accumulate(&plan, outputs.data(), cols, &centre, &weights);
+    let items = accumulate::accumulate(&plan, outputs, &centre, &weights);
     let est = estimates_from_sums(&plan, options, &items, weights.groups, cols);
     Ok(assemble(&plan, options, &est, cols))
 }
@@ -387,7 +356,7 @@ pub fn analyze(
 fn estimates_from_sums(
     plan: &Plan,
     options: &SobolOptions,
-    items: &[kernel::ItemSums],
+    items: &[accumulate::ItemSums],
     groups: usize,
     cols: usize,
 ) -> Estimates {

@@ -1,9 +1,10 @@
 //! The Saltelli (pick-freeze) design and its row layout.
 
+use faer::{Mat, MatRef};
 use impactcal_core::ParameterSpace;
-use impactcal_core::sampling::{Method, Points, SamplingWarning, to_space, unit_sample};
+use impactcal_core::sampling::{Method, SamplingWarning, unit_sample};
 
-use crate::error::{Result, SobolError};
+use crate::error::{Result, SobolError, invalid_option, mismatch};
 
 /// Where each model run of a Saltelli design sits: the row layout shared with SALib's
 /// `sample.sobol` / `sample.saltelli` and `analyze.sobol`.
@@ -33,18 +34,22 @@ impl DesignLayout {
     /// The layout of `n` base rows and `d` parameters.
     ///
     /// # Errors
-    /// [`SobolError::InvalidOption`] when `n < 2` or `d == 0`;
-    /// [`SobolError::TooSmallForSecondOrder`] when `second_order` and `d < 2`.
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) when `n < 2`
+    /// or `d == 0`; [`SobolError::TooSmallForSecondOrder`] when `second_order` and `d < 2`.
     pub fn new(n: usize, d: usize, second_order: bool) -> Result<Self> {
         if d == 0 {
-            return Err(SobolError::InvalidOption(
-                "a design needs at least one parameter".into(),
+            return Err(invalid_option(
+                "parameters",
+                d,
+                "a design needs at least one parameter",
             ));
         }
         if n < 2 {
-            return Err(SobolError::InvalidOption(format!(
-                "a design needs at least 2 base rows to estimate a variance; {n} given"
-            )));
+            return Err(invalid_option(
+                "base rows",
+                n,
+                "a design needs at least 2 base rows to estimate a variance",
+            ));
         }
         if second_order && d < 2 {
             return Err(SobolError::TooSmallForSecondOrder {
@@ -63,8 +68,10 @@ impl DesignLayout {
     /// [`DesignLayout::new`].
     pub fn from_rows(rows: usize, d: usize, second_order: bool) -> Result<Self> {
         if d == 0 {
-            return Err(SobolError::InvalidOption(
-                "a design needs at least one parameter".into(),
+            return Err(invalid_option(
+                "parameters",
+                d,
+                "a design needs at least one parameter",
             ));
         }
         let stride = if second_order { 2 * d + 2 } else { d + 2 };
@@ -149,25 +156,28 @@ impl DesignLayout {
         j * self.stride() + 1 + self.d + i
     }
 
-    /// The design rows assembled from the two base samples `a` and `b` (`N x d` each).
+    /// The design rows (`rows() x d`, one model run per row) assembled from the two base
+    /// samples `a` and `b` (`N x d` each, one point per row).
     ///
     /// # Errors
-    /// [`SobolError::Mismatch`] when `a` or `b` is not `N x d`.
-    pub fn assemble(&self, a: &Points, b: &Points) -> Result<Points> {
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when
+    /// `a` or `b` is not `N x d`.
+    pub fn assemble(&self, a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<Mat<f64>> {
         for (name, m) in [("A", a), ("B", b)] {
-            if m.n() != self.n || m.dim() != self.d {
-                return Err(SobolError::Mismatch {
-                    what: format!("shape of base sample {name} (rows x parameters)"),
-                    expected: self.n * self.d,
-                    found: m.n() * m.dim(),
-                });
+            if m.nrows() != self.n || m.ncols() != self.d {
+                return Err(mismatch(
+                    format!("shape of base sample {name} (rows x parameters)"),
+                    self.n * self.d,
+                    m.nrows() * m.ncols(),
+                ));
             }
         }
         let d = self.d;
         let mut data = Vec::with_capacity(self.rows() * d);
         for j in 0..self.n {
-            let (ra, rb) = (a.row(j), b.row(j));
-            data.extend_from_slice(ra);
+            let ra: Vec<f64> = a.row(j).iter().copied().collect();
+            let rb: Vec<f64> = b.row(j).iter().copied().collect();
+            data.extend_from_slice(&ra);
             for i in 0..d {
                 data.extend(
                     ra.iter()
@@ -184,12 +194,17 @@ impl DesignLayout {
                     );
                 }
             }
-            data.extend_from_slice(rb);
+            data.extend_from_slice(&rb);
         }
-        Ok(Points::new(self.rows(), d, data)?)
+        Ok(impactcal_core::points::from_row_major(
+            self.rows(),
+            d,
+            &data,
+        )?)
     }
 
-    /// Checks that `points` has the pick-freeze structure of this layout: every `AB_i` row
+    /// Checks that `points` (`rows() x d`, one model run per row) has the pick-freeze
+    /// structure of this layout: every `AB_i` row
     /// equals its `A` row except in parameter `i`, where it equals the `B` row, and likewise
     /// for `BA_i`. This catches parameter files whose rows were shuffled, truncated or made
     /// for another layout (outputs are matched to parameters by row position only).
@@ -198,22 +213,25 @@ impl DesignLayout {
     /// 10 or more significant digits pass.
     ///
     /// # Errors
-    /// [`SobolError::Mismatch`] for a wrong shape; [`SobolError::DesignStructure`] naming the
-    /// first row and parameter that break the pattern.
-    pub fn check_points(&self, points: &Points) -> Result<()> {
-        if points.n() != self.rows() || points.dim() != self.d {
-            return Err(SobolError::Mismatch {
-                what: format!(
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) for a
+    /// wrong shape; [`SobolError::DesignStructure`] naming the first row and parameter that
+    /// break the pattern.
+    pub fn check_points(&self, points: MatRef<'_, f64>) -> Result<()> {
+        if points.nrows() != self.rows() || points.ncols() != self.d {
+            return Err(mismatch(
+                format!(
                     "parameter matrix shape (rows x parameters) for {} base rows",
                     self.n
                 ),
-                expected: self.rows() * self.d,
-                found: points.n() * points.dim(),
-            });
+                self.rows() * self.d,
+                points.nrows() * points.ncols(),
+            ));
         }
         let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(y.abs());
+        let row = |r: usize| -> Vec<f64> { points.row(r).iter().copied().collect() };
         for j in 0..self.n {
-            let (a, b) = (points.row(self.a_row(j)), points.row(self.b_row(j)));
+            let (a, b) = (row(self.a_row(j)), row(self.b_row(j)));
+            let (a, b) = (a.as_slice(), b.as_slice());
             let mut blocks = vec![("AB", a, b, 0)];
             if self.second_order {
                 blocks.push(("BA", b, a, self.d));
@@ -221,7 +239,7 @@ impl DesignLayout {
             for (name, base, donor, offset) in blocks {
                 for i in 0..self.d {
                     let row = j * self.stride() + 1 + offset + i;
-                    let r = points.row(row);
+                    let r: Vec<f64> = points.row(row).iter().copied().collect();
                     for k in 0..self.d {
                         let (expected, source) = if k == i {
                             (donor[k], if name == "AB" { "B" } else { "A" })
@@ -268,8 +286,9 @@ impl DesignLayout {
 pub struct SaltelliDesign {
     /// The row layout.
     pub layout: DesignLayout,
-    /// `layout.rows()` points in parameter units, in the layout's order.
-    pub points: Points,
+    /// `layout.rows() x d`: one model run per row, in parameter units, in the layout's
+    /// order.
+    pub points: Mat<f64>,
     /// Warnings of the base sample (for example a Sobol' size that is not a power of two).
     pub warnings: Vec<SamplingWarning>,
 }
@@ -290,16 +309,11 @@ impl SaltelliDesign {
         let d = space.dim();
         let layout = DesignLayout::new(n, d, second_order)?;
         let base = unit_sample(method, n, 2 * d, seed)?;
-        let mut a = Vec::with_capacity(n * d);
-        let mut b = Vec::with_capacity(n * d);
-        for row in base.points.rows() {
-            a.extend_from_slice(&row[..d]);
-            b.extend_from_slice(&row[d..]);
-        }
-        let unit = layout.assemble(&Points::new(n, d, a)?, &Points::new(n, d, b)?)?;
+        let (a, b) = (base.points.subcols(0, d), base.points.subcols(d, d));
+        let unit = layout.assemble(a, b)?;
         Ok(SaltelliDesign {
             layout,
-            points: to_space(space, &unit)?,
+            points: space.from_unit_matrix(unit.as_ref())?,
             warnings: base.warnings,
         })
     }

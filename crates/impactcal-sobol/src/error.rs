@@ -1,15 +1,19 @@
 //! The error type of `impactcal-sobol`.
 
-use impactcal_core::CoreError;
+use impactcal_core::{CoreError, ErrorKind};
 
 /// Everything that can go wrong when building a design or estimating indices.
 ///
 /// Row and column numbers are 0-based positions in the design (row `r` is the `r`-th model
-/// run in the SALib order) and in the output matrix.
+/// run in the SALib order) and in the output matrix. Faults shared with the other crates (a
+/// wrong size, a non-finite output, an option out of range) are [`CoreError`]s, under
+/// [`SobolError::Core`].
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SobolError {
-    /// An error of the shared types (parameter spaces, sampling, tables).
+    /// A fault of a kind shared by every crate ([`CoreError::DimensionMismatch`],
+    /// [`CoreError::NonFinite`], [`CoreError::InvalidOption`]), or of the shared types
+    /// (parameter spaces, sampling, tables).
     #[error(transparent)]
     Core(#[from] CoreError),
     /// The number of rows is not `N (d + 2)` (or `N (2d + 2)` with second order).
@@ -21,26 +25,6 @@ pub enum SobolError {
         d: usize,
         /// What was expected, and a hint.
         detail: String,
-    },
-    /// A matrix has the wrong number of columns or rows for its partner.
-    #[error("{what}: expected {expected}, found {found}")]
-    Mismatch {
-        /// What does not match.
-        what: String,
-        /// The size required.
-        expected: usize,
-        /// The size given.
-        found: usize,
-    },
-    /// A NaN or infinite model output.
-    #[error("output row {row}, column {column}: non-finite value {value}")]
-    NonFiniteOutput {
-        /// 0-based row (model run).
-        row: usize,
-        /// 0-based output column.
-        column: usize,
-        /// The value.
-        value: f64,
     },
     /// Second-order indices asked of a design that cannot give them.
     #[error("second-order indices need {needs}; the design has {has}")]
@@ -60,10 +44,37 @@ pub enum SobolError {
         /// What is wrong.
         detail: String,
     },
-    /// An option out of its range.
-    #[error("invalid option: {0}")]
-    InvalidOption(String),
 }
 
 /// `Result` with [`SobolError`].
 pub type Result<T, E = SobolError> = std::result::Result<T, E>;
+
+impl SobolError {
+    /// What kind of fault this is: that of the [`CoreError`] it wraps, else
+    /// [`ErrorKind::BadInput`] (a design of the wrong size or structure).
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            SobolError::Core(e) => e.kind(),
+            _ => ErrorKind::BadInput,
+        }
+    }
+}
+
+/// An [`InvalidOption`](CoreError::InvalidOption) error as a [`SobolError`].
+pub(crate) fn invalid_option(
+    name: &str,
+    value: impl std::fmt::Display,
+    message: impl Into<String>,
+) -> SobolError {
+    CoreError::invalid_option(name, value, message).into()
+}
+
+/// A [`DimensionMismatch`](CoreError::DimensionMismatch) error as a [`SobolError`].
+pub(crate) fn mismatch(what: impl Into<String>, expected: usize, found: usize) -> SobolError {
+    CoreError::DimensionMismatch {
+        what: what.into(),
+        expected,
+        found,
+    }
+    .into()
+}

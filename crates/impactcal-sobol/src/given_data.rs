@@ -1,11 +1,11 @@
 //! First-order indices from one existing sample (no pick-freeze design).
 
-use impactcal_core::Points;
+use faer::MatRef;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::analysis::OutputView;
-use crate::error::{Result, SobolError};
+use crate::analysis::non_finite_output;
+use crate::error::{Result, invalid_option, mismatch};
 
 /// Options of [`given_data_first_order`].
 #[derive(Debug, Clone, PartialEq)]
@@ -69,58 +69,56 @@ pub struct GivenDataIndices {
     pub low_variance_outputs: Vec<String>,
 }
 
-/// Estimates first-order indices of every output column from runs `x` (one row per run, in
-/// any design: Halton, Latin hypercube, an existing ensemble) and their `outputs` (same
-/// rows). See [`GivenDataIndices`] for the estimator.
+/// Estimates first-order indices of every output column from runs `x` (`n x d`, one run per
+/// row, in any design: Halton, Latin hypercube, an existing ensemble) and their `outputs`
+/// (`n x T`, same rows). See [`GivenDataIndices`] for the estimator.
 ///
 /// # Errors
-/// [`SobolError::Mismatch`] when the row counts differ or a name list has the wrong
-/// length; [`SobolError::InvalidOption`] when there are fewer than 2 runs per bin or fewer
-/// than 2 bins; [`SobolError::NonFiniteOutput`] for NaN or infinite outputs.
+/// Under [`SobolError::Core`]:
+/// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when the
+/// row counts differ, there is no output column, or a name list has the wrong length;
+/// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) when there are
+/// fewer than 2 runs per bin or fewer than 2 bins;
+/// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for NaN or infinite
+/// outputs or parameter values, naming row and column.
 pub fn given_data_first_order(
-    x: &Points,
-    outputs: OutputView<'_>,
+    x: MatRef<'_, f64>,
+    outputs: MatRef<'_, f64>,
     options: &GivenDataOptions,
 ) -> Result<GivenDataIndices> {
-    let (n, d, cols) = (x.n(), x.dim(), outputs.cols());
-    if outputs.rows() != n {
-        return Err(SobolError::Mismatch {
-            what: "output rows (one per run of the sample)".into(),
-            expected: n,
-            found: outputs.rows(),
-        });
+    let (n, d, cols) = (x.nrows(), x.ncols(), outputs.ncols());
+    if outputs.nrows() != n {
+        return Err(mismatch(
+            "output rows (one per run of the sample)",
+            n,
+            outputs.nrows(),
+        ));
+    }
+    if cols == 0 {
+        return Err(mismatch("output columns, at least", 1, 0));
     }
     let bins = options
         .bins
         .unwrap_or_else(|| ((n as f64).cbrt().round() as usize).max(2));
     if bins < 2 || n < 2 * bins {
-        return Err(SobolError::InvalidOption(format!(
-            "{bins} bins need at least 2 bins and 2 runs per bin; the sample has {n} runs"
-        )));
+        return Err(invalid_option(
+            "bins",
+            bins,
+            format!("need at least 2 bins and 2 runs per bin; the sample has {n} runs"),
+        ));
     }
-    for (r, row) in outputs.data().chunks_exact(cols).enumerate() {
-        if let Some(t) = row.iter().position(|v| !v.is_finite()) {
-            return Err(SobolError::NonFiniteOutput {
-                row: r,
-                column: t,
-                value: row[t],
-            });
+    for r in 0..n {
+        if let Some(t) = outputs.row(r).iter().position(|v| !v.is_finite()) {
+            return Err(non_finite_output(r, t, outputs[(r, t)]));
         }
     }
-    if let Some(k) = x.as_slice().iter().position(|v| !v.is_finite()) {
-        return Err(SobolError::InvalidOption(format!(
-            "parameter value {} at run {}, parameter {} is not finite",
-            x.as_slice()[k],
-            k / d,
-            k % d
-        )));
-    }
+    impactcal_core::check_finite_mat("parameter values", x)?;
     let names = |given: &Option<Vec<String>>, prefix: &str, count: usize, what: &str| match given {
-        Some(v) if v.len() != count => Err(SobolError::Mismatch {
-            what: format!("number of {what} names"),
-            expected: count,
-            found: v.len(),
-        }),
+        Some(v) if v.len() != count => Err(mismatch(
+            format!("number of {what} names"),
+            count,
+            v.len(),
+        )),
         Some(v) => Ok(v.clone()),
         None => Ok((1..=count).map(|k| format!("{prefix}{k}")).collect()),
     };
@@ -128,13 +126,13 @@ pub fn given_data_first_order(
     let output_names = names(&options.output_names, "y", cols, "output")?;
 
     let mut mean = vec![0.0; cols];
-    for row in outputs.data().chunks_exact(cols) {
-        mean.iter_mut().zip(row).for_each(|(m, v)| *m += v);
+    for row in outputs.row_iter() {
+        mean.iter_mut().zip(row.iter()).for_each(|(m, v)| *m += v);
     }
     mean.iter_mut().for_each(|m| *m /= n as f64);
     let mut sst = vec![0.0; cols];
-    for row in outputs.data().chunks_exact(cols) {
-        for ((s, v), m) in sst.iter_mut().zip(row).zip(&mean) {
+    for row in outputs.row_iter() {
+        for ((s, v), m) in sst.iter_mut().zip(row.iter()).zip(&mean) {
             *s += (v - m) * (v - m);
         }
     }
@@ -149,14 +147,16 @@ pub fn given_data_first_order(
         .into_par_iter()
         .map(|i| {
             let mut order: Vec<usize> = (0..n).collect();
-            order.sort_by(|&p, &q| x.row(p)[i].total_cmp(&x.row(q)[i]).then(p.cmp(&q)));
+            order.sort_by(|&p, &q| x[(p, i)].total_cmp(&x[(q, i)]).then(p.cmp(&q)));
             let mut sums = vec![0.0; bins * cols];
             let mut counts = vec![0usize; bins];
             for (rank, &r) in order.iter().enumerate() {
                 let m = rank * bins / n;
                 counts[m] += 1;
                 let s = &mut sums[m * cols..(m + 1) * cols];
-                s.iter_mut().zip(outputs.row(r)).for_each(|(a, v)| *a += v);
+                s.iter_mut()
+                    .zip(outputs.row(r).iter())
+                    .for_each(|(a, v)| *a += v);
             }
             let mut out = vec![0.0; cols];
             for (m, &c) in counts.iter().enumerate() {

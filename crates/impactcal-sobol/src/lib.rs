@@ -18,13 +18,19 @@
 //!    for every column, and flags columns whose variance is (nearly) zero.
 //!
 //! Also: [`given_data_first_order`] for first-order indices from an existing ensemble
-//! without a pick-freeze design, [`replicate_spread`] for intervals from independently
-//! scrambled designs, and [`test_functions`] with exact indices.
+//! without a pick-freeze design, and [`replicate_spread`] for intervals from independently
+//! scrambled designs. Test functions with exact indices (Ishigami, the G-function) are in
+//! [`impactcal_core::test_functions`].
+//!
+//! Designs and outputs are faer matrices with one model run per row: the design's points
+//! (`N (d + 2) x d`) and the outputs (`N (d + 2) x T`, one column per output).
 //!
 //! ```
+//! use faer::ColRef;
 //! use impactcal_core::sampling::Method;
+//! use impactcal_core::test_functions;
 //! use impactcal_core::{Parameter, ParameterSpace};
-//! use impactcal_sobol::{analyze, test_functions, OutputView, SaltelliDesign, SobolOptions};
+//! use impactcal_sobol::{analyze, SaltelliDesign, SobolOptions};
 //! use std::f64::consts::PI;
 //!
 //! let space = ParameterSpace::new(
@@ -36,10 +42,14 @@
 //! let design = SaltelliDesign::generate(&space, 4096, Method::ScrambledSobol, false, 1)?;
 //! let y: Vec<f64> = design
 //!     .points
-//!     .rows()
-//!     .map(|x| test_functions::ishigami(x, 7.0, 0.1))
+//!     .row_iter()
+//!     .map(|x| {
+//!         let x: Vec<f64> = x.iter().copied().collect();
+//!         test_functions::ishigami(&x, 7.0, 0.1)
+//!     })
 //!     .collect();
-//! let s = analyze(&design.layout, OutputView::column(&y), &SobolOptions::default())?;
+//! let outputs = ColRef::from_slice(&y).as_mat();
+//! let s = analyze(&design.layout, outputs, &SobolOptions::default())?;
 //! let exact = test_functions::ishigami_indices(7.0, 0.1);
 //! for i in 0..3 {
 //!     assert!((s.first_order[0][i] - exact.first_order[i]).abs() < 0.02);
@@ -48,19 +58,16 @@
 //! # Ok::<(), impactcal_sobol::SobolError>(())
 //! ```
 
+mod accumulate;
 mod analysis;
 mod design;
 mod error;
 mod estimators;
 mod given_data;
-mod kernel;
 mod replicates;
 pub mod stats;
-pub mod test_functions;
 
-pub use analysis::{
-    AggregatedIndices, BootstrapInfo, OutputView, SobolIndices, SobolOptions, analyze,
-};
+pub use analysis::{AggregatedIndices, BootstrapInfo, SobolIndices, SobolOptions, analyze};
 pub use design::{DesignLayout, SaltelliDesign};
 pub use error::{Result, SobolError};
 pub use estimators::{FirstOrderEstimator, TotalEstimator};

@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 use crate::analysis::SobolIndices;
-use crate::error::{Result, SobolError};
+use crate::error::{Result, invalid_option, mismatch};
 use crate::stats::{sample_sd, student_t_quantile};
 
 /// The spread of first-order and total indices over `R` analyses of independently
@@ -37,29 +37,34 @@ pub struct ReplicateSpread {
 /// Combines replicate analyses into means and t intervals (see [`ReplicateSpread`]).
 ///
 /// # Errors
-/// [`SobolError::InvalidOption`] for fewer than 2 replicates or a confidence outside
-/// (0, 1); [`SobolError::Mismatch`] when the replicates differ in their numbers of outputs
-/// or parameters.
+/// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for fewer than 2
+/// replicates or a confidence outside (0, 1);
+/// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when the
+/// replicates differ in their numbers of outputs or parameters.
 pub fn replicate_spread(results: &[SobolIndices], confidence: f64) -> Result<ReplicateSpread> {
     let r = results.len();
     if r < 2 {
-        return Err(SobolError::InvalidOption(format!(
-            "a replicate spread needs at least 2 replicates; {r} given"
-        )));
+        return Err(invalid_option(
+            "replicates",
+            r,
+            "a replicate spread needs at least 2 replicates",
+        ));
     }
     if !(confidence > 0.0 && confidence < 1.0) {
-        return Err(SobolError::InvalidOption(format!(
-            "the confidence level must lie in (0, 1); {confidence} given"
-        )));
+        return Err(invalid_option(
+            "confidence",
+            confidence,
+            "the confidence level must lie in (0, 1)",
+        ));
     }
     let (cols, d) = (results[0].first_order.len(), results[0].parameters.len());
     for res in results {
         if res.first_order.len() != cols || res.parameters.len() != d {
-            return Err(SobolError::Mismatch {
-                what: "outputs x parameters of a replicate".into(),
-                expected: cols * d,
-                found: res.first_order.len() * res.parameters.len(),
-            });
+            return Err(mismatch(
+                "outputs x parameters of a replicate",
+                cols * d,
+                res.first_order.len() * res.parameters.len(),
+            ));
         }
     }
     let q = student_t_quantile(0.5 + 0.5 * confidence, (r - 1) as f64);

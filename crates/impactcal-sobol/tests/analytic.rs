@@ -8,15 +8,22 @@
 
 use std::f64::consts::PI;
 
+use faer::{ColRef, Mat, MatRef};
+use impactcal_core::points::{row, to_rows};
 use impactcal_core::sampling::{Method, unit_sample};
-use impactcal_core::{Parameter, ParameterSpace, Points};
-use impactcal_sobol::test_functions::{
+use impactcal_core::test_functions::{
     g_function, g_function_indices, ishigami, ishigami_indices, linear_indices,
 };
+use impactcal_core::{Parameter, ParameterSpace};
 use impactcal_sobol::{
-    FirstOrderEstimator, GivenDataOptions, OutputView, SaltelliDesign, SobolIndices, SobolOptions,
+    FirstOrderEstimator, GivenDataOptions, SaltelliDesign, SobolIndices, SobolOptions,
     TotalEstimator, analyze, given_data_first_order, replicate_spread,
 };
+
+/// One output per run, as a one-column matrix.
+fn column(y: &[f64]) -> MatRef<'_, f64> {
+    ColRef::from_slice(y).as_mat()
+}
 
 fn space(bounds: &[(f64, f64)]) -> ParameterSpace {
     ParameterSpace::new(
@@ -39,13 +46,17 @@ fn run(
     f: impl Fn(&[f64], &mut [f64]),
     options: &SobolOptions,
 ) -> SobolIndices {
-    let mut y = vec![0.0; design.points.n() * cols];
-    for (x, out) in design.points.rows().zip(y.chunks_exact_mut(cols)) {
+    let rows = design.points.nrows();
+    let mut y = vec![0.0; rows * cols];
+    for (x, out) in to_rows(design.points.as_ref())
+        .iter()
+        .zip(y.chunks_exact_mut(cols))
+    {
         f(x, out);
     }
     analyze(
         &design.layout,
-        OutputView::new(&y, design.points.n(), cols).unwrap(),
+        MatRef::from_row_major_slice(&y, rows, cols),
         options,
     )
     .unwrap()
@@ -86,8 +97,8 @@ fn ishigami_second_order_and_other_estimators() {
     let exact = ishigami_indices(7.0, 0.1);
     let d =
         SaltelliDesign::generate(&ishigami_space(), 8192, Method::ScrambledSobol, true, 5).unwrap();
-    assert_eq!(d.points.n(), 8192 * 8);
-    d.layout.check_points(&d.points).unwrap();
+    assert_eq!(d.points.nrows(), 8192 * 8);
+    d.layout.check_points(d.points.as_ref()).unwrap();
     let firsts = [
         FirstOrderEstimator::Saltelli2010,
         FirstOrderEstimator::Jansen1999,
@@ -178,9 +189,9 @@ fn linear_model_sums_to_one() {
     let lhs = impactcal_core::sampling::sample(&sp, Method::LatinHypercube, 4096, 2)
         .unwrap()
         .points;
-    let y: Vec<f64> = lhs.rows().map(f).collect();
-    let g =
-        given_data_first_order(&lhs, OutputView::column(&y), &GivenDataOptions::default()).unwrap();
+    let y: Vec<f64> = to_rows(lhs.as_ref()).iter().map(|x| f(x)).collect();
+    let g = given_data_first_order(lhs.as_ref(), column(&y), &GivenDataOptions::default())
+        .unwrap();
     assert_eq!(g.bins, 16);
     assert_close("given-data S1", &g.first_order[0], &exact.first_order, 0.02);
     let sum: f64 = g.normalised_first_order_share[0].iter().sum();
@@ -195,9 +206,12 @@ fn given_data_on_ishigami() {
     let x = impactcal_core::sampling::sample(&ishigami_space(), Method::ScrambledHalton, 8000, 4)
         .unwrap()
         .points;
-    let y: Vec<f64> = x.rows().map(|x| ishigami(x, 7.0, 0.1)).collect();
+    let y: Vec<f64> = to_rows(x.as_ref())
+        .iter()
+        .map(|x| ishigami(x, 7.0, 0.1))
+        .collect();
     let g =
-        given_data_first_order(&x, OutputView::column(&y), &GivenDataOptions::default()).unwrap();
+        given_data_first_order(x.as_ref(), column(&y), &GivenDataOptions::default()).unwrap();
     assert_close("S1", &g.first_order[0], &exact.first_order, 0.03);
     assert!(g.first_order[0][2].abs() < 0.005);
     assert!(g.first_order_uncorrected[0][2] > g.first_order[0][2]);
@@ -379,12 +393,14 @@ fn unit_space_design_matches_plain_sequence() {
     // 2d-dimensional sequence.
     let sp = space(&[(0.0, 1.0); 2]);
     let d = SaltelliDesign::generate(&sp, 8, Method::Sobol, true, 0).unwrap();
-    let base: Points = unit_sample(Method::Sobol, 8, 4, 0).unwrap().points;
+    let base: Mat<f64> = unit_sample(Method::Sobol, 8, 4, 0).unwrap().points;
+    let p = d.points.as_ref();
     for j in 0..8 {
-        let (a, b) = (base.row(j)[..2].to_vec(), base.row(j)[2..].to_vec());
-        assert_eq!(d.points.row(d.layout.a_row(j)), &a[..]);
-        assert_eq!(d.points.row(d.layout.b_row(j)), &b[..]);
-        assert_eq!(d.points.row(d.layout.ab_row(j, 1)), &[a[0], b[1]]);
-        assert_eq!(d.points.row(d.layout.ba_row(j, 1)), &[b[0], a[1]]);
+        let r = row(base.as_ref(), j);
+        let (a, b) = (r[..2].to_vec(), r[2..].to_vec());
+        assert_eq!(row(p, d.layout.a_row(j)), a);
+        assert_eq!(row(p, d.layout.b_row(j)), b);
+        assert_eq!(row(p, d.layout.ab_row(j, 1)), [a[0], b[1]]);
+        assert_eq!(row(p, d.layout.ba_row(j, 1)), [b[0], a[1]]);
     }
 }

@@ -8,8 +8,10 @@
 )]
 
 use impactcal_core::sampling::Method;
-use impactcal_core::{Parameter, ParameterSpace, Points};
-use impactcal_sobol::{DesignLayout, OutputView, SaltelliDesign, SobolOptions, analyze};
+use faer::{ColRef, MatRef};
+use impactcal_core::points::{from_row_major, from_rows, to_rows};
+use impactcal_core::{CoreError, Parameter, ParameterSpace};
+use impactcal_sobol::{DesignLayout, SaltelliDesign, SobolOptions, analyze};
 use serde_json::Value;
 
 fn fixture() -> Value {
@@ -41,18 +43,19 @@ fn vector(v: &Value) -> Vec<f64> {
 #[test]
 fn point_estimates_equal_salib() {
     let f = fixture();
-    let x = Points::from_rows(&matrix(&f["x"])).unwrap();
+    let x = from_rows(&matrix(&f["x"]), "x").unwrap();
     let y = matrix(&f["y"]);
-    let layout = DesignLayout::from_rows(x.n(), 3, true).unwrap();
+    let layout = DesignLayout::from_rows(x.nrows(), 3, true).unwrap();
     assert_eq!(layout.n(), 64);
     // SALib's rows have the structure our layout describes.
-    layout.check_points(&x).unwrap();
+    layout.check_points(x.as_ref()).unwrap();
     let flat: Vec<f64> = y.iter().flatten().copied().collect();
     let options = SobolOptions {
         bootstrap: 100,
         ..SobolOptions::default()
     };
-    let s = analyze(&layout, OutputView::new(&flat, x.n(), 2).unwrap(), &options).unwrap();
+    let outputs = MatRef::from_row_major_slice(&flat, x.nrows(), 2);
+    let s = analyze(&layout, outputs, &options).unwrap();
     let columns = f["columns"].as_array().unwrap();
     for (t, col) in columns.iter().enumerate() {
         let (s1, st, s2) = (vector(&col["S1"]), vector(&col["ST"]), matrix(&col["S2"]));
@@ -101,46 +104,45 @@ fn plain_design_equals_salib_rows() {
     )
     .unwrap();
     let ours = SaltelliDesign::generate(&space, 8, Method::Sobol, true, 0).unwrap();
-    assert_eq!(ours.points.to_rows(), salib);
+    assert_eq!(to_rows(ours.points.as_ref()), salib);
 }
 
 #[test]
 fn malformed_inputs_are_typed_errors() {
     use impactcal_sobol::SobolError as E;
     let f = fixture();
-    let x = Points::from_rows(&matrix(&f["x"])).unwrap();
+    let x = from_rows(&matrix(&f["x"]), "x").unwrap();
+    let n = x.nrows();
     // 64 * 8 rows fit d = 3 only with second order; the error says so.
-    let e = DesignLayout::from_rows(x.n(), 3, false).unwrap_err();
+    let e = DesignLayout::from_rows(n, 3, false).unwrap_err();
     assert!(matches!(e, E::RowCount { .. }) && e.to_string().contains("with second order"));
     assert!(matches!(
         DesignLayout::new(64, 1, true),
         Err(E::TooSmallForSecondOrder { .. })
     ));
-    let layout = DesignLayout::from_rows(x.n(), 3, true).unwrap();
+    let layout = DesignLayout::from_rows(n, 3, true).unwrap();
     // Swapping two rows breaks the pick-freeze structure.
-    let mut rows = x.to_rows();
+    let mut rows = to_rows(x.as_ref());
     rows.swap(9, 10);
     let e = layout
-        .check_points(&Points::from_rows(&rows).unwrap())
+        .check_points(from_rows(&rows, "x").unwrap().as_ref())
         .unwrap_err();
     assert!(matches!(e, E::DesignStructure { row: 9, .. }), "{e}");
-    let mut y = vec![1.0; x.n()];
+    let mut y = vec![1.0; n];
     y[5] = 2.0;
-    let short = OutputView::column(&y[..x.n() - 1]);
+    let column = |y: &[f64]| ColRef::from_slice(y).as_mat().to_owned();
+    let short = column(&y[..n - 1]);
     assert!(matches!(
-        analyze(&layout, short, &SobolOptions::default()),
+        analyze(&layout, short.as_ref(), &SobolOptions::default()),
         Err(E::RowCount { .. })
     ));
     y[17] = f64::NAN;
-    let e = analyze(&layout, OutputView::column(&y), &SobolOptions::default()).unwrap_err();
+    let e = analyze(&layout, column(&y).as_ref(), &SobolOptions::default()).unwrap_err();
     assert!(
         matches!(
-            e,
-            E::NonFiniteOutput {
-                row: 17,
-                column: 0,
-                ..
-            }
+            &e,
+            E::Core(CoreError::NonFinite { location, .. })
+                if location == "row 17, column 0 (0-based)"
         ),
         "{e}"
     );
@@ -159,7 +161,7 @@ fn malformed_inputs_are_typed_errors() {
             ..SobolOptions::default()
         },
     ] {
-        assert!(analyze(&layout, OutputView::column(&y), &bad).is_err());
+        assert!(analyze(&layout, column(&y).as_ref(), &bad).is_err());
     }
-    assert!(OutputView::new(&y, 10, 3).is_err());
+    assert!(from_row_major(10, 3, &y).is_err());
 }

@@ -3,7 +3,9 @@
 use rand::Rng;
 use rand::seq::SliceRandom;
 
-use super::{BELOW_ONE, Points};
+use faer::Mat;
+
+use super::BELOW_ONE;
 use crate::error::{CoreError, Result};
 
 /// The Halton sequence in the first `dim` primes.
@@ -108,14 +110,14 @@ impl Halton {
         }
     }
 
-    /// Points `start .. start + n`.
-    pub fn points(&self, start: usize, n: usize) -> Points {
+    /// Points `start .. start + n`, one per row of an `n x dim` matrix.
+    pub fn points(&self, start: usize, n: usize) -> Mat<f64> {
         let dim = self.dim();
         let mut data = vec![0.0; n * dim];
         for (i, row) in data.chunks_exact_mut(dim).enumerate() {
             self.point(start + i, row);
         }
-        Points::from_parts(n, dim, data)
+        Mat::from_fn(n, dim, |i, j| data[i * dim + j])
     }
 }
 
@@ -189,6 +191,7 @@ fn first_primes(count: usize) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::points::{column, row, to_row_major};
     use crate::sampling::seeded_rng;
 
     #[test]
@@ -197,8 +200,8 @@ mod tests {
         assert_eq!(first_primes(1000)[999], 7919);
         let h = Halton::new(2).unwrap();
         let p = h.points(0, 4);
-        assert_eq!(p.column(0), vec![0.0, 0.5, 0.25, 0.75]); // exact binary fractions
-        assert!((p.row(3)[1] - 1.0 / 9.0).abs() < 1e-16);
+        assert_eq!(column(p.as_ref(), 0), vec![0.0, 0.5, 0.25, 0.75]); // exact binary fractions
+        assert!((row(p.as_ref(), 3)[1] - 1.0 / 9.0).abs() < 1e-16);
     }
 
     #[test]
@@ -208,13 +211,17 @@ mod tests {
         let h = Halton::scrambled(3, 125, &mut seeded_rng(3)).unwrap();
         let p = h.points(0, 125);
         let mut seen = [false; 125];
-        for x in p.column(2) {
+        for x in column(p.as_ref(), 2) {
             let cell = (x * 125.0) as usize;
             assert!(!seen[cell], "two points in stratum {cell}");
             seen[cell] = true;
         }
         // Beyond the capacity the sequence stays inside [0, 1).
         let far = h.points(10_000, 10);
-        assert!(far.as_slice().iter().all(|&x| (0.0..1.0).contains(&x)));
+        assert!(
+            to_row_major(far.as_ref())
+                .iter()
+                .all(|&x| (0.0..1.0).contains(&x))
+        );
     }
 }

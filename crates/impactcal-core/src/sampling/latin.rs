@@ -3,7 +3,7 @@
 use rand::Rng;
 use rand::seq::SliceRandom;
 
-use super::Points;
+use faer::Mat;
 use crate::error::{CoreError, Result};
 
 fn check(n: usize, dim: usize) -> Result<()> {
@@ -15,7 +15,8 @@ fn check(n: usize, dim: usize) -> Result<()> {
     Ok(())
 }
 
-/// A Latin hypercube of `n` points in `[0, 1)^dim` (McKay, Beckman & Conover 1979).
+/// A Latin hypercube of `n` points in `[0, 1)^dim` (McKay, Beckman & Conover 1979), one per
+/// row of an `n x dim` matrix.
 ///
 /// Every dimension is cut into `n` strata `[k/n, (k+1)/n)`; each stratum holds exactly one
 /// point, at a uniform random position inside it, and the strata of different dimensions
@@ -23,7 +24,7 @@ fn check(n: usize, dim: usize) -> Result<()> {
 ///
 /// # Errors
 /// [`CoreError::Invalid`] when `n` or `dim` is zero.
-pub fn latin_hypercube(n: usize, dim: usize, rng: &mut impl Rng) -> Result<Points> {
+pub fn latin_hypercube(n: usize, dim: usize, rng: &mut impl Rng) -> Result<Mat<f64>> {
     check(n, dim)?;
     let mut data = vec![0.0; n * dim];
     let mut strata: Vec<usize> = (0..n).collect();
@@ -34,10 +35,11 @@ pub fn latin_hypercube(n: usize, dim: usize, rng: &mut impl Rng) -> Result<Point
             data[i * dim + j] = ((k as f64 + rng.random::<f64>()) * width).min(super::BELOW_ONE);
         }
     }
-    Ok(Points::from_parts(n, dim, data))
+    Ok(Mat::from_fn(n, dim, |i, j| data[i * dim + j]))
 }
 
-/// A symmetric Latin hypercube of `n` points in `(0, 1)^dim` (Ye, Li & Sudjianto 2000), the
+/// A symmetric Latin hypercube of `n` points in `(0, 1)^dim` (Ye, Li & Sudjianto 2000), one
+/// per row of an `n x dim` matrix; the
 /// initial design of the CORS-RBF optimiser (Regis & Shoemaker).
 ///
 /// Points sit at the centres `(k + 1/2)/n` of the strata, one per stratum in every
@@ -48,7 +50,7 @@ pub fn latin_hypercube(n: usize, dim: usize, rng: &mut impl Rng) -> Result<Point
 ///
 /// # Errors
 /// [`CoreError::Invalid`] when `n` or `dim` is zero.
-pub fn symmetric_latin_hypercube(n: usize, dim: usize, rng: &mut impl Rng) -> Result<Points> {
+pub fn symmetric_latin_hypercube(n: usize, dim: usize, rng: &mut impl Rng) -> Result<Mat<f64>> {
     check(n, dim)?;
     let half = n / 2;
     let mut data = vec![0.0; n * dim];
@@ -65,5 +67,5 @@ pub fn symmetric_latin_hypercube(n: usize, dim: usize, rng: &mut impl Rng) -> Re
             data[half * dim + j] = 0.5;
         }
     }
-    Ok(Points::from_parts(n, dim, data))
+    Ok(Mat::from_fn(n, dim, |i, j| data[i * dim + j]))
 }

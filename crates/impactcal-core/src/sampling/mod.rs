@@ -1,8 +1,9 @@
 //! Space-filling samples of the unit cube and of a [`ParameterSpace`].
 //!
-//! Every method produces `n` points of `[0, 1)^dim` (rows of a [`Points`]), reproducibly
-//! from a seed, and [`sample`] maps them affinely onto the box of a parameter space
-//! (`x = lower + u (upper - lower)`).
+//! Every method produces `n` points of `[0, 1)^dim`, one per row of an `n x dim` faer
+//! matrix, reproducibly from a seed, and [`sample`] maps them affinely onto the box of a
+//! parameter space (`x = lower + u (upper - lower)`,
+//! [`ParameterSpace::from_unit_matrix`]).
 //!
 //! | [`Method`] | what | when |
 //! |---|---|---|
@@ -27,8 +28,10 @@
 //!     Parameter::new("E", 1.0e7, 1.1e7, 1.05e7)?,
 //! ])?;
 //! let s = sample(&space, Method::ScrambledSobol, 64, 7)?;
-//! assert_eq!((s.points.n(), s.points.dim()), (64, 2));
-//! assert!(s.points.rows().all(|x| space.contains(x)));
+//! assert_eq!((s.points.nrows(), s.points.ncols()), (64, 2));
+//! assert!(impactcal_core::points::to_rows(s.points.as_ref())
+//!     .iter()
+//!     .all(|x| space.contains(x)));
 //! assert!(s.warnings.is_empty());
 //! // 48 is not a power of two: the sample is made, with a warning.
 //! assert_eq!(sample(&space, Method::Sobol, 48, 0)?.warnings.len(), 1);
@@ -37,11 +40,11 @@
 
 mod halton;
 mod latin;
-mod points;
 mod sobol;
 
 use std::fmt;
 
+use faer::Mat;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -51,7 +54,6 @@ use crate::space::ParameterSpace;
 
 pub use halton::Halton;
 pub use latin::{latin_hypercube, symmetric_latin_hypercube};
-pub use points::Points;
 pub use sobol::Sobol;
 
 /// A sampling method; see the [module documentation](self) for what each one is.
@@ -135,8 +137,8 @@ impl fmt::Display for SamplingWarning {
 /// Points together with the warnings raised while making them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sample {
-    /// The points, one per row.
-    pub points: Points,
+    /// The points, one per row (`n x dim`).
+    pub points: Mat<f64>,
     /// Warnings (empty when all is as recommended).
     pub warnings: Vec<SamplingWarning>,
 }
@@ -193,8 +195,8 @@ pub fn unit_sample(method: Method, n: usize, dim: usize, seed: u64) -> Result<Sa
         Method::LatinHypercube => latin_hypercube(n, dim, &mut rng)?,
         Method::SymmetricLatinHypercube => symmetric_latin_hypercube(n, dim, &mut rng)?,
         Method::Random => {
-            let data = (0..n * dim).map(|_| rng.random::<f64>()).collect();
-            Points::new(n, dim, data)?
+            let data: Vec<f64> = (0..n * dim).map(|_| rng.random::<f64>()).collect();
+            crate::points::from_row_major(n, dim, &data)?
         }
     };
     Ok(Sample {
@@ -204,38 +206,16 @@ pub fn unit_sample(method: Method, n: usize, dim: usize, seed: u64) -> Result<Sa
 }
 
 /// `n` points of the box of `space` by `method`: [`unit_sample`] in `space.dim()`
-/// dimensions mapped by [`to_space`].
+/// dimensions mapped by [`ParameterSpace::from_unit_matrix`].
 ///
 /// # Errors
 /// As [`unit_sample`].
 pub fn sample(space: &ParameterSpace, method: Method, n: usize, seed: u64) -> Result<Sample> {
     let Sample { points, warnings } = unit_sample(method, n, space.dim(), seed)?;
     Ok(Sample {
-        points: to_space(space, &points)?,
+        points: space.from_unit_matrix(points.as_ref())?,
         warnings,
     })
-}
-
-/// Maps points of the unit cube onto the box of `space`: `x_ij = l_j + u_ij (u_j - l_j)`.
-///
-/// # Errors
-/// [`CoreError::DimensionMismatch`] when `unit.dim() != space.dim()`.
-pub fn to_space(space: &ParameterSpace, unit: &Points) -> Result<Points> {
-    if unit.dim() != space.dim() {
-        return Err(CoreError::DimensionMismatch {
-            what: "sample dimension (number of parameters)".into(),
-            expected: space.dim(),
-            found: unit.dim(),
-        });
-    }
-    let params = space.parameters();
-    let mut out = unit.clone();
-    for row in out.rows_mut() {
-        for (x, p) in row.iter_mut().zip(params) {
-            *x = p.lower + *x * p.width();
-        }
-    }
-    Ok(out)
 }
 
 /// Largest `f64` below 1: where generators clamp values that round up to 1.

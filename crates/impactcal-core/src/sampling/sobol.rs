@@ -1,6 +1,8 @@
 //! Sobol' sequences with Joe-Kuo direction numbers, plain and Owen-scrambled.
 
-use super::{BELOW_ONE, Points};
+use faer::Mat;
+
+use super::BELOW_ONE;
 use crate::error::{CoreError, Result};
 
 /// Joe & Kuo (2008) D6 direction numbers, dimensions 2..=2048, one line `s a m_1 .. m_s`
@@ -110,11 +112,12 @@ impl Sobol {
         }
     }
 
-    /// Points `start .. start + n`, generated incrementally in Gray-code order.
+    /// Points `start .. start + n`, one per row of an `n x dim` matrix, generated
+    /// incrementally in Gray-code order.
     ///
     /// # Errors
     /// [`CoreError::Invalid`] when `start + n` exceeds 2^32.
-    pub fn points(&self, start: usize, n: usize) -> Result<Points> {
+    pub fn points(&self, start: usize, n: usize) -> Result<Mat<f64>> {
         let end = start.checked_add(n).filter(|&e| e <= 1usize << BITS);
         let Some(end) = end else {
             return Err(CoreError::Invalid(format!(
@@ -124,7 +127,7 @@ impl Sobol {
         let dim = self.dim;
         let mut data = vec![0.0; n * dim];
         if n == 0 {
-            return Ok(Points::from_parts(0, dim, data));
+            return Ok(Mat::zeros(0, dim));
         }
         let mut bits = vec![0u32; dim];
         self.point_bits(start as u32, &mut bits);
@@ -141,7 +144,7 @@ impl Sobol {
                 }
             }
         }
-        Ok(Points::from_parts(n, dim, data))
+        Ok(Mat::from_fn(n, dim, |i, j| data[i * dim + j]))
     }
 
     fn to_unit(&self, j: usize, bits: u32) -> f64 {
@@ -257,7 +260,7 @@ mod tests {
         let mut x = vec![0.0; 5];
         for i in 0..20 {
             s.point(37 + i as u32, &mut x);
-            assert_eq!(block.row(i), &x[..]);
+            assert_eq!(crate::points::row(block.as_ref(), i), x);
         }
     }
 
@@ -268,12 +271,12 @@ mod tests {
         let s = Sobol::owen_scrambled(3, 99).unwrap();
         let p = s.points(0, 64).unwrap();
         for j in 0..3 {
-            let mut cells: Vec<usize> = p.column(j).iter().map(|x| (x * 64.0) as usize).collect();
+            let mut cells: Vec<usize> = p.col(j).iter().map(|x| (x * 64.0) as usize).collect();
             cells.sort_unstable();
             assert_eq!(cells, (0..64).collect::<Vec<_>>(), "dimension {j}");
         }
         let mut boxes: Vec<usize> = p
-            .rows()
+            .row_iter()
             .map(|r| (r[0] * 8.0) as usize * 8 + (r[1] * 8.0) as usize)
             .collect();
         boxes.sort_unstable();

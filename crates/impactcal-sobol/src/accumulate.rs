@@ -8,6 +8,7 @@
 //! accumulator is a sum over `j` in a fixed order, so results do not depend on the number of
 //! threads or on how the work was split.
 
+use faer::MatRef;
 use rayon::prelude::*;
 
 use crate::design::DesignLayout;
@@ -80,14 +81,15 @@ pub(crate) fn group_blocks(
         .collect()
 }
 
-/// Runs every work item and returns their sums (in no particular order).
+/// Runs every work item over `outputs` (one row per model run) and returns their sums (in
+/// no particular order).
 pub(crate) fn accumulate(
     plan: &Plan,
-    data: &[f64],
-    cols: usize,
+    outputs: MatRef<'_, f64>,
     centre: &[f64],
     weights: &Weights,
 ) -> Vec<ItemSums> {
+    let cols = outputs.ncols();
     let tiles: Vec<usize> = (0..cols).step_by(TILE).collect();
     let blocks = group_blocks(plan, weights.groups, tiles.len());
     let items: Vec<(usize, std::ops::Range<usize>)> = tiles
@@ -98,16 +100,29 @@ pub(crate) fn accumulate(
         .into_par_iter()
         .map(|(t0, groups)| {
             let width = TILE.min(cols - t0);
-            accumulate_item(plan, data, cols, centre, weights, t0, width, groups)
+            accumulate_item(plan, outputs, centre, weights, t0, width, groups)
         })
         .collect()
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Columns `t0 .. t0 + w` of row `r` of `m`: borrowed where the row is contiguous (a
+/// row-major view), else copied into `buf`.
+fn tile<'a>(m: MatRef<'a, f64>, r: usize, t0: usize, w: usize, buf: &'a mut [f64]) -> &'a [f64] {
+    let row = m.row(r).subcols(t0, w);
+    match row.try_as_row_major() {
+        Some(contiguous) => contiguous.as_slice(),
+        None => {
+            for (b, v) in buf.iter_mut().zip(row.iter()) {
+                *b = *v;
+            }
+            &buf[..w]
+        }
+    }
+}
+
 fn accumulate_item(
     plan: &Plan,
-    data: &[f64],
-    cols: usize,
+    outputs: MatRef<'_, f64>,
     centre: &[f64],
     weights: &Weights,
     t0: usize,
@@ -123,14 +138,15 @@ fn accumulate_item(
     let mut ab = vec![0.0; d * w];
     let mut ba = vec![0.0; if layout.second_order() { d * w } else { 0 }];
     let mu = &centre[t0..t0 + w];
-    let row = |r: usize| &data[r * cols + t0..r * cols + t0 + w];
+    let (mut buf_a, mut buf_b, mut buf_x) = (vec![0.0; w], vec![0.0; w], vec![0.0; w]);
     for j in 0..layout.n() {
         let wrow =
             &weights.data[j * weights.groups + groups.start..j * weights.groups + groups.end];
         if wrow.iter().all(|&x| x == 0) {
             continue;
         }
-        let (ra, rb) = (row(layout.a_row(j)), row(layout.b_row(j)));
+        let ra = tile(outputs, layout.a_row(j), t0, w, &mut buf_a);
+        let rb = tile(outputs, layout.b_row(j), t0, w, &mut buf_b);
         let (shared, rest) = scratch.split_at_mut(SHARED * w);
         let (sa, tail) = shared.split_at_mut(w);
         let (sb, tail) = tail.split_at_mut(w);
@@ -145,7 +161,7 @@ fn accumulate_item(
             sab[t] = ca * cb;
         }
         for i in 0..d {
-            let rx = row(layout.ab_row(j, i));
+            let rx = tile(outputs, layout.ab_row(j, i), t0, w, &mut buf_x);
             let cx = &mut ab[i * w..(i + 1) * w];
             for t in 0..w {
                 cx[t] = rx[t] - mu[t];
@@ -171,7 +187,7 @@ fn accumulate_item(
         }
         if layout.second_order() {
             for i in 0..d {
-                let rx = row(layout.ba_row(j, i));
+                let rx = tile(outputs, layout.ba_row(j, i), t0, w, &mut buf_x);
                 for t in 0..w {
                     ba[i * w + t] = rx[t] - mu[t];
                 }
