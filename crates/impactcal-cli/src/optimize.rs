@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
-use impactcal::core::{ParameterSpace, Table, TableOptions};
+use faer::Mat;
+use impactcal::core::{CoreError, ParameterSpace, Table, TableOptions, read_samples};
 use impactcal::cors::{Cors, CorsOptions, InitialDesign, Restart, SurrogateKernel, Transform};
 
 use crate::error::CliError;
@@ -56,8 +57,8 @@ struct SuggestArgs {
     #[arg(long)]
     bounds: PathBuf,
     /// History: the parameter columns and an `objective` column (empty or `nan` for a
-    /// failed run), one row per evaluation in the order they were run. A missing or empty
-    /// file means no evaluation yet.
+    /// failed run), one row per evaluation in the order they were run. A file that does not
+    /// exist (in a directory that does) means no evaluation yet; a header without rows too.
     #[arg(long)]
     history: PathBuf,
     /// Number of distinct points to suggest (to run at once).
@@ -109,54 +110,43 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
 }
 
-/// Reads the history: rows of parameters (by name, any column order) and objectives.
+/// Reads the history: the parameters (by name, any column order) and the objectives. Only
+/// a file that does not exist, in a directory that does, is a study without evaluations;
+/// any other failure to read it (a missing directory, a directory in its place, an empty
+/// or malformed file) is reported.
 fn read_history(
     space: &ParameterSpace,
-    args: &SuggestArgs,
-) -> Result<(Vec<Vec<f64>>, Vec<f64>), CliError> {
-    let path = &args.history;
-    let empty = match std::fs::metadata(path) {
-        Err(_) => true,
-        Ok(m) => m.len() == 0,
-    };
-    if empty {
-        return Ok((Vec::new(), Vec::new()));
-    }
-    let table = Table::read(
-        path,
-        TableOptions {
-            allow_missing: true,
-            allow_no_rows: true,
-        },
-    )?;
-    let name = path.display();
-    let columns = space
-        .names()
-        .iter()
-        .map(|p| {
-            table.column_index(p).ok_or_else(|| {
-                CliError::input(format!(
-                    "{name}: no column `{p}` (a parameter of the bounds)"
-                ))
-            })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let objective = table
-        .column_index("objective")
-        .ok_or_else(|| CliError::input(format!("{name}: no `objective` column")))?;
-    let mut points = Vec::with_capacity(table.rows.len());
-    for (row, line) in table.rows.iter().zip(&table.lines) {
-        let x: Vec<f64> = columns.iter().map(|&j| row[j]).collect();
-        if let Some(j) = columns.iter().position(|&j| row[j].is_nan()) {
-            return Err(CliError::input(format!(
-                "{name}: row {line}: parameter `{}` is empty",
-                space.names()[j]
-            )));
+    path: &std::path::Path,
+) -> Result<(Mat<f64>, Vec<f64>), CliError> {
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound && parent_exists(path) => {
+            return Ok((Mat::zeros(0, space.dim()), Vec::new()));
         }
-        points.push(x);
+        Err(source) => {
+            return Err(CoreError::Io {
+                path: path.display().to_string(),
+                source,
+            }
+            .into());
+        }
+        Ok(_) => {}
     }
-    let values = table.rows.iter().map(|r| r[objective]).collect();
-    Ok((points, values))
+    let options = TableOptions {
+        allow_missing: true,
+        allow_no_rows: true,
+    };
+    let mut samples = read_samples(path, space, &["objective"], options)?;
+    let values = samples.also.pop().unwrap_or_default();
+    Ok((samples.points, values))
+}
+
+/// Whether the directory that would hold `path` exists (the current directory for a bare
+/// file name).
+fn parent_exists(path: &std::path::Path) -> bool {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir.is_dir(),
+        _ => true,
+    }
 }
 
 fn suggest(args: SuggestArgs) -> Result<(), CliError> {
@@ -164,7 +154,8 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
     if args.batch == 0 {
         return Err(CliError::input("--batch must be at least 1"));
     }
-    let (points, values) = read_history(&space, &args)?;
+    let (points, values) = read_history(&space, &args.history)?;
+    let points = impactcal::core::points::to_rows(points.as_ref());
     let options = CorsOptions {
         kernel: match args.kernel {
             KernelArg::Cubic => SurrogateKernel::Cubic,
@@ -205,11 +196,10 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
     let next = study
         .suggest(args.batch)
         .map_err(|e| CliError::input(format!("{history}: {e}")))?;
-    let table = Table {
-        header: space.names().iter().map(|s| s.to_string()).collect(),
-        rows: next.iter().map(|s| s.x.clone()).collect(),
-        lines: Vec::new(),
-    };
+    let table = Table::new(
+        space.names().iter().map(|s| s.to_string()).collect(),
+        next.iter().map(|s| s.x.clone()).collect(),
+    )?;
     let (out, name) = writer(args.out.as_deref())?;
     table.write(out, &name)?;
     Ok(())

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
-use impactcal::core::ParameterSpace;
+use impactcal::core::{ParameterSpace, Table};
 use impactcal::core::sampling::{self, Method};
 use impactcal::sobol::SaltelliDesign;
 
@@ -102,7 +102,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         eprintln!("impactcal: warning: {w}");
     }
     let names = space.names().into_iter().map(str::to_string).collect();
-    let table = points.to_table(names)?;
+    let table = Table::from_matrix(names, points.as_ref())?;
     let (out, name) = writer(args.out.as_deref())?;
     table.write(out, &name)?;
     Ok(())

@@ -4,10 +4,11 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
-use impactcal::core::{ParameterSpace, Points, Table, TableOptions};
+use faer::MatRef;
+use impactcal::core::{ParameterSpace, Table, TableOptions, read_samples};
 use impactcal::sobol::{
-    DesignLayout, FirstOrderEstimator, GivenDataOptions, OutputView, SobolError, SobolOptions,
-    TotalEstimator, analyze, given_data_first_order,
+    DesignLayout, FirstOrderEstimator, GivenDataOptions, SobolError, SobolOptions, TotalEstimator,
+    analyze, given_data_first_order,
 };
 
 use crate::error::CliError;
@@ -28,8 +29,9 @@ pub struct Args {
     /// Bounds file: `name,lower,upper,nominal[,unit]`.
     #[arg(long)]
     bounds: PathBuf,
-    /// Parameter values, one row per run, header of parameter names (as written by
-    /// `impactcal sample --method saltelli`, or SALib's design with that header).
+    /// Parameter values, one row per run, header of parameter names (exactly the names of
+    /// the bounds file, in any order; as written by `impactcal sample --method saltelli`,
+    /// or SALib's design with that header).
     #[arg(long)]
     params: PathBuf,
     /// Model outputs, one row per run in the same order, one named column per output
@@ -82,67 +84,38 @@ enum TotalChoice {
     Martinez2011,
 }
 
-/// Columns of `table` in the order of the space's parameters.
-fn parameter_points(space: &ParameterSpace, table: &Table, file: &str) -> Result<Points, CliError> {
-    if table.header.len() != space.dim() {
-        return Err(CliError::Input(format!(
-            "{file}: {} columns, but the bounds file has {} parameters",
-            table.header.len(),
-            space.dim()
-        )));
-    }
-    let mut index = Vec::with_capacity(space.dim());
-    for name in space.names() {
-        let k = table.column_index(name).ok_or_else(|| {
-            CliError::Input(format!(
-                "{file}: no column `{name}` (a parameter of the bounds file)"
-            ))
-        })?;
-        index.push(k);
-    }
-    let mut data = Vec::with_capacity(table.rows.len() * space.dim());
-    for row in &table.rows {
-        data.extend(index.iter().map(|&k| row[k]));
-    }
-    Ok(Points::new(table.rows.len(), space.dim(), data)?)
-}
-
 /// Runs `impactcal sobol`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let space = ParameterSpace::read_csv(&args.bounds)?;
     let params_name = args.params.display().to_string();
-    let x = parameter_points(
-        &space,
-        &Table::read(&args.params, TableOptions::default())?,
-        &params_name,
-    )?;
+    let x = read_samples(&args.params, &space, &[], TableOptions::default())?.points;
     let y = Table::read(&args.outputs, TableOptions::default())?;
-    if y.rows.len() != x.n() {
+    if y.len() != x.nrows() {
         return Err(CliError::Input(format!(
             "{}: {} rows, but {params_name} has {} runs",
             args.outputs.display(),
-            y.rows.len(),
-            x.n()
+            y.len(),
+            x.nrows()
         )));
     }
-    let cols = y.header.len();
-    let flat: Vec<f64> = y.rows.iter().flatten().copied().collect();
-    let view = OutputView::new(&flat, x.n(), cols)?;
+    let cols = y.header().len();
+    let flat: Vec<f64> = y.rows().iter().flatten().copied().collect();
+    let view = MatRef::from_row_major_slice(&flat, x.nrows(), cols);
     let parameter_names: Vec<String> = space.names().into_iter().map(str::to_string).collect();
     if args.given_data {
         let options = GivenDataOptions {
             bins: args.bins,
             parameter_names: Some(parameter_names),
-            output_names: Some(y.header.clone()),
+            output_names: Some(y.header().to_vec()),
             ..GivenDataOptions::default()
         };
         return write_json(
-            &given_data_first_order(&x, view, &options)?,
+            &given_data_first_order(x.as_ref(), view, &options)?,
             args.out.as_deref(),
         );
     }
-    let layout = DesignLayout::from_rows(x.n(), space.dim(), args.second_order)?;
-    layout.check_points(&x).map_err(|e| {
+    let layout = DesignLayout::from_rows(x.nrows(), space.dim(), args.second_order)?;
+    layout.check_points(x.as_ref()).map_err(|e| {
         CliError::Input(format!(
             "{params_name}: {e} (use --given-data for any other sample)"
         ))
@@ -164,7 +137,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         confidence: args.confidence,
         seed: args.seed,
         parameter_names: Some(parameter_names),
-        output_names: Some(y.header.clone()),
+        output_names: Some(y.header().to_vec()),
         ..SobolOptions::default()
     };
     let indices = analyze(&layout, view, &options)?;

@@ -3,8 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
-use faer::Mat;
-use impactcal::core::{ParameterSpace, Table, TableOptions};
+use impactcal::core::{ParameterSpace, Samples, Table, TableOptions, read_samples};
 use impactcal::erbf::{ErbfError, ErrorSummary, LooMethod, Surrogate, SurrogateKind};
 
 use crate::error::CliError;
@@ -58,8 +57,8 @@ struct FitArgs {
     /// Bounds file: `name,lower,upper,nominal[,unit]`; inputs are scaled by these bounds.
     #[arg(long)]
     bounds: PathBuf,
-    /// Parameter samples: a header of parameter names (every name of the bounds file), one
-    /// row per sample.
+    /// Parameter samples: a header of parameter names (exactly the names of the bounds
+    /// file, in any order), one row per sample.
     #[arg(long)]
     params: PathBuf,
     /// Responses: a header of output names, one row per sample (same order as --params),
@@ -79,7 +78,8 @@ struct PredictArgs {
     /// A model written by `impactcal surrogate fit`.
     #[arg(long)]
     model: PathBuf,
-    /// Parameter values: a header of parameter names, one row per query.
+    /// Parameter values: a header of parameter names (exactly the model's), one row per
+    /// query.
     #[arg(long)]
     params: PathBuf,
     /// Where to write the predictions (CSV with the model's output names); stdout when
@@ -98,27 +98,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
 fn fit(a: FitArgs) -> Result<(), CliError> {
     let space = ParameterSpace::read_csv(&a.bounds)?;
-    let params = Table::read(&a.params, TableOptions::default())?;
+    let params = read_samples(&a.params, &space, &[], TableOptions::default())?;
     let outputs = Table::read(&a.outputs, TableOptions::default())?;
-    let x = parameter_matrix(&space, &params, &a.params)?;
-    if outputs.rows.len() != params.rows.len() {
+    if outputs.len() != params.points.nrows() {
         return Err(CliError::Input(format!(
             "{}: {} sample rows, but {} has {}; one response row per sample is required",
             a.outputs.display(),
-            outputs.rows.len(),
+            outputs.len(),
             a.params.display(),
-            params.rows.len()
+            params.points.nrows()
         )));
     }
-    let f = Mat::from_fn(outputs.rows.len(), outputs.header.len(), |i, j| {
-        outputs.rows[i][j]
-    });
     let model = Surrogate::fit(
         &space,
         a.kind.into(),
-        x.as_ref(),
-        f.as_ref(),
-        outputs.header.clone(),
+        params.points.as_ref(),
+        outputs.to_matrix().as_ref(),
+        outputs.header().to_vec(),
     )
     .map_err(|e| fit_error(e, &params, &a.params))?;
     eprintln!(
@@ -126,7 +122,7 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
         model.kind(),
         model.n_samples(),
         space.dim(),
-        outputs.header.len()
+        outputs.header().len()
     );
     eprintln!(
         "training residual max|f(x_k) - F_k| / max|F| = {:.3e}",
@@ -154,8 +150,8 @@ fn predict(a: PredictArgs) -> Result<(), CliError> {
             a.model.display()
         ))
     })?;
-    let params = Table::read(&a.params, TableOptions::default())?;
-    let x = parameter_matrix(model.space(), &params, &a.params)?;
+    let params = read_samples(&a.params, model.space(), &[], TableOptions::default())?;
+    let x = &params.points;
     let outside: Vec<usize> = (0..x.nrows())
         .filter(|&i| {
             let row: Vec<f64> = x.row(i).iter().copied().collect();
@@ -175,53 +171,15 @@ fn predict(a: PredictArgs) -> Result<(), CliError> {
     let y = model
         .predict_batch(x.as_ref())
         .map_err(|e| CliError::Input(format!("{}: {e}", a.params.display())))?;
-    let table = Table {
-        header: model.output_names().to_vec(),
-        rows: (0..y.nrows())
-            .map(|i| y.row(i).iter().copied().collect())
-            .collect(),
-        lines: Vec::new(),
-    };
+    let table = Table::from_matrix(model.output_names().to_vec(), y.as_ref())?;
     let (out, name) = writer(a.out.as_deref())?;
     table
         .write(out, &name)
         .map_err(|e| CliError::Failure(e.to_string()))
 }
 
-/// The samples as an `N x m` matrix in the order of `space`, matched by column name.
-fn parameter_matrix(
-    space: &ParameterSpace,
-    table: &Table,
-    path: &Path,
-) -> Result<Mat<f64>, CliError> {
-    let mut columns = Vec::with_capacity(space.dim());
-    for name in space.names() {
-        match table.column_index(name) {
-            Some(c) => columns.push(c),
-            None => {
-                return Err(CliError::Input(format!(
-                    "{}: no column `{name}` (the header must name every parameter of the \
-                     bounds file: {})",
-                    path.display(),
-                    space.names().join(", ")
-                )));
-            }
-        }
-    }
-    if let Some(extra) = table.header.iter().find(|h| space.index_of(h).is_none()) {
-        return Err(CliError::Input(format!(
-            "{}: column `{extra}` is not a parameter of the bounds file ({})",
-            path.display(),
-            space.names().join(", ")
-        )));
-    }
-    Ok(Mat::from_fn(table.rows.len(), columns.len(), |i, j| {
-        table.rows[i][columns[j]]
-    }))
-}
-
 /// Maps sample indices in a fit error to lines of the samples file.
-fn fit_error(e: ErbfError, params: &Table, path: &Path) -> CliError {
+fn fit_error(e: ErbfError, params: &Samples, path: &Path) -> CliError {
     let line = |k: usize| params.lines.get(k).copied().unwrap_or(k + 2);
     match e {
         ErbfError::DuplicateSamples {

@@ -35,8 +35,8 @@ fn suggest(bounds: &Path, history: &Path, extra: &[&str]) -> Vec<Vec<f64>> {
     );
     let text = String::from_utf8(out.stdout).unwrap();
     let t = Table::parse(&text, "stdout", TableOptions::default()).unwrap();
-    assert_eq!(t.header, vec!["x1", "x2"]);
-    t.rows
+    assert_eq!(t.header(), &["x1", "x2"]);
+    t.rows().to_vec()
 }
 
 fn append(history: &Path, x: &[f64], value: f64) {

@@ -7,17 +7,27 @@
 use std::io::Write;
 use std::path::Path;
 
+use faer::{Mat, MatRef};
+
 use crate::error::{CoreError, Result};
+use crate::space::ParameterSpace;
 
 /// A numeric table: one name per column and rows of equal length.
+///
+/// Built only by the reader ([`Table::read`], [`Table::parse`]) or the checked constructors
+/// ([`Table::new`], [`Table::from_matrix`]), so that its invariants hold: names unique and
+/// non-empty, every row as long as the header, no infinite value (NaN marks a missing
+/// value), and a source line for every row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table {
     /// Column names from the header row, trimmed, unique and non-empty.
-    pub header: Vec<String>,
+    pub(crate) header: Vec<String>,
     /// Data rows; every row has `header.len()` values.
-    pub rows: Vec<Vec<f64>>,
+    pub(crate) rows: Vec<Vec<f64>>,
     /// For each data row, its 1-based line number in the source (for later error messages).
-    pub lines: Vec<usize>,
+    pub(crate) lines: Vec<usize>,
+    /// The file (or the name given to text parsed from memory) the table came from.
+    pub(crate) source: String,
 }
 
 /// What a table reader accepts beyond plain finite numbers.
@@ -31,6 +41,107 @@ pub struct TableOptions {
 }
 
 impl Table {
+    /// A table of the given columns and rows, as it would be written to a file: row `k`
+    /// (0-based) gets line `k + 2` (the header is line 1).
+    ///
+    /// # Errors
+    /// [`CoreError::Invalid`] for no columns, or an empty or repeated name;
+    /// [`CoreError::DimensionMismatch`] for a row whose length differs from the header's;
+    /// [`CoreError::NonFinite`] for an infinite value (NaN is allowed: a missing value,
+    /// written as an empty cell).
+    pub fn new(header: Vec<String>, rows: Vec<Vec<f64>>) -> Result<Table> {
+        if header.is_empty() {
+            return Err(CoreError::Invalid("a table needs at least one column".into()));
+        }
+        for (j, name) in header.iter().enumerate() {
+            if name.trim().is_empty() {
+                return Err(CoreError::Invalid(format!(
+                    "column {} of a table has an empty name",
+                    j + 1
+                )));
+            }
+            if header[..j].contains(name) {
+                return Err(CoreError::Invalid(format!(
+                    "column name `{name}` is used twice"
+                )));
+            }
+        }
+        for (i, row) in rows.iter().enumerate() {
+            if row.len() != header.len() {
+                return Err(CoreError::DimensionMismatch {
+                    what: format!("table row {i}: number of values (one per column)"),
+                    expected: header.len(),
+                    found: row.len(),
+                });
+            }
+            if let Some(j) = row.iter().position(|v| v.is_infinite()) {
+                return Err(CoreError::NonFinite {
+                    what: "table".into(),
+                    location: format!("row {i}, column `{}`", header[j]),
+                    value: row[j],
+                });
+            }
+        }
+        let lines = (2..rows.len() + 2).collect();
+        Ok(Table {
+            header,
+            rows,
+            lines,
+            source: "(table)".into(),
+        })
+    }
+
+    /// A table of the rows of `m` (`n x header.len()`), for example points or predictions.
+    ///
+    /// # Errors
+    /// As [`Table::new`]; [`CoreError::DimensionMismatch`] when `m` has not one column per
+    /// name.
+    pub fn from_matrix(header: Vec<String>, m: MatRef<'_, f64>) -> Result<Table> {
+        if header.len() != m.ncols() {
+            return Err(CoreError::DimensionMismatch {
+                what: "number of column names (one per matrix column)".into(),
+                expected: m.ncols(),
+                found: header.len(),
+            });
+        }
+        Table::new(header, crate::points::to_rows(m))
+    }
+
+    /// Column names, in order.
+    pub fn header(&self) -> &[String] {
+        &self.header
+    }
+
+    /// Data rows; every row has one value per column (NaN for a missing value).
+    pub fn rows(&self) -> &[Vec<f64>] {
+        &self.rows
+    }
+
+    /// The 1-based line of each data row in its source.
+    pub fn lines(&self) -> &[usize] {
+        &self.lines
+    }
+
+    /// The file (or name) the table was read from; `(table)` for one built in memory.
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Number of data rows.
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Whether there is no data row.
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    /// The whole table as an `n x columns` matrix, one row per data row.
+    pub fn to_matrix(&self) -> Mat<f64> {
+        Mat::from_fn(self.rows.len(), self.header.len(), |i, j| self.rows[i][j])
+    }
+
     /// Reads a table from a file; see [`Table::parse`] for the rules.
     ///
     /// # Errors
@@ -124,12 +235,74 @@ impl Table {
             header,
             rows,
             lines,
+            source: source_name.to_string(),
         })
     }
 
     /// Index of the column called `name`.
     pub fn column_index(&self, name: &str) -> Option<usize> {
         self.header.iter().position(|h| h == name)
+    }
+
+    /// Reads samples by parameter name: the columns named by the parameters of `space`, in
+    /// the space's order, as an `n x dim` matrix, and the columns named in `also` (for
+    /// example `objective`), in that order. The header must hold exactly these names, in any
+    /// order: the one rule of every command that reads samples.
+    ///
+    /// # Errors
+    /// [`CoreError::Columns`] naming every missing and every unexpected column;
+    /// [`CoreError::Csv`] naming the file, row and column of an empty (missing) parameter
+    /// value, which tables read with [`TableOptions::allow_missing`] can hold.
+    pub fn samples(&self, space: &ParameterSpace, also: &[&str]) -> Result<Samples> {
+        let expected: Vec<String> = space
+            .names()
+            .into_iter()
+            .chain(also.iter().copied())
+            .map(str::to_string)
+            .collect();
+        let missing: Vec<String> = expected
+            .iter()
+            .filter(|n| self.column_index(n).is_none())
+            .cloned()
+            .collect();
+        let unexpected: Vec<String> = self
+            .header
+            .iter()
+            .filter(|h| !expected.contains(h))
+            .cloned()
+            .collect();
+        if !missing.is_empty() || !unexpected.is_empty() {
+            return Err(CoreError::Columns {
+                file: self.source.clone(),
+                missing,
+                unexpected,
+                expected,
+            });
+        }
+        let index: Vec<usize> = expected
+            .iter()
+            .filter_map(|n| self.column_index(n))
+            .collect();
+        let (params, others) = index.split_at(space.dim());
+        for (row, &line) in self.rows.iter().zip(&self.lines) {
+            if let Some(&j) = params.iter().find(|&&j| row[j].is_nan()) {
+                return Err(CoreError::Csv {
+                    file: self.source.clone(),
+                    row: line,
+                    column: j + 1,
+                    message: format!("parameter `{}` is empty", self.header[j]),
+                });
+            }
+        }
+        let n = self.rows.len();
+        Ok(Samples {
+            points: Mat::from_fn(n, params.len(), |i, j| self.rows[i][params[j]]),
+            also: others
+                .iter()
+                .map(|&j| self.rows.iter().map(|r| r[j]).collect())
+                .collect(),
+            lines: self.lines.clone(),
+        })
     }
 
     /// Writes the table as CSV; numbers use Rust's shortest round-trip formatting, so reading
@@ -148,6 +321,31 @@ impl Table {
         }
         out.flush().map_err(io)
     }
+}
+
+/// Samples read by parameter name ([`Table::samples`], [`read_samples`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Samples {
+    /// `n x dim`: one sample per row, columns in the order of the parameter space.
+    pub points: Mat<f64>,
+    /// The columns asked for besides the parameters, in the order asked (NaN for a missing
+    /// value where the table allows them).
+    pub also: Vec<Vec<f64>>,
+    /// The 1-based line of each sample in its file.
+    pub lines: Vec<usize>,
+}
+
+/// Reads a sample table by parameter name: [`Table::read`] then [`Table::samples`].
+///
+/// # Errors
+/// As [`Table::read`] and [`Table::samples`].
+pub fn read_samples(
+    path: impl AsRef<Path>,
+    space: &ParameterSpace,
+    also: &[&str],
+    options: TableOptions,
+) -> Result<Samples> {
+    Table::read(path, options)?.samples(space, also)
 }
 
 /// Reads a whole text file, returning its text and its path as a display name.
@@ -275,9 +473,10 @@ mod tests {
     #[test]
     fn reads_header_and_rows() {
         let t = parse("a, b\n1,2\n\n3,4.5\n").unwrap();
-        assert_eq!(t.header, vec!["a", "b"]);
-        assert_eq!(t.rows, vec![vec![1.0, 2.0], vec![3.0, 4.5]]);
-        assert_eq!(t.lines, vec![2, 4]);
+        assert_eq!(t.header(), &["a", "b"]);
+        assert_eq!(t.rows(), &[vec![1.0, 2.0], vec![3.0, 4.5]]);
+        assert_eq!(t.lines(), &[2, 4]);
+        assert_eq!(t.source(), "t.csv");
     }
 
     #[test]
@@ -304,20 +503,82 @@ mod tests {
             allow_no_rows: false,
         };
         let t = Table::parse("a,b\n1,\n2,nan\n", "t.csv", options).unwrap();
-        assert!(t.rows[0][1].is_nan() && t.rows[1][1].is_nan());
+        assert!(t.rows()[0][1].is_nan() && t.rows()[1][1].is_nan());
         assert!(Table::parse("a,b\n1,inf\n", "t.csv", options).is_err());
     }
 
     #[test]
     fn write_then_read_is_lossless() {
-        let t = Table {
-            header: vec!["x".into(), "y".into()],
-            rows: vec![vec![0.1 + 0.2, -1e-300], vec![std::f64::consts::PI, 7.0]],
-            lines: vec![2, 3],
-        };
+        let t = Table::new(
+            vec!["x".into(), "y".into()],
+            vec![vec![0.1 + 0.2, -1e-300], vec![std::f64::consts::PI, 7.0]],
+        )
+        .unwrap();
+        assert_eq!(t.lines(), &[2, 3]);
         let mut buf = Vec::new();
         t.write(&mut buf, "mem").unwrap();
         let back = parse(std::str::from_utf8(&buf).unwrap()).unwrap();
-        assert_eq!(back, t);
+        assert_eq!((back.header(), back.rows(), back.lines()), (t.header(), t.rows(), t.lines()));
+    }
+
+    #[test]
+    fn checked_constructors_refuse_invalid_tables() {
+        let h = |names: &[&str]| names.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        assert!(Table::new(vec![], vec![]).is_err());
+        assert!(Table::new(h(&["a", "a"]), vec![]).is_err());
+        assert!(Table::new(h(&["a", " "]), vec![]).is_err());
+        assert!(matches!(
+            Table::new(h(&["a", "b"]), vec![vec![1.0]]),
+            Err(CoreError::DimensionMismatch { expected: 2, found: 1, .. })
+        ));
+        assert!(Table::new(h(&["a"]), vec![vec![f64::INFINITY]]).is_err());
+        assert!(Table::new(h(&["a"]), vec![vec![f64::NAN]]).is_ok());
+        let m = faer::Mat::from_fn(2, 2, |i, j| (i + 2 * j) as f64);
+        let t = Table::from_matrix(h(&["p", "q"]), m.as_ref()).unwrap();
+        assert_eq!(t.rows(), &[vec![0.0, 2.0], vec![1.0, 3.0]]);
+        assert_eq!(t.to_matrix(), m);
+        assert!(Table::from_matrix(h(&["p"]), m.as_ref()).is_err());
+    }
+
+    #[test]
+    fn samples_by_name_follow_one_rule() {
+        use crate::space::Parameter;
+        let space = ParameterSpace::new(vec![
+            Parameter::new("a", 0.0, 1.0, 0.5).unwrap(),
+            Parameter::new("b", 0.0, 1.0, 0.5).unwrap(),
+        ])
+        .unwrap();
+        let options = TableOptions {
+            allow_missing: true,
+            allow_no_rows: false,
+        };
+        let t = Table::parse("objective,b,a\n3,0.2,0.1\n,0.4,0.3\n", "h.csv", options).unwrap();
+        let s = t.samples(&space, &["objective"]).unwrap();
+        assert_eq!(s.points, faer::Mat::from_fn(2, 2, |i, j| [[0.1, 0.2], [0.3, 0.4]][i][j]));
+        assert_eq!(s.also[0][0], 3.0);
+        assert!(s.also[0][1].is_nan());
+        assert_eq!(s.lines, vec![2, 3]);
+        // Missing and extra columns: one error naming both.
+        let e = t.samples(&space, &[]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "h.csv: unexpected column `objective` (the header must name exactly these \
+             columns, in any order: a, b)"
+        );
+        let t = Table::parse("a,c\n1,2\n", "p.csv", TableOptions::default()).unwrap();
+        match t.samples(&space, &[]).unwrap_err() {
+            CoreError::Columns {
+                missing,
+                unexpected,
+                ..
+            } => assert_eq!((missing, unexpected), (vec!["b".into()], vec!["c".into()])),
+            e => panic!("unexpected {e}"),
+        }
+        // An empty parameter value is named by file, row and column.
+        let t = Table::parse("a,b\n1,\n", "q.csv", options).unwrap();
+        assert_eq!(
+            position(t.samples(&space, &[]).unwrap_err()),
+            (2, 2)
+        );
     }
 }
