@@ -6,9 +6,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use faer::Mat;
+use impactcal::core::sampling::latin_hypercube;
+use impactcal::core::test_functions::surrogate_accuracy_set;
 use impactcal::core::{Parameter, ParameterSpace};
-use impactcal::erbf::testfns::{TestFunction, latin_hypercube};
-use impactcal::erbf::{Accuracy, Erbf, ErbfOptions, Kernel, RbfInterpolant, RbfOptions};
+use impactcal::erbf::{Accuracy, Erbf, ErbfOptions, RadialFunction, RbfInterpolant, RbfOptions};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -20,8 +21,8 @@ fn main() {
     let mut wins = 0;
     let mut overall = [0.0; 4];
     let mut cases = 0;
-    for f in TestFunction::ALL {
-        let m = f.dim();
+    for f in surrogate_accuracy_set() {
+        let m = f.dim;
         let space = ParameterSpace::new(
             (0..m)
                 .map(|j| Parameter::new(format!("x{j}"), 0.0, 1.0, 0.5).unwrap())
@@ -33,7 +34,7 @@ fn main() {
             let mut sums = [[0.0; 3]; 4];
             for seed in 0..seeds {
                 let mut rng = ChaCha8Rng::seed_from_u64(1000 * seed + n as u64);
-                let x = latin_hypercube(n, m, &mut rng);
+                let x = latin_hypercube(n, m, &mut rng).unwrap();
                 let q = Mat::from_fn(n_test, m, |_, _| rng.random::<f64>());
                 let eval = |p: &Mat<f64>| {
                     Mat::from_fn(p.nrows(), 1, |i, _| {
@@ -48,7 +49,7 @@ fn main() {
                 let gauss = RbfInterpolant::fit(
                     x.as_ref(),
                     fx.as_ref(),
-                    RbfOptions::new(Kernel::Gaussian { width: 0.15 }),
+                    RbfOptions::new(RadialFunction::Gaussian { width: 0.15 }),
                 )
                 .unwrap()
                 .predict_batch(q.as_ref())
@@ -82,7 +83,7 @@ fn main() {
                 let s = seeds as f64;
                 println!(
                     "| {} | {m} | {n} | {name} | {:.3} | {:.3} | {:.3} |",
-                    f.name(),
+                    f.title,
                     sums[k][0] / s,
                     sums[k][1] / s,
                     sums[k][2] / s

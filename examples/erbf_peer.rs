@@ -12,7 +12,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use faer::MatRef;
-use impactcal::erbf::{Erbf, ErbfOptions, Kernel, RbfInterpolant, RbfOptions};
+use impactcal::erbf::{Erbf, ErbfOptions, RadialFunction, RbfInterpolant, RbfOptions};
 
 #[path = "../benches/common/surrogate_data.rs"]
 mod surrogate_data;
@@ -76,7 +76,7 @@ fn main() {
     let (pred_e, _) = time(reps, || erbf.predict_batch(q.as_ref()).unwrap());
     let one: Vec<f64> = q.row(0).iter().copied().collect();
     let (pred1_e, _) = time(reps * 4, || erbf.predict(&one).unwrap());
-    let gauss_opts = RbfOptions::new(Kernel::Gaussian { width: 0.15 });
+    let gauss_opts = RbfOptions::new(RadialFunction::Gaussian { width: 0.15 });
     let (fit_g, gauss) = time(reps, || {
         RbfInterpolant::fit(x.as_ref(), f.as_ref(), gauss_opts).unwrap()
     });

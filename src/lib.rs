@@ -44,7 +44,7 @@ pub mod prelude {
         Cors, CorsError, CorsOptions, InitialDesign, Outcome, StopReason, Suggestion, Transform,
     };
     pub use impactcal_erbf::{
-        Accuracy, ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions,
+        Accuracy, ErbfError, LooMethod, PolyDegree, RadialFunction, RbfInterpolant, RbfOptions,
     };
     pub use impactcal_sensors::{
         CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,

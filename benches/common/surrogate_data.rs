@@ -3,7 +3,7 @@
 
 use faer::Mat;
 use impactcal::core::{Parameter, ParameterSpace};
-use impactcal::erbf::testfns::latin_hypercube;
+use impactcal::core::sampling::latin_hypercube;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -26,7 +26,7 @@ pub fn surrogate_data() -> (ParameterSpace, Mat<f64>, Mat<f64>, Mat<f64>) {
     )
     .unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(42);
-    let x = latin_hypercube(N, M, &mut rng);
+    let x = latin_hypercube(N, M, &mut rng).unwrap();
     let f = Mat::from_fn(N, T, |i, t| {
         let s: f64 = (0..M)
             .map(|j| (3.0 * x[(i, j)] + 1e-3 * (t * (j + 1)) as f64).sin())

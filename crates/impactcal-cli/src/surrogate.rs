@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
 use impactcal::core::{ParameterSpace, Samples, Table, TableOptions, read_samples};
-use impactcal::erbf::{ErbfError, ErrorSummary, LooMethod, Surrogate, SurrogateKind};
+use impactcal::erbf::{ErbfError, ErrorSummary, LooMethod, ResponseSurrogate, SurrogateKind};
 
 use crate::error::CliError;
 use crate::output::{write_json, writer};
@@ -109,7 +109,7 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
             params.points.nrows()
         )));
     }
-    let model = Surrogate::fit(
+    let model = ResponseSurrogate::fit(
         &space,
         a.kind.into(),
         params.points.as_ref(),
@@ -144,7 +144,7 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
 fn predict(a: PredictArgs) -> Result<(), CliError> {
     let text = std::fs::read_to_string(&a.model)
         .map_err(|e| CliError::Input(format!("{}: {e}", a.model.display())))?;
-    let model: Surrogate = serde_json::from_str(&text).map_err(|e| {
+    let model: ResponseSurrogate = serde_json::from_str(&text).map_err(|e| {
         CliError::Input(format!(
             "{}: not a surrogate model written by `impactcal surrogate fit`: {e}",
             a.model.display()

@@ -8,7 +8,7 @@
 //! (hundreds of gradient steps) need.
 
 use faer::MatRef;
-use impactcal_erbf::{Kernel, RbfInterpolant, RbfOptions};
+use impactcal_erbf::{RadialFunction, RbfInterpolant, RbfOptions};
 
 use crate::error::Result;
 use crate::geometry::Columns;
@@ -17,7 +17,7 @@ use crate::options::SurrogateKernel;
 /// A fitted cubic or thin-plate RBF with a linear tail on the unit box.
 #[derive(Debug, Clone)]
 pub struct Surrogate {
-    kernel: Kernel,
+    kernel: RadialFunction,
     dim: usize,
     /// Centres, row-major `N x d`.
     centres: Vec<f64>,
@@ -44,7 +44,7 @@ impl Surrogate {
             Ok(r) => r,
             Err(first) => {
                 let d = points.first().map_or(1, Vec::len) as f64;
-                let kmax = options.kernel.value(d.sqrt()).abs().max(1.0);
+                let kmax = options.radial.value(d.sqrt()).abs().max(1.0);
                 RbfInterpolant::fit_rows(points, values, options.with_smoothing(1e-10 * kmax))
                     .map_err(|_| first)?
             }
@@ -65,10 +65,10 @@ impl Surrogate {
         for i in 0..n {
             centres.extend(pts.row(i).iter().copied());
         }
-        let weights: Vec<f64> = rbf.kernel_weights().col(0).iter().copied().collect();
+        let weights: Vec<f64> = rbf.radial_weights().col(0).iter().copied().collect();
         let tail = rbf.tail_coefficients();
         if tail.nrows() != dim + 1 || tail.ncols() == 0 {
-            return Err(impactcal_erbf::ErbfError::DimensionMismatch {
+            return Err(impactcal_core::CoreError::DimensionMismatch {
                 what: "surrogate tail: linear terms".into(),
                 expected: dim + 1,
                 found: tail.nrows(),
@@ -77,7 +77,7 @@ impl Surrogate {
         }
         let columns = Columns::new(&centres, dim);
         Ok(Surrogate {
-            kernel: rbf.options().kernel,
+            kernel: rbf.options().radial,
             dim,
             centres,
             columns,
@@ -97,7 +97,7 @@ impl Surrogate {
     /// sum over centres keep the order of operations of the plain loop.
     fn kernel_part(&self, x: &[f64]) -> f64 {
         match self.kernel {
-            Kernel::Cubic => self.weighted_sum(x, |r| r * r * r),
+            RadialFunction::Cubic => self.weighted_sum(x, |r| r * r * r),
             kernel => self.weighted_sum(x, |r| kernel.value(r)),
         }
     }

@@ -1,26 +1,28 @@
 //! Input checks shared by both surrogates, and the serialised form of a matrix.
 
 use faer::{Mat, MatRef};
+use impactcal_core::check_finite_mat;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{ErbfError, Result};
+use crate::error::{ErbfError, Result, mismatch, no_samples};
 
 /// A dense matrix in serialisable form: its shape and its entries in column-major order
 /// (entry `(i, j)` at `data[i + j * nrows]`). faer 0.24 has no serde support, so fitted
-/// models store their matrices this way.
+/// models store their matrices this way; it is the private form of a saved model, not part
+/// of the API (matrices are faer's everywhere else).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StoredMat {
+pub(crate) struct StoredMat {
     /// Number of rows.
-    pub nrows: usize,
+    nrows: usize,
     /// Number of columns.
-    pub ncols: usize,
+    ncols: usize,
     /// `nrows * ncols` entries, column-major.
-    pub data: Vec<f64>,
+    data: Vec<f64>,
 }
 
 impl StoredMat {
     /// Copies a matrix.
-    pub fn from_mat(m: MatRef<'_, f64>) -> Self {
+    pub(crate) fn from_mat(m: MatRef<'_, f64>) -> Self {
         let mut data = Vec::with_capacity(m.nrows() * m.ncols());
         for j in 0..m.ncols() {
             data.extend(m.col(j).iter().copied());
@@ -36,7 +38,7 @@ impl StoredMat {
     ///
     /// # Errors
     /// [`ErbfError::InvalidModel`] when `data.len() != nrows * ncols`.
-    pub fn to_mat(&self, what: &str) -> Result<Mat<f64>> {
+    pub(crate) fn to_mat(&self, what: &str) -> Result<Mat<f64>> {
         if self.nrows.checked_mul(self.ncols) != Some(self.data.len()) {
             return Err(ErbfError::InvalidModel(format!(
                 "{what}: {} entries do not fill a {} x {} matrix",
@@ -49,44 +51,18 @@ impl StoredMat {
     }
 }
 
-/// Builds an `n x d` matrix from rows, checking that all rows have length `d` (the length
-/// of the first row).
+/// Builds an `n x d` matrix from rows (the convenience form of the `fit_rows`
+/// constructors).
 ///
 /// # Errors
-/// [`ErbfError::NoSamples`] for no rows; [`ErbfError::DimensionMismatch`] for a ragged row.
-pub fn mat_from_rows(rows: &[Vec<f64>], what: &str) -> Result<Mat<f64>> {
-    let Some(first) = rows.first() else {
-        return Err(ErbfError::NoSamples);
-    };
-    let d = first.len();
-    for (i, r) in rows.iter().enumerate() {
-        if r.len() != d {
-            return Err(ErbfError::DimensionMismatch {
-                what: format!("{what}: length of row {i}"),
-                expected: d,
-                found: r.len(),
-            });
-        }
+/// [`CoreError::Empty`](impactcal_core::CoreError::Empty) for no rows;
+/// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) for a
+/// ragged row.
+pub(crate) fn mat_from_rows(rows: &[Vec<f64>], what: &str) -> Result<Mat<f64>> {
+    if rows.is_empty() {
+        return Err(no_samples());
     }
-    Ok(Mat::from_fn(rows.len(), d, |i, j| rows[i][j]))
-}
-
-/// Checks that every entry is finite.
-pub(crate) fn check_finite(what: &str, m: MatRef<'_, f64>) -> Result<()> {
-    for j in 0..m.ncols() {
-        for i in 0..m.nrows() {
-            let v = m[(i, j)];
-            if !v.is_finite() {
-                return Err(ErbfError::NonFinite {
-                    what: what.to_string(),
-                    row: i,
-                    column: j,
-                    value: v,
-                });
-            }
-        }
-    }
-    Ok(())
+    Ok(impactcal_core::points::from_rows(rows, what)?)
 }
 
 /// Checks the training set: at least one sample, points `N x d` with `d >= 1` (or exactly
@@ -97,53 +73,53 @@ pub(crate) fn check_training(
     expected_dim: Option<usize>,
 ) -> Result<()> {
     if points.nrows() == 0 {
-        return Err(ErbfError::NoSamples);
+        return Err(no_samples());
     }
     if let Some(d) = expected_dim
         && points.ncols() != d
     {
-        return Err(ErbfError::DimensionMismatch {
-            what: "training points: number of columns (parameters)".into(),
-            expected: d,
-            found: points.ncols(),
-        });
+        return Err(mismatch(
+            "training points: number of columns (parameters)",
+            d,
+            points.ncols(),
+        ));
     }
     if points.ncols() == 0 {
-        return Err(ErbfError::DimensionMismatch {
-            what: "training points: number of columns (parameters), at least".into(),
-            expected: 1,
-            found: 0,
-        });
+        return Err(mismatch(
+            "training points: number of columns (parameters), at least",
+            1,
+            0,
+        ));
     }
     if values.nrows() != points.nrows() {
-        return Err(ErbfError::DimensionMismatch {
-            what: "training values: number of rows (one per sample)".into(),
-            expected: points.nrows(),
-            found: values.nrows(),
-        });
+        return Err(mismatch(
+            "training values: number of rows (one per sample)",
+            points.nrows(),
+            values.nrows(),
+        ));
     }
     if values.ncols() == 0 {
-        return Err(ErbfError::DimensionMismatch {
-            what: "training values: number of columns (outputs), at least".into(),
-            expected: 1,
-            found: 0,
-        });
+        return Err(mismatch(
+            "training values: number of columns (outputs), at least",
+            1,
+            0,
+        ));
     }
-    check_finite("training points", points)?;
-    check_finite("training values", values)?;
+    check_finite_mat("training points", points)?;
+    check_finite_mat("training values", values)?;
     Ok(())
 }
 
 /// Checks query points: `d` columns, all finite.
 pub(crate) fn check_queries(points: MatRef<'_, f64>, d: usize) -> Result<()> {
     if points.ncols() != d {
-        return Err(ErbfError::DimensionMismatch {
-            what: "query points: number of columns (parameters)".into(),
-            expected: d,
-            found: points.ncols(),
-        });
+        return Err(mismatch(
+            "query points: number of columns (parameters)",
+            d,
+            points.ncols(),
+        ));
     }
-    check_finite("query points", points)
+    Ok(check_finite_mat("query points", points)?)
 }
 
 /// Returns the first pair `(i, j)`, `i < j`, of rows closer than `tol` (Euclidean), with
@@ -180,7 +156,6 @@ pub(crate) fn reject_duplicates(points: MatRef<'_, f64>, tol: f64) -> Result<()>
     }
 }
 
-/// A copy of `m` without row `k`.
 /// Stacks per-sample rows of `t` values (as computed in parallel, each possibly failed) into
 /// an `n x t` matrix, returning the error of the lowest sample that failed.
 pub(crate) fn collect_rows(rows: Vec<Result<Vec<f64>>>, t: usize) -> Result<Mat<f64>> {
@@ -193,6 +168,7 @@ pub(crate) fn collect_rows(rows: Vec<Result<Vec<f64>>>, t: usize) -> Result<Mat<
     Ok(e)
 }
 
+/// A copy of `m` without row `k`.
 pub(crate) fn without_row(m: MatRef<'_, f64>, k: usize) -> Mat<f64> {
     Mat::from_fn(m.nrows() - 1, m.ncols(), |i, j| {
         m[(if i < k { i } else { i + 1 }, j)]

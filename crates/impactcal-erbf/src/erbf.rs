@@ -35,126 +35,21 @@ use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
 use faer::{Accum, Mat, MatRef, Par};
-use impactcal_core::ParameterSpace;
+use impactcal_core::{ParamGuard, ParameterSpace};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::basis::{basis_gradient, basis_matrix_t, fill_basis, row_major};
 use crate::buffer;
 use crate::data::{
     StoredMat, check_queries, check_training, collect_rows, reject_duplicates, without_row,
 };
 use crate::error::{ErbfError, Result};
 use crate::loo::LooMethod;
-use crate::nrbf::{LeftRight, dphi_l, dphi_r};
+use crate::options::{ErbfOptions, ValidErbfOptions};
 use crate::projection::Projection;
 use crate::rbf::{condition_number, relative_max_error};
 use crate::thin_qr::{ThinQr, thin_qr};
-
-/// Multipliers of the three basis families. The minimum-norm solution is not invariant
-/// to them (rescaling a family changes how much of the data it carries), so they are an
-/// implicit hyper-parameter; the paper's form is all ones.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct FamilyWeights {
-    /// Weight of the Gaussian radial functions `psi_i`.
-    pub radial: f64,
-    /// Weight of the `phi_L` and `phi_R` functions.
-    pub left_right: f64,
-    /// Weight of the linear functions `xi`.
-    pub beta: f64,
-}
-
-impl Default for FamilyWeights {
-    fn default() -> Self {
-        FamilyWeights {
-            radial: 1.0,
-            left_right: 1.0,
-            beta: 1.0,
-        }
-    }
-}
-
-/// Options of an ERBF model. The defaults are those of Horta et al.: local polynomial
-/// order `n_t = 4`, smoothness (half-width) `gamma = 0.15`, Gaussian radius `r_c = 0.15`,
-/// all in unit-scaled inputs.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ErbfOptions {
-    /// Order `n_t` of the local monomials; even, at least 2.
-    pub order: u32,
-    /// Half-width `gamma > 0` of the polynomial region of the N-RBFs.
-    pub gamma: f64,
-    /// Gaussian radius `r_c > 0`.
-    pub rc: f64,
-    /// Family weights (all 1 by default).
-    pub weights: FamilyWeights,
-    /// Subtract each output column's mean before fitting and add it back when predicting
-    /// (off by default; not part of the original method).
-    pub center_outputs: bool,
-    /// Two samples closer than this (Euclidean distance in unit-scaled inputs) are
-    /// rejected as duplicates.
-    pub duplicate_tolerance: f64,
-}
-
-impl Default for ErbfOptions {
-    fn default() -> Self {
-        ErbfOptions {
-            order: 4,
-            gamma: 0.15,
-            rc: 0.15,
-            weights: FamilyWeights::default(),
-            center_outputs: false,
-            duplicate_tolerance: 1e-9,
-        }
-    }
-}
-
-impl ErbfOptions {
-    /// Checks every option.
-    ///
-    /// # Errors
-    /// [`ErbfError::InvalidOption`] for an odd order or one below 2, a `gamma` or `r_c`
-    /// that is not finite and positive, a negative or non-finite family weight or
-    /// duplicate tolerance, or all weights zero.
-    pub fn validate(&self) -> Result<()> {
-        let bad = |name: &'static str, value: String, message: &str| {
-            Err(ErbfError::InvalidOption {
-                name,
-                value,
-                message: message.into(),
-            })
-        };
-        if self.order < 2 || self.order % 2 != 0 || self.order > 64 {
-            return bad(
-                "order (n_t)",
-                self.order.to_string(),
-                "must be an even integer between 2 and 64",
-            );
-        }
-        for (name, v) in [("gamma", self.gamma), ("r_c", self.rc)] {
-            if !(v.is_finite() && v > 0.0) {
-                return bad(name, v.to_string(), "must be finite and positive");
-            }
-        }
-        let w = self.weights;
-        for (name, v) in [
-            ("radial weight", w.radial),
-            ("left/right weight", w.left_right),
-            ("beta weight", w.beta),
-            ("duplicate tolerance", self.duplicate_tolerance),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return bad(name, v.to_string(), "must be finite and non-negative");
-            }
-        }
-        if w.radial == 0.0 && w.left_right == 0.0 && w.beta == 0.0 {
-            return bad(
-                "weights",
-                "0".into(),
-                "at least one family weight must be positive",
-            );
-        }
-        Ok(())
-    }
-}
 
 /// A fitted ERBF model of `T` outputs over a parameter space of `m` inputs.
 ///
@@ -163,13 +58,11 @@ impl ErbfOptions {
 #[derive(Debug, Clone)]
 pub struct Erbf {
     space: ParameterSpace,
-    options: ErbfOptions,
+    options: ValidErbfOptions,
     points: Mat<f64>,
     unit: Mat<f64>,
     values: Mat<f64>,
     mean: Vec<f64>,
-    lower: Vec<f64>,
-    width: Vec<f64>,
     /// `Q_1^T` and the tables that evaluate `Q_1^T b(x)` quickly.
     projection: Projection,
     r: Mat<f64>,
@@ -183,34 +76,35 @@ pub struct Erbf {
 
 impl Erbf {
     /// Fits the model to samples `points` (`N x m`, raw parameter values, one sample per
-    /// row, columns in the order of `space`) and responses `values` (`N x T`).
+    /// row, columns in the order of `space`) and responses `values` (`N x T`, one row per
+    /// sample). Takes [`ErbfOptions`] (checked here) or [`ValidErbfOptions`].
     ///
     /// Cost: `O(N^2 m)` to build `A`, `O(M N^2)` to factorise, `O(m N^2)` for the
     /// prediction tables, and a copy of `values`; `O(N^2 T)` more only when `T` is small
     /// enough that the coefficients `c` are stored.
     ///
     /// # Errors
-    /// - [`ErbfError::InvalidOption`] for invalid options;
-    /// - [`ErbfError::NoSamples`] for `N = 0`;
-    /// - [`ErbfError::DimensionMismatch`] when `points` has not `m` columns or `values` has
-    ///   not `N` rows;
-    /// - [`ErbfError::NonFinite`] for NaN or infinite entries;
-    /// - [`ErbfError::DuplicateSamples`] for two samples closer than the tolerance in
-    ///   scaled inputs, naming both;
-    /// - [`ErbfError::Singular`] when `min |R_ii| / max |R_ii|` falls below `N eps`.
+    /// Under [`ErbfError::Core`]:
+    /// - [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for invalid
+    ///   options;
+    /// - [`CoreError::Empty`](impactcal_core::CoreError::Empty) for `N = 0`;
+    /// - [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when
+    ///   `points` has not `m` columns or `values` has not `N` rows;
+    /// - [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for NaN or infinite
+    ///   entries, naming row and column.
+    ///
+    /// And [`ErbfError::DuplicateSamples`] for two samples closer than the tolerance in
+    /// scaled inputs, naming both; [`ErbfError::Singular`] when `min |R_ii| / max |R_ii|`
+    /// falls below `N eps`.
     pub fn fit(
         space: &ParameterSpace,
         points: MatRef<'_, f64>,
         values: MatRef<'_, f64>,
-        options: ErbfOptions,
+        options: impl ParamGuard<Checked = ValidErbfOptions>,
     ) -> Result<Self> {
-        options.validate()?;
+        let options = options.check()?;
         check_training(points, values, Some(space.dim()))?;
-        let lower = space.lower();
-        let width: Vec<f64> = space.parameters().iter().map(|p| p.width()).collect();
-        let unit = Mat::from_fn(points.nrows(), points.ncols(), |i, j| {
-            (points[(i, j)] - lower[j]) / width[j]
-        });
+        let unit = space.to_unit_matrix(points)?;
         reject_duplicates(unit.as_ref(), options.duplicate_tolerance)?;
         let t = values.ncols();
         let mean: Vec<f64> = if options.center_outputs {
@@ -241,8 +135,6 @@ impl Erbf {
             unit,
             values: buffer::copy(values),
             mean,
-            lower,
-            width,
             projection,
             r: factor.r,
             centred,
@@ -254,13 +146,14 @@ impl Erbf {
     /// Fits one output from rows of raw parameter values.
     ///
     /// # Errors
-    /// As [`fit`](Self::fit); [`ErbfError::DimensionMismatch`] for ragged rows or a
-    /// `values` length different from the number of rows.
+    /// As [`fit`](Self::fit);
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) for
+    /// ragged rows or a `values` length different from the number of rows.
     pub fn fit_rows(
         space: &ParameterSpace,
         points: &[Vec<f64>],
         values: &[f64],
-        options: ErbfOptions,
+        options: impl ParamGuard<Checked = ValidErbfOptions>,
     ) -> Result<Self> {
         let x = crate::data::mat_from_rows(points, "training points")?;
         let f = MatRef::from_column_major_slice(values, values.len(), 1);
@@ -361,7 +254,8 @@ impl Erbf {
     /// The prediction at `x` (raw parameters): `T` values.
     ///
     /// # Errors
-    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for a bad `x`.
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) or
+    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for a bad `x`.
     pub fn predict(&self, x: &[f64]) -> Result<Vec<f64>> {
         let out = self.predict_batch(MatRef::from_row_major_slice(x, 1, x.len()))?;
         Ok(out.row(0).iter().copied().collect())
@@ -377,14 +271,13 @@ impl Erbf {
     /// depend on the number of threads.
     ///
     /// # Errors
-    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for bad points.
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) or
+    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for bad points.
     pub fn predict_batch(&self, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
         check_queries(points, self.dim())?;
         let q = points.nrows();
         let m = self.dim();
-        let unit: Vec<f64> = (0..q)
-            .flat_map(|i| (0..m).map(move |j| (points[(i, j)] - self.lower[j]) / self.width[j]))
-            .collect();
+        let unit = row_major(self.space.to_unit_matrix(points)?.as_ref());
         let mut out = buffer::zeros(q, self.n_outputs());
         match &self.coef {
             Some(c) => {
@@ -445,18 +338,18 @@ impl Erbf {
     /// `d / d q^j = (1 / (hi_j - lo_j)) d / d u^j`.
     ///
     /// # Errors
-    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for a bad `x`.
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) or
+    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for a bad `x`.
     pub fn predict_gradient(&self, x: &[f64]) -> Result<Mat<f64>> {
         check_queries(MatRef::from_row_major_slice(x, 1, x.len()), self.dim())?;
         let m = self.dim();
-        let u: Vec<f64> = (0..m)
-            .map(|j| (x[j] - self.lower[j]) / self.width[j])
-            .collect();
+        let u = self.space.to_unit(x)?;
         let db = basis_gradient(&u, self.unit.as_ref(), &self.options);
         let mut g = Mat::<f64>::zeros(m, self.n_outputs());
         self.apply(db.as_ref(), g.as_mut());
+        let p = self.space.parameters();
         Ok(Mat::from_fn(self.n_outputs(), m, |t, j| {
-            g[(j, t)] / self.width[j]
+            g[(j, t)] / p[j].width()
         }))
     }
 
@@ -596,93 +489,6 @@ impl Factor {
     }
 }
 
-/// The basis vectors of the queries `u` (`Q x m`, scaled) with respect to the centres
-/// `centres` (`N x m`, scaled), as the columns of an `M x Q` matrix (built in parallel).
-pub(crate) fn basis_matrix_t(
-    u: MatRef<'_, f64>,
-    centres: MatRef<'_, f64>,
-    o: &ErbfOptions,
-) -> Mat<f64> {
-    let m = centres.ncols();
-    let c = row_major(centres);
-    let q = u.nrows();
-    let u = row_major(u);
-    // Small chunks: the matrix of a fit has only N columns to share between threads.
-    const COLUMNS: usize = 16;
-    let mut bt = buffer::zeros(centres.nrows() * (3 * m + 1), q);
-    bt.par_col_chunks_mut(COLUMNS)
-        .enumerate()
-        .for_each(|(k, cols)| {
-            let len = cols.ncols();
-            fill_basis(&u[k * COLUMNS * m..(k * COLUMNS + len) * m], &c, m, o, cols);
-        });
-    bt
-}
-
-/// The entries of `a` (`r x m`) row by row.
-fn row_major(a: MatRef<'_, f64>) -> Vec<f64> {
-    (0..a.nrows())
-        .flat_map(|i| (0..a.ncols()).map(move |j| a[(i, j)]))
-        .collect()
-}
-
-/// Writes into the columns of `out` (`M x Q`) the basis vectors of the scaled queries `u`
-/// (row-major, `Q x m`) with respect to the scaled centres `c` (row-major, `N x m`):
-/// radial values first, then per centre and input `{phi_L, phi_R, xi}`, each family times
-/// its weight.
-fn fill_basis(u: &[f64], c: &[f64], m: usize, o: &ErbfOptions, mut out: faer::MatMut<'_, f64>) {
-    let lr = LeftRight::new(o.order as i32, o.gamma);
-    let inv2rc2 = 0.5 / (o.rc * o.rc);
-    let w = o.weights;
-    let n = c.len() / m.max(1);
-    for (q, x) in u.chunks_exact(m.max(1)).enumerate() {
-        let Some(col) = out.as_mut().col_mut(q).try_as_col_major_mut() else {
-            continue;
-        };
-        let col = col.as_slice_mut();
-        let (radial, rest) = col.split_at_mut(n);
-        for ((r, out3m), ci) in radial
-            .iter_mut()
-            .zip(rest.chunks_exact_mut(3 * m))
-            .zip(c.chunks_exact(m))
-        {
-            let mut d2 = 0.0;
-            for ((&xj, &cj), o3) in x.iter().zip(ci).zip(out3m.chunks_exact_mut(3)) {
-                let xi = xj - cj;
-                d2 += xi * xi;
-                let (l, rr) = lr.values(xi);
-                o3[0] = w.left_right * l;
-                o3[1] = w.left_right * rr;
-                o3[2] = w.beta * xi;
-            }
-            *r = w.radial * (-d2 * inv2rc2).exp();
-        }
-    }
-}
-
-/// Derivatives of the basis vector at the scaled point `u`: an `M x m` matrix whose column
-/// `j` is `d b / d u^j`.
-fn basis_gradient(u: &[f64], centres: MatRef<'_, f64>, o: &ErbfOptions) -> Mat<f64> {
-    let n = centres.nrows();
-    let m = centres.ncols();
-    let order = o.order as i32;
-    let w = o.weights;
-    let mut db = Mat::<f64>::zeros(n * (3 * m + 1), m);
-    for i in 0..n {
-        let d2: f64 = (0..m).map(|j| (u[j] - centres[(i, j)]).powi(2)).sum();
-        let psi = w.radial * (-0.5 * d2 / (o.rc * o.rc)).exp();
-        for j in 0..m {
-            let xi = u[j] - centres[(i, j)];
-            db[(i, j)] = -xi / (o.rc * o.rc) * psi;
-            let base = n + 3 * (i * m + j);
-            db[(base, j)] = w.left_right * dphi_l(xi, order, o.gamma);
-            db[(base + 1, j)] = w.left_right * dphi_r(xi, order, o.gamma);
-            db[(base + 2, j)] = w.beta;
-        }
-    }
-    db
-}
-
 /// The serialised form of an [`Erbf`]: space, options and training data.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct ErbfData {
@@ -696,7 +502,7 @@ impl Serialize for Erbf {
     fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
         ErbfData {
             space: self.space.clone(),
-            options: self.options,
+            options: *self.options,
             points: StoredMat::from_mat(self.points.as_ref()),
             values: StoredMat::from_mat(self.values.as_ref()),
         }

@@ -1,42 +1,22 @@
 //! The error type of `impactcal-erbf`.
 
-use impactcal_core::CoreError;
+use impactcal_core::{CoreError, ErrorKind};
 
 /// Everything that can go wrong when fitting, evaluating or loading a surrogate.
 ///
 /// Sample indices in messages are 0-based positions in the training set (row `k` of the
-/// points matrix); callers that read samples from a file map them to file lines.
+/// points matrix); callers that read samples from a file map them to file lines. Faults
+/// shared with the other crates are [`CoreError`]s under [`ErbfError::Core`]: an empty
+/// training set ([`CoreError::Empty`]), a wrong size ([`CoreError::DimensionMismatch`]), a
+/// NaN or infinite entry ([`CoreError::NonFinite`], naming row and column) and an option
+/// out of range ([`CoreError::InvalidOption`]).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ErbfError {
-    /// An error of the shared types (parameter space, tables).
+    /// A fault of a kind shared by every crate, or of the shared types (parameter space,
+    /// tables).
     #[error(transparent)]
     Core(#[from] CoreError),
-    /// The training set is empty.
-    #[error("no training samples (N = 0): a surrogate needs at least one sample")]
-    NoSamples,
-    /// A matrix or vector has the wrong size.
-    #[error("{what}: expected {expected}, found {found}")]
-    DimensionMismatch {
-        /// The quantity whose size is wrong.
-        what: String,
-        /// The size required.
-        expected: usize,
-        /// The size given.
-        found: usize,
-    },
-    /// A NaN or infinite number where finite numbers are required.
-    #[error("{what}: non-finite value {value} at row {row}, column {column} (0-based)")]
-    NonFinite {
-        /// The quantity (for example `training points`).
-        what: String,
-        /// 0-based row.
-        row: usize,
-        /// 0-based column.
-        column: usize,
-        /// The offending value.
-        value: f64,
-    },
     /// Two training samples coincide or nearly coincide, so exact interpolation is
     /// impossible (two equal rows of the interpolation matrix).
     #[error(
@@ -52,16 +32,6 @@ pub enum ErbfError {
         distance: f64,
         /// The tolerance that was applied.
         tolerance: f64,
-    },
-    /// An option is out of its valid range.
-    #[error("option `{name}` = {value}: {message}")]
-    InvalidOption {
-        /// The option.
-        name: &'static str,
-        /// The value given, as text.
-        value: String,
-        /// What is required.
-        message: String,
     },
     /// The interpolation system is numerically singular.
     #[error(
@@ -91,3 +61,43 @@ pub enum ErbfError {
 
 /// `Result` with [`ErbfError`].
 pub type Result<T, E = ErbfError> = std::result::Result<T, E>;
+
+impl ErbfError {
+    /// What kind of fault this is: that of the wrapped [`CoreError`];
+    /// [`ErrorKind::Numerical`] for a singular system or an undefined leave-one-out error;
+    /// [`ErrorKind::BadInput`] for duplicate samples and invalid model data.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            ErbfError::Core(e) => e.kind(),
+            ErbfError::Singular { .. } | ErbfError::LooUndefined { .. } => ErrorKind::Numerical,
+            _ => ErrorKind::BadInput,
+        }
+    }
+}
+
+/// A [`DimensionMismatch`](CoreError::DimensionMismatch) error as an [`ErbfError`].
+pub(crate) fn mismatch(what: impl Into<String>, expected: usize, found: usize) -> ErbfError {
+    CoreError::DimensionMismatch {
+        what: what.into(),
+        expected,
+        found,
+    }
+    .into()
+}
+
+/// An [`InvalidOption`](CoreError::InvalidOption) error as an [`ErbfError`].
+pub(crate) fn invalid_option(
+    name: &str,
+    value: impl std::fmt::Display,
+    message: impl Into<String>,
+) -> ErbfError {
+    CoreError::invalid_option(name, value, message).into()
+}
+
+/// The empty training set.
+pub(crate) fn no_samples() -> ErbfError {
+    CoreError::Empty {
+        what: "the training set (N = 0; a surrogate needs at least one sample)".into(),
+    }
+    .into()
+}

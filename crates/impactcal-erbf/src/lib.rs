@@ -1,15 +1,22 @@
 //! Surrogates of whole time histories for impact-model calibration.
 //!
 //! - [`RbfInterpolant`]: classic radial basis function interpolation (cubic, thin-plate,
-//!   Gaussian, multiquadric kernels; polynomial tail of degree -1, 0 or 1; optional
+//!   Gaussian, multiquadric [`RadialFunction`]s; polynomial tail of degree -1, 0 or 1; optional
 //!   smoothing), with values, gradients, batch prediction, leave-one-out errors and cheap
 //!   growth by [`RbfInterpolant::add_points`]. The surrogate of the CORS-RBF optimiser.
 //! - [`Erbf`]: the extended radial basis function metamodel of Mullur and Messac (Gaussian
 //!   radial functions plus, per sample and input, the non-radial functions of [`nrbf`]),
 //!   inputs scaled by the bounds of a parameter space, minimum-norm coefficients through a
 //!   QR factorisation of `A^T`. Predicts whole time histories at the cost of one solve.
-//! - [`metrics`]: RAAE, RMAE and R^2; [`testfns`]: Branin, Goldstein-Price, Hartmann-3/6,
-//!   Dixon-Price and a Latin hypercube design for accuracy studies.
+//! - [`ResponseSurrogate`]: any of the above over a parameter space with named outputs, as
+//!   the `impactcal surrogate` command fits, saves and loads it.
+//! - [`metrics`]: RAAE, RMAE and R^2. The test functions of the accuracy record are
+//!   [`impactcal_core::test_functions`]; its designs, core's Latin hypercube.
+//!
+//! Training points and queries are faer matrices with one sample per row (`N x m`),
+//! responses one row per sample (`N x T`); `fit_rows` takes rows of `Vec<f64>` for
+//! convenience. Options are checked into [`ValidErbfOptions`] / [`ValidRbfOptions`]
+//! ([`ParamGuard`](impactcal_core::ParamGuard)) before a fit works with them.
 //!
 //! Both models offer batch prediction (parallel, thread-count independent), gradients with
 //! respect to the inputs, leave-one-out errors, a conditioning diagnostic, a flag for
@@ -56,25 +63,26 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod basis;
 pub mod buffer;
-pub mod data;
+mod data;
 pub mod erbf;
 pub mod error;
-pub mod kernel;
 pub mod loo;
 pub mod metrics;
 pub mod nrbf;
+pub mod options;
 mod projection;
+pub mod radial;
 pub mod rbf;
 pub mod surrogate;
-pub mod testfns;
 mod thin_qr;
 
-pub use data::StoredMat;
-pub use erbf::{Erbf, ErbfOptions, FamilyWeights};
+pub use erbf::Erbf;
 pub use error::{ErbfError, Result};
-pub use kernel::{Kernel, PolyDegree};
 pub use loo::{ErrorSummary, LooMethod};
 pub use metrics::Accuracy;
-pub use rbf::{RbfInterpolant, RbfOptions};
-pub use surrogate::{Surrogate, SurrogateKind, SurrogateModel};
+pub use options::{ErbfOptions, FamilyWeights, ValidErbfOptions};
+pub use radial::{PolyDegree, RadialFunction};
+pub use rbf::{RbfInterpolant, RbfOptions, ValidRbfOptions};
+pub use surrogate::{ResponseSurrogate, SurrogateKind, SurrogateModel};

@@ -27,7 +27,7 @@ use faer::{Accum, ColMut, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
 use crate::buffer;
-use crate::erbf::ErbfOptions;
+use crate::options::ErbfOptions;
 use crate::nrbf::even_power;
 
 /// `Q_1^T` and the tables that give `Q_1^T b(x)`; see the module documentation.
@@ -262,7 +262,8 @@ fn accumulate(base: &[f64], row: &[f64], c: f64, out: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::erbf::{FamilyWeights, basis_matrix_t};
+    use crate::basis::basis_matrix_t;
+    use crate::options::FamilyWeights;
     use crate::thin_qr::thin_qr;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;

@@ -30,6 +30,7 @@ use faer::linalg::triangular_solve::{
     solve_unit_upper_triangular_in_place, solve_upper_triangular_in_place,
 };
 use faer::{Accum, Mat, MatRef, Par};
+use impactcal_core::{CoreError, ParamGuard};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -38,16 +39,18 @@ use crate::data::{
     StoredMat, check_queries, check_training, collect_rows, find_duplicate, mat_from_rows,
     stack_rows, without_row,
 };
-use crate::error::{ErbfError, Result};
-use crate::kernel::{Kernel, PolyDegree};
+use crate::error::{ErbfError, Result, mismatch};
 use crate::loo::LooMethod;
+use crate::radial::{PolyDegree, RadialFunction};
 
-/// Options of a classic RBF interpolant, validated by [`RbfInterpolant::fit`].
+/// Options of a classic RBF interpolant, checked into [`ValidRbfOptions`] (by
+/// [`ParamGuard::check`], or by [`RbfInterpolant::fit`] itself) before they reach a fit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RbfOptions {
-    /// The radial kernel.
-    pub kernel: Kernel,
-    /// The polynomial tail; must be at least [`Kernel::min_degree`].
+    /// The radial function.
+    #[serde(alias = "kernel")]
+    pub radial: RadialFunction,
+    /// The polynomial tail; must be at least [`RadialFunction::min_degree`].
     pub degree: PolyDegree,
     /// Smoothing `lambda >= 0` added to the diagonal of `K`; 0 interpolates exactly.
     pub smoothing: f64,
@@ -57,26 +60,26 @@ pub struct RbfOptions {
 }
 
 impl RbfOptions {
-    /// Options for `kernel` with its minimum tail ([`Kernel::min_degree`]: linear for cubic
-    /// and thin-plate, constant for multiquadric, none for Gaussian), no smoothing and a
-    /// duplicate tolerance of `1e-10`.
-    pub fn new(kernel: Kernel) -> Self {
+    /// Options for the radial function `radial` with its minimum tail
+    /// ([`RadialFunction::min_degree`]: linear for cubic and thin-plate, constant for
+    /// multiquadric, none for Gaussian), no smoothing and a duplicate tolerance of `1e-10`.
+    pub fn new(radial: RadialFunction) -> Self {
         RbfOptions {
-            kernel,
-            degree: kernel.min_degree(),
+            radial,
+            degree: radial.min_degree(),
             smoothing: 0.0,
             duplicate_tolerance: 1e-10,
         }
     }
 
-    /// Cubic kernel with a linear tail, the usual choice of surrogate optimisers.
+    /// Cubic radial function with a linear tail, the usual choice of surrogate optimisers.
     pub fn cubic() -> Self {
-        Self::new(Kernel::Cubic)
+        Self::new(RadialFunction::Cubic)
     }
 
     /// Thin-plate spline with a linear tail.
     pub fn thin_plate() -> Self {
-        Self::new(Kernel::ThinPlate)
+        Self::new(RadialFunction::ThinPlate)
     }
 
     /// The same options with another tail.
@@ -93,39 +96,86 @@ impl RbfOptions {
         self
     }
 
+}
+
+impl ParamGuard for RbfOptions {
+    type Checked = ValidRbfOptions;
+
     /// Checks every option.
     ///
     /// # Errors
-    /// [`ErbfError::InvalidOption`] for a bad kernel parameter, a tail below the kernel's
-    /// minimum, a negative or non-finite smoothing, or a negative duplicate tolerance.
-    pub fn validate(&self) -> Result<()> {
-        self.kernel.validate()?;
-        if self.degree < self.kernel.min_degree() {
-            return Err(ErbfError::InvalidOption {
-                name: "polynomial degree",
-                value: self.degree.as_i32().to_string(),
-                message: format!(
-                    "the {:?} kernel needs a tail of degree at least {}",
-                    self.kernel,
-                    self.kernel.min_degree().as_i32()
+    /// [`CoreError::InvalidOption`] for a bad shape parameter of the radial function, a tail
+    /// below its minimum, a negative or non-finite smoothing, or a negative duplicate
+    /// tolerance.
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        self.radial.validate()?;
+        if self.degree < self.radial.min_degree() {
+            return Err(CoreError::invalid_option(
+                "polynomial degree",
+                self.degree.as_i32(),
+                format!(
+                    "the {:?} radial function needs a tail of degree at least {}",
+                    self.radial,
+                    self.radial.min_degree().as_i32()
                 ),
-            });
+            ));
         }
         if !(self.smoothing.is_finite() && self.smoothing >= 0.0) {
-            return Err(ErbfError::InvalidOption {
-                name: "smoothing",
-                value: self.smoothing.to_string(),
-                message: "must be finite and non-negative".into(),
-            });
+            return Err(CoreError::invalid_option(
+                "smoothing",
+                self.smoothing,
+                "must be finite and non-negative",
+            ));
         }
         if !(self.duplicate_tolerance.is_finite() && self.duplicate_tolerance >= 0.0) {
-            return Err(ErbfError::InvalidOption {
-                name: "duplicate tolerance",
-                value: self.duplicate_tolerance.to_string(),
-                message: "must be finite and non-negative".into(),
-            });
+            return Err(CoreError::invalid_option(
+                "duplicate tolerance",
+                self.duplicate_tolerance,
+                "must be finite and non-negative",
+            ));
         }
         Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<ValidRbfOptions> {
+        self.check_ref()?;
+        Ok(ValidRbfOptions(self))
+    }
+}
+
+/// [`RbfOptions`] that passed their checks: the only form a fit works with. Read the
+/// options through `Deref`; serialises as the plain options and is checked again when read.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RbfOptions", into = "RbfOptions")]
+pub struct ValidRbfOptions(RbfOptions);
+
+impl std::ops::Deref for ValidRbfOptions {
+    type Target = RbfOptions;
+    fn deref(&self) -> &RbfOptions {
+        &self.0
+    }
+}
+
+impl TryFrom<RbfOptions> for ValidRbfOptions {
+    type Error = CoreError;
+    fn try_from(options: RbfOptions) -> impactcal_core::Result<Self> {
+        options.check()
+    }
+}
+
+impl From<ValidRbfOptions> for RbfOptions {
+    fn from(valid: ValidRbfOptions) -> Self {
+        valid.0
+    }
+}
+
+impl ParamGuard for ValidRbfOptions {
+    type Checked = ValidRbfOptions;
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        Ok(())
+    }
+    fn check(self) -> impactcal_core::Result<ValidRbfOptions> {
+        Ok(self)
     }
 }
 
@@ -136,7 +186,7 @@ impl RbfOptions {
 /// deserialised model is refitted, which reproduces the same predictions.
 #[derive(Debug, Clone)]
 pub struct RbfInterpolant {
-    options: RbfOptions,
+    options: ValidRbfOptions,
     points: Mat<f64>,
     values: Mat<f64>,
     lower: Vec<f64>,
@@ -160,37 +210,42 @@ impl RbfInterpolant {
     /// Cost: `O(N^2 d)` to assemble, `O(n^3)` to factorise (`n = N + ` tail terms), and
     /// `O(n^2 T)` to solve for the coefficients when `T <= n`; for longer outputs the
     /// coefficients are not formed (see [`predict_batch`](Self::predict_batch)) and are
-    /// solved for only if [`kernel_weights`](Self::kernel_weights),
+    /// solved for only if [`radial_weights`](Self::radial_weights),
     /// [`tail_coefficients`](Self::tail_coefficients) or the closed-form leave-one-out
     /// errors ask for them.
     ///
     /// # Errors
-    /// - [`ErbfError::NoSamples`] for `N = 0`;
-    /// - [`ErbfError::DimensionMismatch`] when `values` has not `N` rows, or fewer samples
+    /// Takes [`RbfOptions`] (checked here) or [`ValidRbfOptions`].
+    ///
+    /// # Errors
+    /// - [`CoreError::InvalidOption`] for invalid options;
+    /// - [`CoreError::Empty`] for `N = 0`;
+    /// - [`CoreError::DimensionMismatch`] when `values` has not `N` rows, or fewer samples
     ///   than tail terms;
-    /// - [`ErbfError::NonFinite`] for NaN or infinite entries;
-    /// - [`ErbfError::InvalidOption`] for invalid options;
+    /// - [`CoreError::NonFinite`] for NaN or infinite entries (naming row and column);
     /// - [`ErbfError::DuplicateSamples`] for two (nearly) coincident points, naming both;
     /// - [`ErbfError::Singular`] when the factorisation has a pivot below `n * eps` of the
     ///   largest (for example points on a hyperplane with a linear tail).
+    ///
+    /// The [`CoreError`]s come wrapped as [`ErbfError::Core`].
     pub fn fit(
         points: MatRef<'_, f64>,
         values: MatRef<'_, f64>,
-        options: RbfOptions,
+        options: impl ParamGuard<Checked = ValidRbfOptions>,
     ) -> Result<Self> {
-        options.validate()?;
+        let options = options.check()?;
         check_training(points, values, None)?;
         let d = points.ncols();
         let q = options.degree.terms(d);
         if points.nrows() < q {
-            return Err(ErbfError::DimensionMismatch {
-                what: format!(
+            return Err(mismatch(
+                format!(
                     "number of samples for a tail of degree {} in {d} dimensions, at least",
                     options.degree.as_i32()
                 ),
-                expected: q,
-                found: points.nrows(),
-            });
+                q,
+                points.nrows(),
+            ));
         }
         let (lower, upper) = bounding_box(points);
         let diameter = diameter(&lower, &upper);
@@ -203,7 +258,7 @@ impl RbfInterpolant {
                 tolerance: tol,
             });
         }
-        let kernel_block = kernel_matrix(&options, points);
+        let kernel_block = radial_matrix(&options, points);
         Self::assemble(options, points.to_owned(), values.to_owned(), kernel_block)
     }
 
@@ -211,9 +266,13 @@ impl RbfInterpolant {
     /// `values[k]` its value.
     ///
     /// # Errors
-    /// As [`fit`](Self::fit); [`ErbfError::DimensionMismatch`] for ragged rows or a
+    /// As [`fit`](Self::fit); [`CoreError::DimensionMismatch`] for ragged rows or a
     /// `values` length that differs from the number of points.
-    pub fn fit_rows(points: &[Vec<f64>], values: &[f64], options: RbfOptions) -> Result<Self> {
+    pub fn fit_rows(
+        points: &[Vec<f64>],
+        values: &[f64],
+        options: impl ParamGuard<Checked = ValidRbfOptions>,
+    ) -> Result<Self> {
         let x = mat_from_rows(points, "training points")?;
         let f = MatRef::from_column_major_slice(values, values.len(), 1);
         Self::fit(x.as_ref(), f, options)
@@ -222,7 +281,7 @@ impl RbfInterpolant {
     /// Builds the system from a kernel block `K + lambda I` of the given points, factorises
     /// and solves.
     fn assemble(
-        options: RbfOptions,
+        options: ValidRbfOptions,
         points: Mat<f64>,
         values: Mat<f64>,
         kernel_block: Mat<f64>,
@@ -304,11 +363,11 @@ impl RbfInterpolant {
     pub fn add_points(&mut self, points: MatRef<'_, f64>, values: MatRef<'_, f64>) -> Result<()> {
         check_training(points, values, Some(self.dim()))?;
         if values.ncols() != self.n_outputs() {
-            return Err(ErbfError::DimensionMismatch {
-                what: "new values: number of columns (outputs)".into(),
-                expected: self.n_outputs(),
-                found: values.ncols(),
-            });
+            return Err(mismatch(
+                "new values: number of columns (outputs)",
+                self.n_outputs(),
+                values.ncols(),
+            ));
         }
         let all_points = stack_rows(self.points.as_ref(), points);
         let all_values = stack_rows(self.values.as_ref(), values);
@@ -329,7 +388,7 @@ impl RbfInterpolant {
                 }
             }
         }
-        let kernel = self.options.kernel;
+        let radial = self.options.radial;
         let smoothing = self.options.smoothing;
         let old = self.system.as_ref().submatrix(0, 0, n_old, n_old);
         let kernel_block = Mat::from_fn(n_all, n_all, |i, j| {
@@ -337,7 +396,7 @@ impl RbfInterpolant {
                 old[(i, j)]
             } else {
                 let r = distance(all_points.row(i), all_points.row(j));
-                kernel.value(r) + if i == j { smoothing } else { 0.0 }
+                radial.value(r) + if i == j { smoothing } else { 0.0 }
             }
         });
         *self = Self::assemble(self.options, all_points, all_values, kernel_block)?;
@@ -384,10 +443,10 @@ impl RbfInterpolant {
         self.values.as_ref()
     }
 
-    /// The kernel weights `c`, `N x T` (row `i` belongs to row `i` of
+    /// The weights `c` of the radial functions, `N x T` (row `i` belongs to row `i` of
     /// [`points`](Self::points)); with [`tail_coefficients`](Self::tail_coefficients) they
     /// give the interpolant explicitly.
-    pub fn kernel_weights(&self) -> MatRef<'_, f64> {
+    pub fn radial_weights(&self) -> MatRef<'_, f64> {
         self.coef().as_ref().subrows(0, self.n_samples())
     }
 
@@ -399,7 +458,7 @@ impl RbfInterpolant {
     /// s_t(x) = sum_i W_it phi(|x - x_i|) + A_0t + sum_j A_(1+j)t x_j
     /// ```
     ///
-    /// with `W` the [`kernel_weights`](Self::kernel_weights) and `x_i` the rows of
+    /// with `W` the [`radial_weights`](Self::radial_weights) and `x_i` the rows of
     /// [`points`](Self::points). `q` is 0 without a tail, 1 for a constant one, `d + 1` for
     /// a linear one. (Internally the tail is solved in centred, scaled and weighted
     /// coordinates; this converts it back.)
@@ -453,7 +512,7 @@ impl RbfInterpolant {
     /// The prediction at `x` (length `d`): `T` values.
     ///
     /// # Errors
-    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for a bad `x`.
+    /// [`CoreError::DimensionMismatch`] or [`CoreError::NonFinite`] for a bad `x`.
     pub fn predict(&self, x: &[f64]) -> Result<Vec<f64>> {
         let q = MatRef::from_row_major_slice(x, 1, x.len());
         let out = self.predict_batch(q)?;
@@ -472,7 +531,7 @@ impl RbfInterpolant {
     /// threads.
     ///
     /// # Errors
-    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for bad points.
+    /// [`CoreError::DimensionMismatch`] or [`CoreError::NonFinite`] for bad points.
     pub fn predict_batch(&self, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
         check_queries(points, self.dim())?;
         let n = self.system.nrows();
@@ -538,7 +597,7 @@ impl RbfInterpolant {
     /// gradient.
     ///
     /// # Errors
-    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for a bad `x`.
+    /// [`CoreError::DimensionMismatch`] or [`CoreError::NonFinite`] for a bad `x`.
     pub fn predict_gradient(&self, x: &[f64]) -> Result<Mat<f64>> {
         check_queries(MatRef::from_row_major_slice(x, 1, x.len()), self.dim())?;
         let n_pts = self.n_samples();
@@ -549,7 +608,7 @@ impl RbfInterpolant {
         for i in 0..n_pts {
             let xi = self.points.row(i);
             let r = (0..d).map(|j| (x[j] - xi[j]).powi(2)).sum::<f64>().sqrt();
-            let g = self.options.kernel.derivative_over_r(r);
+            let g = self.options.radial.derivative_over_r(r);
             for j in 0..d {
                 db[(i, j)] = g * (x[j] - xi[j]);
             }
@@ -653,7 +712,7 @@ impl RbfInterpolant {
         let n_pts = self.n_samples();
         for (i, o) in out.iter_mut().enumerate().take(n_pts) {
             let r = distance_slice(x, self.points.row(i));
-            *o = self.options.kernel.value(r);
+            *o = self.options.radial.value(r);
         }
         tail_row(
             self.options.degree,
@@ -707,7 +766,7 @@ struct RbfData {
 impl Serialize for RbfInterpolant {
     fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
         RbfData {
-            options: self.options,
+            options: *self.options,
             points: StoredMat::from_mat(self.points.as_ref()),
             values: StoredMat::from_mat(self.values.as_ref()),
         }
@@ -727,7 +786,9 @@ impl<'de> Deserialize<'de> for RbfInterpolant {
     }
 }
 
-fn kernel_matrix(options: &RbfOptions, points: MatRef<'_, f64>) -> Mat<f64> {
+/// `K + lambda I`: the radial function at every pair of training points, plus the
+/// smoothing on the diagonal.
+fn radial_matrix(options: &RbfOptions, points: MatRef<'_, f64>) -> Mat<f64> {
     let n = points.nrows();
     let mut k = Mat::<f64>::zeros(n, n);
     k.par_col_chunks_mut(1)
@@ -736,7 +797,7 @@ fn kernel_matrix(options: &RbfOptions, points: MatRef<'_, f64>) -> Mat<f64> {
             for i in 0..n {
                 let r = distance(points.row(i), points.row(j));
                 col[(i, 0)] =
-                    options.kernel.value(r) + if i == j { options.smoothing } else { 0.0 };
+                    options.radial.value(r) + if i == j { options.smoothing } else { 0.0 };
             }
         });
     k

@@ -10,17 +10,18 @@ use faer::{Mat, MatRef};
 use impactcal_core::ParameterSpace;
 use serde::{Deserialize, Serialize};
 
-use crate::erbf::{Erbf, ErbfOptions};
-use crate::error::{ErbfError, Result};
-use crate::kernel::Kernel;
+use crate::erbf::Erbf;
+use crate::error::{Result, mismatch};
 use crate::loo::LooMethod;
+use crate::options::ValidErbfOptions;
+use crate::radial::RadialFunction;
 use crate::rbf::{RbfInterpolant, RbfOptions};
 
 /// The kinds of surrogate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SurrogateKind {
-    /// ERBF with the default options ([`ErbfOptions::default`]).
+    /// ERBF with the default options ([`ErbfOptions::default`](crate::ErbfOptions)).
     Erbf,
     /// Gaussian RBF, width 0.15 in scaled inputs, no tail.
     Gaussian,
@@ -37,15 +38,19 @@ impl SurrogateKind {
     pub fn rbf_options(self) -> Option<RbfOptions> {
         match self {
             SurrogateKind::Erbf => None,
-            SurrogateKind::Gaussian => Some(RbfOptions::new(Kernel::Gaussian { width: 0.15 })),
+            SurrogateKind::Gaussian => Some(RbfOptions::new(RadialFunction::Gaussian {
+                width: 0.15,
+            })),
             SurrogateKind::Cubic => Some(RbfOptions::cubic()),
             SurrogateKind::ThinPlate => Some(RbfOptions::thin_plate()),
-            SurrogateKind::Multiquadric => Some(RbfOptions::new(Kernel::Multiquadric { c: 0.15 })),
+            SurrogateKind::Multiquadric => {
+                Some(RbfOptions::new(RadialFunction::Multiquadric { c: 0.15 }))
+            }
         }
     }
 }
 
-/// The fitted model inside a [`Surrogate`].
+/// The fitted model inside a [`ResponseSurrogate`].
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum SurrogateModel {
@@ -62,22 +67,24 @@ pub enum SurrogateModel {
     },
 }
 
-/// A fitted surrogate of named outputs over a parameter space.
+/// A fitted surrogate of named responses over a parameter space: any [`SurrogateKind`],
+/// raw parameter values in, one value per named output out.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Surrogate {
+pub struct ResponseSurrogate {
     /// Names of the outputs (columns of the training responses).
     output_names: Vec<String>,
     /// The model.
     model: SurrogateModel,
 }
 
-impl Surrogate {
+impl ResponseSurrogate {
     /// Fits a surrogate of `kind` to raw samples `points` (`N x m`, columns in the order of
     /// `space`) and responses `values` (`N x T`) with one name per output column.
     ///
     /// # Errors
-    /// [`ErbfError::DimensionMismatch`] when the names do not match the columns; otherwise
-    /// as [`Erbf::fit`] or [`RbfInterpolant::fit`].
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when
+    /// the names do not match the columns; otherwise as [`Erbf::fit`] or
+    /// [`RbfInterpolant::fit`].
     pub fn fit(
         space: &ParameterSpace,
         kind: SurrogateKind,
@@ -86,16 +93,21 @@ impl Surrogate {
         output_names: Vec<String>,
     ) -> Result<Self> {
         if output_names.len() != values.ncols() {
-            return Err(ErbfError::DimensionMismatch {
-                what: "output names (one per output column)".into(),
-                expected: values.ncols(),
-                found: output_names.len(),
-            });
+            return Err(mismatch(
+                "output names (one per output column)",
+                values.ncols(),
+                output_names.len(),
+            ));
         }
         let model = match kind.rbf_options() {
-            None => SurrogateModel::Erbf(Erbf::fit(space, points, values, ErbfOptions::default())?),
+            None => SurrogateModel::Erbf(Erbf::fit(
+                space,
+                points,
+                values,
+                ValidErbfOptions::default(),
+            )?),
             Some(options) => {
-                let unit = to_unit(space, points)?;
+                let unit = space.to_unit_matrix(points)?;
                 SurrogateModel::Rbf {
                     rbf_kind: kind,
                     space: space.clone(),
@@ -103,7 +115,7 @@ impl Surrogate {
                 }
             }
         };
-        Ok(Surrogate {
+        Ok(ResponseSurrogate {
             output_names,
             model,
         })
@@ -146,13 +158,14 @@ impl Surrogate {
     /// Predictions at raw points (`Q x m`): `Q x T`.
     ///
     /// # Errors
-    /// [`ErbfError::DimensionMismatch`] or [`ErbfError::NonFinite`] for bad points.
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) or
+    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for bad points.
     pub fn predict_batch(&self, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
         match &self.model {
             SurrogateModel::Erbf(e) => e.predict_batch(points),
             SurrogateModel::Rbf {
                 space, interpolant, ..
-            } => interpolant.predict_batch(to_unit(space, points)?.as_ref()),
+            } => interpolant.predict_batch(space.to_unit_matrix(points)?.as_ref()),
         }
     }
 
@@ -194,7 +207,7 @@ impl Surrogate {
     /// [`RbfInterpolant::loo_errors`]).
     ///
     /// # Errors
-    /// [`ErbfError::LooUndefined`] when they are undefined.
+    /// [`ErbfError::LooUndefined`](crate::ErbfError::LooUndefined) when they are undefined.
     pub fn loo_errors(&self, method: LooMethod) -> Result<Mat<f64>> {
         match &self.model {
             SurrogateModel::Erbf(e) => e.loo_errors(method),
@@ -209,18 +222,4 @@ impl Surrogate {
             SurrogateModel::Rbf { interpolant, .. } => interpolant.values(),
         }
     }
-}
-
-fn to_unit(space: &ParameterSpace, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
-    if points.ncols() != space.dim() {
-        return Err(ErbfError::DimensionMismatch {
-            what: "points: number of columns (parameters)".into(),
-            expected: space.dim(),
-            found: points.ncols(),
-        });
-    }
-    let p = space.parameters();
-    Ok(Mat::from_fn(points.nrows(), points.ncols(), |i, j| {
-        (points[(i, j)] - p[j].lower) / p[j].width()
-    }))
 }

@@ -4,9 +4,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use faer::Mat;
+use impactcal_core::sampling::latin_hypercube;
+use impactcal_core::test_functions::{DIXON_PRICE10, HARTMANN3};
 use impactcal_core::{Parameter, ParameterSpace};
-use impactcal_erbf::testfns::{TestFunction, latin_hypercube};
-use impactcal_erbf::{Accuracy, Erbf, ErbfOptions, Kernel, RbfInterpolant, RbfOptions};
+use impactcal_erbf::{Accuracy, Erbf, ErbfOptions, RadialFunction, RbfInterpolant, RbfOptions};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -14,11 +15,8 @@ use rand_chacha::ChaCha8Rng;
 fn erbf_beats_gaussian_only_on_average() {
     let mut erbf_raae = 0.0;
     let mut gauss_raae = 0.0;
-    for (f, n) in [
-        (TestFunction::Hartmann3, 30),
-        (TestFunction::DixonPrice10, 50),
-    ] {
-        let m = f.dim();
+    for (f, n) in [(HARTMANN3, 30), (DIXON_PRICE10, 50)] {
+        let m = f.dim;
         let space = ParameterSpace::new(
             (0..m)
                 .map(|j| Parameter::new(format!("x{j}"), 0.0, 1.0, 0.5).unwrap())
@@ -27,7 +25,7 @@ fn erbf_beats_gaussian_only_on_average() {
         .unwrap();
         for seed in 0..3 {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let x = latin_hypercube(n, m, &mut rng);
+            let x = latin_hypercube(n, m, &mut rng).unwrap();
             let q = Mat::from_fn(300, m, |_, _| rng.random::<f64>());
             let eval = |p: &Mat<f64>| {
                 Mat::from_fn(p.nrows(), 1, |i, _| {
@@ -39,7 +37,7 @@ fn erbf_beats_gaussian_only_on_average() {
             let g = RbfInterpolant::fit(
                 x.as_ref(),
                 fx.as_ref(),
-                RbfOptions::new(Kernel::Gaussian { width: 0.15 }),
+                RbfOptions::new(RadialFunction::Gaussian { width: 0.15 }),
             )
             .unwrap();
             erbf_raae +=

@@ -4,7 +4,7 @@
 
 use approx::assert_relative_eq;
 use faer::{Mat, MatRef};
-use impactcal_core::{Parameter, ParameterSpace};
+use impactcal_core::{CoreError, Parameter, ParameterSpace};
 use impactcal_erbf::{Accuracy, Erbf, ErbfError, ErbfOptions, LooMethod};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -399,7 +399,7 @@ fn invalid_input_is_a_typed_error() {
     let empty = Mat::<f64>::zeros(0, 2);
     assert!(matches!(
         fit(empty.as_ref(), Mat::<f64>::zeros(0, 1).as_ref(), d),
-        Err(ErbfError::NoSamples)
+        Err(ErbfError::Core(CoreError::Empty { .. }))
     ));
     let mut dup = u.clone();
     dup[(6, 0)] = u[(1, 0)];
@@ -416,26 +416,23 @@ fn invalid_input_is_a_typed_error() {
     nan[(3, 1)] = f64::NAN;
     assert!(matches!(
         fit(nan.as_ref(), f.as_ref(), d),
-        Err(ErbfError::NonFinite {
-            row: 3,
-            column: 1,
-            ..
-        })
+        Err(ErbfError::Core(CoreError::NonFinite { location, .. }))
+            if location == "row 3, column 1 (0-based)"
     ));
     let mut inf = f.clone();
     inf[(2, 0)] = f64::INFINITY;
     assert!(matches!(
         fit(u.as_ref(), inf.as_ref(), d),
-        Err(ErbfError::NonFinite { .. })
+        Err(ErbfError::Core(CoreError::NonFinite { .. }))
     ));
     let three = random_unit(10, 3, 14);
     assert!(matches!(
         fit(three.as_ref(), f.as_ref(), d),
-        Err(ErbfError::DimensionMismatch { .. })
+        Err(ErbfError::Core(CoreError::DimensionMismatch { .. }))
     ));
     assert!(matches!(
         fit(u.as_ref(), f.as_ref().subrows(0, 9), d),
-        Err(ErbfError::DimensionMismatch { .. })
+        Err(ErbfError::Core(CoreError::DimensionMismatch { .. }))
     ));
     for bad in [
         ErbfOptions { gamma: 0.0, ..d },
@@ -447,7 +444,7 @@ fn invalid_input_is_a_typed_error() {
     ] {
         assert!(matches!(
             fit(u.as_ref(), f.as_ref(), bad),
-            Err(ErbfError::InvalidOption { .. })
+            Err(ErbfError::Core(CoreError::InvalidOption { .. }))
         ));
     }
     let e = fit(u.as_ref(), f.as_ref(), d).unwrap();

@@ -4,7 +4,10 @@
 
 use approx::assert_relative_eq;
 use faer::{Mat, MatRef};
-use impactcal_erbf::{ErbfError, Kernel, LooMethod, PolyDegree, RbfInterpolant, RbfOptions};
+use impactcal_core::CoreError;
+use impactcal_erbf::{
+    ErbfError, LooMethod, PolyDegree, RadialFunction, RbfInterpolant, RbfOptions,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -30,9 +33,9 @@ fn all_options() -> Vec<RbfOptions> {
     vec![
         RbfOptions::cubic(),
         RbfOptions::thin_plate(),
-        RbfOptions::new(Kernel::Gaussian { width: 0.3 }),
-        RbfOptions::new(Kernel::Gaussian { width: 0.3 }).with_degree(PolyDegree::Linear),
-        RbfOptions::new(Kernel::Multiquadric { c: 0.2 }),
+        RbfOptions::new(RadialFunction::Gaussian { width: 0.3 }),
+        RbfOptions::new(RadialFunction::Gaussian { width: 0.3 }).with_degree(PolyDegree::Linear),
+        RbfOptions::new(RadialFunction::Multiquadric { c: 0.2 }),
     ]
 }
 
@@ -85,10 +88,10 @@ fn long_outputs_predict_as_their_columns_fitted_alone() {
                     max_relative = 1e-9
                 );
             }
-            let w = one.kernel_weights();
+            let w = one.radial_weights();
             for i in 0..30 {
                 assert_relative_eq!(
-                    all.kernel_weights()[(i, t)],
+                    all.radial_weights()[(i, t)],
                     w[(i, 0)],
                     epsilon = 1e-9,
                     max_relative = 1e-9
@@ -106,7 +109,7 @@ fn linear_tail_reproduces_affine_functions() {
     let f = eval(x.as_ref(), affine);
     for opts in [RbfOptions::cubic(), RbfOptions::thin_plate()] {
         let s = RbfInterpolant::fit(x.as_ref(), f.as_ref(), opts).unwrap();
-        for v in s.kernel_weights().col(0).iter() {
+        for v in s.radial_weights().col(0).iter() {
             assert!(v.abs() < 1e-9, "kernel weight {v}");
         }
         let q = random_points(50, 3, 3);
@@ -152,7 +155,7 @@ fn explicit_coefficients_give_the_interpolant() {
                         .map(|j| (q[(i, j)] - x[(k, j)]).powi(2))
                         .sum::<f64>()
                         .sqrt();
-                    v += s.kernel_weights()[(k, c)] * opts.kernel.value(r);
+                    v += s.radial_weights()[(k, c)] * opts.radial.value(r);
                 }
                 if a.nrows() > 0 {
                     v += a[(0, c)];
@@ -222,7 +225,7 @@ fn closed_form_loo_equals_refitting() {
     let f = eval(x.as_ref(), smooth);
     let mut opts = all_options();
     opts.push(RbfOptions::cubic().with_smoothing(1e-3));
-    opts.push(RbfOptions::new(Kernel::Gaussian { width: 0.3 }).with_smoothing(1e-2));
+    opts.push(RbfOptions::new(RadialFunction::Gaussian { width: 0.3 }).with_smoothing(1e-2));
     for o in opts {
         let s = RbfInterpolant::fit(x.as_ref(), f.as_ref(), o).unwrap();
         let closed = s.loo_errors(LooMethod::Closed).unwrap();
@@ -333,7 +336,7 @@ fn serde_round_trip_predicts_the_same() {
     let s = RbfInterpolant::fit(
         x.as_ref(),
         f.as_ref(),
-        RbfOptions::new(Kernel::Multiquadric { c: 0.5 }),
+        RbfOptions::new(RadialFunction::Multiquadric { c: 0.5 }),
     )
     .unwrap();
     let json = serde_json::to_string(&s).unwrap();
@@ -360,21 +363,18 @@ fn invalid_input_is_a_typed_error() {
             Mat::<f64>::zeros(0, 1).as_ref(),
             RbfOptions::cubic()
         ),
-        Err(ErbfError::NoSamples)
+        Err(ErbfError::Core(CoreError::Empty { .. }))
     ));
     let mut bad = x.clone();
     bad[(4, 1)] = f64::NAN;
     assert!(matches!(
         RbfInterpolant::fit(bad.as_ref(), f.as_ref(), RbfOptions::cubic()),
-        Err(ErbfError::NonFinite {
-            row: 4,
-            column: 1,
-            ..
-        })
+        Err(ErbfError::Core(CoreError::NonFinite { location, .. }))
+            if location == "row 4, column 1 (0-based)"
     ));
     assert!(matches!(
         RbfInterpolant::fit(x.as_ref(), f.as_ref().subrows(0, 9), RbfOptions::cubic()),
-        Err(ErbfError::DimensionMismatch { .. })
+        Err(ErbfError::Core(CoreError::DimensionMismatch { .. }))
     ));
     let mut dup = x.clone();
     dup[(7, 0)] = x[(2, 0)];
@@ -390,9 +390,9 @@ fn invalid_input_is_a_typed_error() {
     let low = RbfOptions::cubic().with_degree(PolyDegree::Constant);
     assert!(matches!(
         RbfInterpolant::fit(x.as_ref(), f.as_ref(), low),
-        Err(ErbfError::InvalidOption { .. })
+        Err(ErbfError::Core(CoreError::InvalidOption { .. }))
     ));
-    let bad_width = RbfOptions::new(Kernel::Gaussian { width: 0.0 });
+    let bad_width = RbfOptions::new(RadialFunction::Gaussian { width: 0.0 });
     assert!(RbfInterpolant::fit(x.as_ref(), f.as_ref(), bad_width).is_err());
     assert!(
         RbfInterpolant::fit(
@@ -420,7 +420,7 @@ fn invalid_input_is_a_typed_error() {
 fn conditioning_diagnostics_flag_a_dense_gaussian() {
     let x = Mat::from_fn(40, 1, |i, _| i as f64 / 39.0);
     let f = Mat::from_fn(40, 1, |i, _| (6.0 * x[(i, 0)]).sin());
-    let wide = RbfOptions::new(Kernel::Gaussian { width: 0.15 });
+    let wide = RbfOptions::new(RadialFunction::Gaussian { width: 0.15 });
     match RbfInterpolant::fit(x.as_ref(), f.as_ref(), wide) {
         Err(ErbfError::Singular { .. }) => {}
         Ok(s) => assert!(s.condition_number().unwrap() > 1e12),

@@ -1,17 +1,20 @@
-//! Radial kernels of the classic RBF interpolant and the polynomial tail degrees.
+//! Radial functions of the classic RBF interpolant and the polynomial tail degrees.
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{ErbfError, Result};
+use impactcal_core::CoreError;
 
-/// A radial kernel `phi(r)` of the distance `r = |x - x_i|`.
+use crate::error::{Result, invalid_option};
+
+/// A radial function `phi(r)` of the distance `r = |x - x_i|` (the "kernel" of an RBF
+/// interpolant).
 ///
-/// The signs follow the convention under which each kernel is conditionally positive
-/// definite of the order that its minimum polynomial tail ([`Kernel::min_degree`])
+/// The signs follow the convention under which each function is conditionally positive
+/// definite of the order that its minimum polynomial tail ([`RadialFunction::min_degree`])
 /// removes, so that smoothing (a positive diagonal) keeps the system well posed.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "kebab-case")]
-pub enum Kernel {
+pub enum RadialFunction {
     /// `phi(r) = r^3`; needs at least a linear tail.
     Cubic,
     /// Thin-plate spline `phi(r) = r^2 ln r` (0 at `r = 0`); needs at least a linear tail.
@@ -30,21 +33,21 @@ pub enum Kernel {
     },
 }
 
-impl Kernel {
+impl RadialFunction {
     /// `phi(r)` for `r >= 0`.
     #[inline]
     pub fn value(&self, r: f64) -> f64 {
         match *self {
-            Kernel::Cubic => r * r * r,
-            Kernel::ThinPlate => {
+            RadialFunction::Cubic => r * r * r,
+            RadialFunction::ThinPlate => {
                 if r > 0.0 {
                     r * r * r.ln()
                 } else {
                     0.0
                 }
             }
-            Kernel::Gaussian { width } => (-0.5 * (r / width) * (r / width)).exp(),
-            Kernel::Multiquadric { c } => -(r * r + c * c).sqrt(),
+            RadialFunction::Gaussian { width } => (-0.5 * (r / width) * (r / width)).exp(),
+            RadialFunction::Multiquadric { c } => -(r * r + c * c).sqrt(),
         }
     }
 
@@ -55,16 +58,16 @@ impl Kernel {
     #[inline]
     pub fn derivative_over_r(&self, r: f64) -> f64 {
         match *self {
-            Kernel::Cubic => 3.0 * r,
-            Kernel::ThinPlate => {
+            RadialFunction::Cubic => 3.0 * r,
+            RadialFunction::ThinPlate => {
                 if r > 0.0 {
                     2.0 * r.ln() + 1.0
                 } else {
                     0.0
                 }
             }
-            Kernel::Gaussian { width } => -self.value(r) / (width * width),
-            Kernel::Multiquadric { c } => -1.0 / (r * r + c * c).sqrt(),
+            RadialFunction::Gaussian { width } => -self.value(r) / (width * width),
+            RadialFunction::Multiquadric { c } => -1.0 / (r * r + c * c).sqrt(),
         }
     }
 
@@ -72,30 +75,30 @@ impl Kernel {
     /// for distinct (and, for the linear tail, affinely spanning) points.
     pub fn min_degree(&self) -> PolyDegree {
         match self {
-            Kernel::Cubic | Kernel::ThinPlate => PolyDegree::Linear,
-            Kernel::Multiquadric { .. } => PolyDegree::Constant,
-            Kernel::Gaussian { .. } => PolyDegree::None,
+            RadialFunction::Cubic | RadialFunction::ThinPlate => PolyDegree::Linear,
+            RadialFunction::Multiquadric { .. } => PolyDegree::Constant,
+            RadialFunction::Gaussian { .. } => PolyDegree::None,
         }
     }
 
     /// Checks the shape parameter.
     ///
     /// # Errors
-    /// [`ErbfError::InvalidOption`] for a width or `c` that is not finite and positive.
-    pub fn validate(&self) -> Result<()> {
+    /// [`CoreError::InvalidOption`] for a width or `c` that is not finite and positive.
+    pub fn validate(&self) -> impactcal_core::Result<()> {
         let (name, v): (&'static str, f64) = match *self {
-            Kernel::Gaussian { width } => ("kernel width", width),
-            Kernel::Multiquadric { c } => ("multiquadric c", c),
-            Kernel::Cubic | Kernel::ThinPlate => return Ok(()),
+            RadialFunction::Gaussian { width } => ("Gaussian width", width),
+            RadialFunction::Multiquadric { c } => ("multiquadric c", c),
+            RadialFunction::Cubic | RadialFunction::ThinPlate => return Ok(()),
         };
         if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            Err(ErbfError::InvalidOption {
+            Err(CoreError::invalid_option(
                 name,
-                value: v.to_string(),
-                message: "must be finite and positive".into(),
-            })
+                v,
+                "must be finite and positive",
+            ))
         }
     }
 }
@@ -125,17 +128,18 @@ impl PolyDegree {
     /// The degree from an integer -1, 0 or 1.
     ///
     /// # Errors
-    /// [`ErbfError::InvalidOption`] for any other integer.
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for any other
+    /// integer.
     pub fn from_i32(degree: i32) -> Result<Self> {
         match degree {
             -1 => Ok(PolyDegree::None),
             0 => Ok(PolyDegree::Constant),
             1 => Ok(PolyDegree::Linear),
-            _ => Err(ErbfError::InvalidOption {
-                name: "polynomial degree",
-                value: degree.to_string(),
-                message: "must be -1 (none), 0 (constant) or 1 (linear)".into(),
-            }),
+            _ => Err(invalid_option(
+                "polynomial degree",
+                degree,
+                "must be -1 (none), 0 (constant) or 1 (linear)",
+            )),
         }
     }
 
