@@ -1,26 +1,17 @@
 //! Input checks shared by the decomposition, comparison and expansion.
 
 use faer::MatRef;
+use impactcal_core::{CoreError, check_finite_mat};
 
-use crate::error::{Result, ShapesError};
+use crate::error::Result;
 
-/// Fails on an empty matrix or a non-finite entry, naming `what` and the position.
+/// Fails on an empty matrix or a non-finite entry, naming `what` and the position
+/// ([`CoreError::Empty`], [`CoreError::NonFinite`]).
 pub(crate) fn finite_nonempty(what: &str, a: MatRef<'_, f64>) -> Result<()> {
     if a.nrows() == 0 || a.ncols() == 0 {
-        return Err(ShapesError::Empty { what: what.into() });
+        return Err(CoreError::Empty { what: what.into() }.into());
     }
-    for j in 0..a.ncols() {
-        for i in 0..a.nrows() {
-            if !a[(i, j)].is_finite() {
-                return Err(ShapesError::NonFinite {
-                    what: what.into(),
-                    row: i,
-                    column: j,
-                });
-            }
-        }
-    }
-    Ok(())
+    Ok(check_finite_mat(what, a)?)
 }
 
 /// Numerical rank of a matrix with singular values `s` (non-increasing) and shape

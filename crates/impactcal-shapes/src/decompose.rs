@@ -6,7 +6,7 @@ use faer::{Col, Mat, MatRef};
 use impactcal_core::Histories;
 
 use crate::checks::{finite_nonempty, numerical_rank};
-use crate::error::{Result, ShapesError};
+use crate::error::{Result, ShapesError, invalid_option};
 use crate::randomized::{RandomizedSvd, randomized_svd};
 
 /// How many shapes to keep.
@@ -115,9 +115,11 @@ impl ImpactShapes {
     /// base is `0, 1, 2, ...`.
     ///
     /// # Errors
-    /// [`ShapesError::Empty`] or [`ShapesError::NonFinite`] for bad data;
+    /// [`CoreError::Empty`](impactcal_core::CoreError::Empty) or
+    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for bad data;
     /// [`ShapesError::TooManyShapes`] when [`Truncation::Count`] exceeds the numerical rank;
-    /// [`ShapesError::InvalidOption`] for a fraction out of range, a zero count, or the
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a fraction
+    /// out of range, a zero count, or the
     /// randomized method without a count; [`ShapesError::NoConvergence`] if the SVD fails.
     pub fn from_matrix(y: MatRef<'_, f64>, options: &ShapeOptions) -> Result<Self> {
         finite_nonempty("response matrix", y)?;
@@ -128,8 +130,10 @@ impl ImpactShapes {
             (SvdMethod::Full, _) => None,
             (SvdMethod::Randomized(r), Truncation::Count(k)) => Some((r, k)),
             (SvdMethod::Randomized(_), _) => {
-                return Err(ShapesError::InvalidOption(
-                    "the randomized solver needs a fixed shape count (Truncation::Count)".into(),
+                return Err(invalid_option(
+                    "method",
+                    "randomized",
+                    "the randomized solver needs a fixed shape count (Truncation::Count)",
                 ));
             }
             (SvdMethod::Auto, Truncation::Count(k)) => {
@@ -318,17 +322,21 @@ impl ImpactShapes {
 
 fn validate_truncation(t: Truncation) -> Result<()> {
     match t {
-        Truncation::Count(0) => Err(ShapesError::InvalidOption(
-            "the shape count must be at least 1".into(),
+        Truncation::Count(0) => Err(invalid_option(
+            "shape count",
+            0,
+            "the shape count must be at least 1",
         )),
-        Truncation::Contribution(f) if !(f > 0.0 && f <= 1.0) => Err(ShapesError::InvalidOption(
-            format!("a cumulative contribution must lie in (0, 1], got {f}"),
+        Truncation::Contribution(f) if !(f > 0.0 && f <= 1.0) => Err(invalid_option(
+            "contribution",
+            f,
+            "a cumulative contribution must lie in (0, 1]",
         )),
-        Truncation::ReconstructionError(e) if !(0.0..1.0).contains(&e) => {
-            Err(ShapesError::InvalidOption(format!(
-                "a relative reconstruction error must lie in [0, 1), got {e}"
-            )))
-        }
+        Truncation::ReconstructionError(e) if !(0.0..1.0).contains(&e) => Err(invalid_option(
+            "reconstruction error",
+            e,
+            "a relative reconstruction error must lie in [0, 1)",
+        )),
         _ => Ok(()),
     }
 }

@@ -1,40 +1,20 @@
 //! The error type of `impactcal-shapes`.
 
-use impactcal_core::CoreError;
+use impactcal_core::{CoreError, ErrorKind};
 
 /// What can go wrong when computing, comparing or expanding impact shapes.
+///
+/// Faults shared with the other crates are [`CoreError`]s under [`ShapesError::Core`]: an
+/// empty matrix ([`CoreError::Empty`]), a NaN or infinite entry ([`CoreError::NonFinite`],
+/// naming row and column), sizes that do not fit ([`CoreError::DimensionMismatch`]) and an
+/// option out of range ([`CoreError::InvalidOption`]).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ShapesError {
-    /// An error from the shared types (file input, histories).
+    /// A fault of a kind shared by every crate, or of the shared types (file input,
+    /// histories).
     #[error(transparent)]
     Core(#[from] CoreError),
-    /// A matrix or set with no rows or columns.
-    #[error("{what} is empty")]
-    Empty {
-        /// The object that is empty.
-        what: String,
-    },
-    /// A NaN or infinite entry.
-    #[error("{what}: non-finite value at row {row}, column {column}")]
-    NonFinite {
-        /// The matrix.
-        what: String,
-        /// 0-based row.
-        row: usize,
-        /// 0-based column.
-        column: usize,
-    },
-    /// Sizes that do not fit together.
-    #[error("{what}: expected {expected}, found {found}")]
-    DimensionMismatch {
-        /// The quantity whose size is wrong.
-        what: String,
-        /// Required size.
-        expected: usize,
-        /// Given size.
-        found: usize,
-    },
     /// More shapes were asked for than the data's numerical rank supports.
     #[error("{requested} shapes requested but the data has numerical rank {rank}")]
     TooManyShapes {
@@ -67,9 +47,6 @@ pub enum ShapesError {
         /// sigma_max / sigma_min of the restricted shape matrix (infinite when singular).
         condition: f64,
     },
-    /// An option outside its valid range.
-    #[error("invalid option: {0}")]
-    InvalidOption(String),
     /// The SVD did not converge.
     #[error("the singular value decomposition did not converge")]
     NoConvergence,
@@ -77,3 +54,35 @@ pub enum ShapesError {
 
 /// `Result` with [`ShapesError`].
 pub type Result<T, E = ShapesError> = std::result::Result<T, E>;
+
+impl ShapesError {
+    /// What kind of fault this is: that of the wrapped [`CoreError`];
+    /// [`ErrorKind::Numerical`] for an SVD that did not converge; [`ErrorKind::BadInput`]
+    /// for the rest (requests the data cannot support).
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            ShapesError::Core(e) => e.kind(),
+            ShapesError::NoConvergence => ErrorKind::Numerical,
+            _ => ErrorKind::BadInput,
+        }
+    }
+}
+
+/// An [`InvalidOption`](CoreError::InvalidOption) error as a [`ShapesError`].
+pub(crate) fn invalid_option(
+    name: &str,
+    value: impl std::fmt::Display,
+    message: impl Into<String>,
+) -> ShapesError {
+    CoreError::invalid_option(name, value, message).into()
+}
+
+/// A [`DimensionMismatch`](CoreError::DimensionMismatch) error as a [`ShapesError`].
+pub(crate) fn mismatch(what: impl Into<String>, expected: usize, found: usize) -> ShapesError {
+    CoreError::DimensionMismatch {
+        what: what.into(),
+        expected,
+        found,
+    }
+    .into()
+}

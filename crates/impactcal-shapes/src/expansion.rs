@@ -6,7 +6,7 @@ use impactcal_core::Histories;
 
 use crate::checks::{finite_nonempty, numerical_rank};
 use crate::decompose::ImpactShapes;
-use crate::error::{Result, ShapesError};
+use crate::error::{Result, ShapesError, invalid_option, mismatch};
 
 /// Unmeasured responses estimated from measured ones.
 ///
@@ -32,7 +32,8 @@ impl Expansion {
     ///
     /// # Errors
     /// [`ShapesError::LabelMismatch`] for a measured channel the model lacks;
-    /// [`ShapesError::InvalidOption`] when every model channel is measured (nothing to
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) when every
+    /// model channel is measured (nothing to
     /// expand), or `shapes` is zero or exceeds the model's; [`ShapesError::RankDeficient`]
     /// when fewer channels are measured than shapes are used, or `Phi` is numerically
     /// rank deficient.
@@ -43,10 +44,11 @@ impl Expansion {
     ) -> Result<Self> {
         let k = shapes.unwrap_or(model.len());
         if k == 0 || k > model.len() {
-            return Err(ShapesError::InvalidOption(format!(
-                "cannot use {k} shapes: the model has {}",
-                model.len()
-            )));
+            return Err(invalid_option(
+                "shapes",
+                k,
+                format!("cannot use {k} shapes: the model has {}", model.len()),
+            ));
         }
         let index: std::collections::HashMap<&str, usize> = model
             .labels()
@@ -70,8 +72,10 @@ impl Expansion {
             .filter(|i| !measured_rows.contains(i))
             .collect();
         if unmeasured.is_empty() {
-            return Err(ShapesError::InvalidOption(
-                "every model channel is measured: nothing to expand".into(),
+            return Err(invalid_option(
+                "measured channels",
+                measured_rows.len(),
+                "every model channel is measured: nothing to expand",
             ));
         }
         let u = model.shapes();
@@ -131,7 +135,8 @@ impl Expansion {
 /// sigma_min(Phi))`.
 ///
 /// # Errors
-/// [`ShapesError::Empty`]/[`ShapesError::NonFinite`] for bad input, a dimension mismatch,
+/// [`CoreError::Empty`](impactcal_core::CoreError::Empty) /
+/// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for bad input, a dimension mismatch,
 /// [`ShapesError::RankDeficient`] when `n_a < k` or `Phi` has numerical rank below `k`.
 pub fn expand_matrix(
     phi: MatRef<'_, f64>,
@@ -141,18 +146,18 @@ pub fn expand_matrix(
     finite_nonempty("shapes at measured channels", phi)?;
     finite_nonempty("measured data", y)?;
     if k_rows.ncols() != phi.ncols() {
-        return Err(ShapesError::DimensionMismatch {
-            what: "shapes at unmeasured channels (columns)".into(),
-            expected: phi.ncols(),
-            found: k_rows.ncols(),
-        });
+        return Err(mismatch(
+            "shapes at unmeasured channels (columns)",
+            phi.ncols(),
+            k_rows.ncols(),
+        ));
     }
     if y.nrows() != phi.nrows() {
-        return Err(ShapesError::DimensionMismatch {
-            what: "measured channels (rows of the data)".into(),
-            expected: phi.nrows(),
-            found: y.nrows(),
-        });
+        return Err(mismatch(
+            "measured channels (rows of the data)",
+            phi.nrows(),
+            y.nrows(),
+        ));
     }
     let (na, k) = phi.shape();
     if na < k {

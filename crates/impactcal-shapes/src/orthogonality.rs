@@ -6,7 +6,7 @@ use faer::{Mat, MatRef};
 use crate::assignment::max_weight_assignment;
 use crate::checks::{finite_nonempty, numerical_rank};
 use crate::decompose::ImpactShapes;
-use crate::error::{Result, ShapesError};
+use crate::error::{Result, ShapesError, invalid_option, mismatch};
 
 /// One analysis shape paired with one test shape.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -51,17 +51,19 @@ impl Orthogonality {
     /// same channels in the same order.
     ///
     /// # Errors
-    /// [`ShapesError::Empty`], [`ShapesError::NonFinite`], a row-count mismatch, or a zero
+    /// [`CoreError::Empty`](impactcal_core::CoreError::Empty),
+    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite), a row-count mismatch,
+    /// or a zero
     /// column (a shape of zero length cannot be normalised).
     pub fn from_matrices(analysis: MatRef<'_, f64>, test: MatRef<'_, f64>) -> Result<Self> {
         finite_nonempty("analysis shapes", analysis)?;
         finite_nonempty("test shapes", test)?;
         if analysis.nrows() != test.nrows() {
-            return Err(ShapesError::DimensionMismatch {
-                what: "channels of the analysis shapes (rows) vs test shapes".into(),
-                expected: test.nrows(),
-                found: analysis.nrows(),
-            });
+            return Err(mismatch(
+                "channels of the analysis shapes (rows) vs test shapes",
+                test.nrows(),
+                analysis.nrows(),
+            ));
         }
         let a = normalise_columns(analysis, "analysis")?;
         let t = normalise_columns(test, "test")?;
@@ -127,9 +129,11 @@ fn normalise_columns(a: MatRef<'_, f64>, side: &str) -> Result<Mat<f64>> {
     for j in 0..out.ncols() {
         let norm = out.col(j).norm_l2();
         if norm == 0.0 {
-            return Err(ShapesError::InvalidOption(format!(
-                "{side} shape {j} is zero and cannot be normalised"
-            )));
+            return Err(invalid_option(
+                format!("{side} shape {j}").as_str(),
+                0,
+                "a shape of zero length cannot be normalised",
+            ));
         }
         out.col_mut(j).iter_mut().for_each(|x| *x /= norm);
     }

@@ -5,7 +5,7 @@ use faer::{Mat, MatRef};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::error::{Result, ShapesError};
+use crate::error::{Result, ShapesError, invalid_option};
 
 /// Settings of the randomized solver.
 ///
@@ -42,8 +42,10 @@ pub(crate) fn randomized_svd(
     opts: &RandomizedSvd,
 ) -> Result<(Mat<f64>, Vec<f64>, Mat<f64>)> {
     if opts.power_iterations == 0 {
-        return Err(ShapesError::InvalidOption(
-            "the randomized solver needs at least one power iteration".into(),
+        return Err(invalid_option(
+            "power_iterations",
+            0,
+            "the randomized solver needs at least one power iteration",
         ));
     }
     let (m, n) = a.shape();
