@@ -7,10 +7,10 @@ use impactcal_core::CoreError;
 
 use crate::error::{Result, SensorsError};
 
-/// A measurement direction of a nodal DOF label `<node>.<x|y|z>`.
+/// The measurement axis of a nodal DOF label `<node>.<x|y|z>`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
-pub enum Direction {
+pub enum Axis {
     /// Global x.
     X,
     /// Global y.
@@ -19,23 +19,23 @@ pub enum Direction {
     Z,
 }
 
-/// Splits a label `<node>.<x|y|z>` (direction case-insensitive) into node and direction;
-/// `None` for any other form.
+/// Splits a label `<node>.<x|y|z>` (axis case-insensitive) into node and axis; `None` for
+/// any other form.
 ///
 /// ```
-/// use impactcal_sensors::{split_label, Direction};
-/// assert_eq!(split_label("1042.z"), Some(("1042", Direction::Z)));
+/// use impactcal_sensors::{split_label, Axis};
+/// assert_eq!(split_label("1042.z"), Some(("1042", Axis::Z)));
 /// assert_eq!(split_label("pelvis_acc"), None);
 /// ```
-pub fn split_label(label: &str) -> Option<(&str, Direction)> {
+pub fn split_label(label: &str) -> Option<(&str, Axis)> {
     let (node, dir) = label.rsplit_once('.')?;
     if node.is_empty() {
         return None;
     }
     let dir = match dir {
-        "x" | "X" => Direction::X,
-        "y" | "Y" => Direction::Y,
-        "z" | "Z" => Direction::Z,
+        "x" | "X" => Axis::X,
+        "y" | "Y" => Axis::Y,
+        "z" | "Z" => Axis::Z,
         _ => return None,
     };
     Some((node, dir))
@@ -59,7 +59,7 @@ impl CandidateShapes {
     /// # Errors
     /// [`CoreError::DimensionMismatch`] when `labels.len() != shapes.nrows()`;
     /// [`CoreError::Invalid`] for no rows, no columns, or an empty or repeated label;
-    /// [`SensorsError::NonFinite`] naming the row and shape of a NaN or infinite value.
+    /// [`CoreError::NonFinite`] naming the candidate and shape of a NaN or infinite value.
     pub fn new(labels: Vec<String>, shapes: MatRef<'_, f64>) -> Result<Self> {
         if labels.len() != shapes.nrows() {
             return Err(CoreError::DimensionMismatch {
@@ -82,11 +82,12 @@ impl CandidateShapes {
             for j in 0..shapes.ncols() {
                 let v = shapes[(i, j)];
                 if !v.is_finite() {
-                    return Err(SensorsError::NonFinite {
-                        label: labels[i].clone(),
-                        shape: j + 1,
+                    return Err(CoreError::NonFinite {
+                        what: "shape matrix".into(),
+                        location: format!("candidate `{}`, shape {}", labels[i], j + 1),
                         value: v,
-                    });
+                    }
+                    .into());
                 }
             }
         }

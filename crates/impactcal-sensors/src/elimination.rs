@@ -2,8 +2,10 @@
 
 use faer::MatRef;
 
-use crate::engine::{Direction, Engine};
-use crate::error::{Result, SensorsError};
+use crate::engine::{Engine, Sweep};
+use impactcal_core::CoreError;
+
+use crate::error::{Result, SensorsError, invalid_option};
 use crate::linalg::singular_values;
 
 /// Scores at or above `1 - ESSENTIAL` mark a block whose removal would make
@@ -53,8 +55,8 @@ impl Elimination {
     /// in no block are ignored).
     ///
     /// # Errors
-    /// [`SensorsError::InvalidOption`] for an empty, oversized or out-of-range block, a row in
-    /// two blocks, or a non-finite value; [`SensorsError::TooFewCandidates`] for fewer rows
+    /// [`CoreError::InvalidOption`] for an empty, oversized or out-of-range block or a row in
+    /// two blocks; [`CoreError::NonFinite`] for a non-finite value; [`SensorsError::TooFewCandidates`] for fewer rows
     /// than columns; [`SensorsError::RankDeficient`] when the rows do not have full column
     /// rank (`sigma_min / sigma_max <= 1e-10`).
     pub fn with_blocks(
@@ -66,16 +68,19 @@ impl Elimination {
         let mut seen = vec![false; s];
         for (b, rows) in blocks.iter().enumerate() {
             if rows.is_empty() || rows.len() > 3 {
-                return Err(SensorsError::InvalidOption(format!(
-                    "block {b} has {} rows (1 to 3 allowed)",
-                    rows.len()
-                )));
+                return Err(invalid_option(
+                    &format!("block {b}"),
+                    format!("{} rows", rows.len()),
+                    "a block has 1 to 3 rows",
+                ));
             }
             for &r in rows {
                 if r >= s || seen[r] {
-                    return Err(SensorsError::InvalidOption(format!(
-                        "block {b}: row {r} is out of range or in two blocks"
-                    )));
+                    return Err(invalid_option(
+                        &format!("block {b}"),
+                        format!("row {r}"),
+                        "the row is out of range or in two blocks",
+                    ));
                 }
                 seen[r] = true;
             }
@@ -92,9 +97,12 @@ impl Elimination {
             for j in 0..k {
                 let v = phi[(i, j)];
                 if !v.is_finite() {
-                    return Err(SensorsError::InvalidOption(format!(
-                        "non-finite value {v} at row {i}, column {j}"
-                    )));
+                    return Err(CoreError::NonFinite {
+                        what: "shape matrix".into(),
+                        location: format!("row {i}, column {j} (0-based)"),
+                        value: v,
+                    }
+                    .into());
                 }
                 flat[i * k + j] = v;
             }
@@ -108,7 +116,7 @@ impl Elimination {
                 blocks,
                 vec![true; nblocks],
                 (0..nblocks).collect(),
-                Direction::Remove,
+                Sweep::Remove,
                 refresh_every,
             ),
             log_ratio: 0.0,

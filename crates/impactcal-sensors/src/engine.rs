@@ -56,7 +56,7 @@ impl Ord for Key {
 
 /// Whether steps remove blocks from the set or add blocks to it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Direction {
+pub(crate) enum Sweep {
     /// Backward elimination: tracked blocks are in the set; the score of a block is the
     /// fraction of `det(A)` lost by removing it, `1 - det(I - E_bb)`.
     Remove,
@@ -70,7 +70,7 @@ pub(crate) struct Engine {
     phi: Vec<f64>,
     blocks: Vec<Vec<usize>>,
     in_set: Vec<bool>,
-    direction: Direction,
+    sweep: Sweep,
     sigma: f64,
     per_dof: bool,
     /// Tracked block ids, ascending, and whether each is still tracked.
@@ -106,7 +106,7 @@ impl Engine {
         blocks: Vec<Vec<usize>>,
         in_set: Vec<bool>,
         tracked: Vec<usize>,
-        direction: Direction,
+        sweep: Sweep,
         refresh_every: usize,
     ) -> Self {
         let per_dof = blocks.iter().all(|b| b.len() == 1);
@@ -115,10 +115,10 @@ impl Engine {
             phi,
             blocks,
             in_set,
-            direction,
-            sigma: match direction {
-                Direction::Remove => -1.0,
-                Direction::Add => 1.0,
+            sweep,
+            sigma: match sweep {
+                Sweep::Remove => -1.0,
+                Sweep::Add => 1.0,
             },
             per_dof,
             alive: vec![true; tracked.len()],
@@ -214,7 +214,7 @@ impl Engine {
         self.since_refresh = 0;
     }
 
-    /// Score of tracked position `pos` (see [`Direction`]).
+    /// Score of tracked position `pos` (see [`Sweep`]).
     fn score(&self, pos: usize) -> f64 {
         if self.per_dof {
             // 1 - (1 - E_ii) when removing, (1 + E_ii) - 1 when adding.
@@ -229,9 +229,9 @@ impl Engine {
             }
         }
         let d = small_det(&mut m[..nb * nb], nb);
-        match self.direction {
-            Direction::Remove => 1.0 - d,
-            Direction::Add => d - 1.0,
+        match self.sweep {
+            Sweep::Remove => 1.0 - d,
+            Sweep::Add => d - 1.0,
         }
     }
 
@@ -245,9 +245,9 @@ impl Engine {
 
     /// Heap key of per-DOF position `pos` from its last evaluated score.
     fn key(&self, pos: usize) -> Key {
-        let v = match self.direction {
-            Direction::Remove => self.e[pos],
-            Direction::Add => -self.e[pos],
+        let v = match self.sweep {
+            Sweep::Remove => self.e[pos],
+            Sweep::Add => -self.e[pos],
         };
         Key(v, self.ids[pos], pos)
     }
@@ -294,9 +294,9 @@ impl Engine {
             let s = self.score(pos);
             let better = match best {
                 None => true,
-                Some((_, b)) => match self.direction {
-                    Direction::Remove => s < b,
-                    Direction::Add => s > b,
+                Some((_, b)) => match self.sweep {
+                    Sweep::Remove => s < b,
+                    Sweep::Add => s > b,
                 },
             };
             if better {
@@ -440,9 +440,9 @@ impl Engine {
                 }
             }
             let d = small_det(&mut m, nb);
-            let s = match self.direction {
-                Direction::Remove => 1.0 - d,
-                Direction::Add => d - 1.0,
+            let s = match self.sweep {
+                Sweep::Remove => 1.0 - d,
+                Sweep::Add => d - 1.0,
             };
             out.push((b, s));
         }

@@ -1,30 +1,24 @@
 //! The error type of `impactcal-sensors`.
 
-use impactcal_core::CoreError;
+use impactcal_core::{CoreError, ErrorKind};
 
 /// Everything that can stop a sensor placement.
 ///
 /// Counts are numbers of candidate DOFs in per-DOF placement and numbers of nodes in
-/// node-grouped placement, as stated in each variant.
+/// node-grouped placement, as stated in each variant. Faults shared with the other crates
+/// are [`CoreError`]s under [`SensorsError::Core`]: a NaN or infinite shape value
+/// ([`CoreError::NonFinite`], naming the candidate and the shape), an option out of range
+/// ([`CoreError::InvalidOption`]), a wrong size, an empty matrix, a CSV fault (file, row and
+/// column).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SensorsError {
-    /// Reading or validating shared input failed (a CSV fault names file, row and column).
+    /// A fault of a kind shared by every crate, or of reading shared input.
     #[error(transparent)]
     Core(#[from] CoreError),
     /// Computing impact shapes from an ensemble of histories failed.
     #[error(transparent)]
     Shapes(#[from] impactcal_shapes::ShapesError),
-    /// A shape value is NaN or infinite.
-    #[error("shape matrix: non-finite value {value} at candidate `{label}`, shape {shape}")]
-    NonFinite {
-        /// Label of the candidate row.
-        label: String,
-        /// 1-based shape (column) number.
-        shape: usize,
-        /// The value.
-        value: f64,
-    },
     /// Fewer usable candidates than target shapes: the shapes cannot be told apart.
     #[error(
         "{candidates} usable candidate DOFs for {shapes} shapes: need at least as many candidates as shapes"
@@ -101,9 +95,6 @@ pub enum SensorsError {
         /// The label.
         label: String,
     },
-    /// An option value is invalid (for example a noise level that is not positive).
-    #[error("invalid option: {0}")]
-    InvalidOption(String),
     /// Every removable candidate is essential: removing any would make the information
     /// matrix singular (the DOFs that must stay do not span the shapes).
     #[error(
@@ -124,3 +115,27 @@ pub enum SensorsError {
 
 /// `Result` with [`SensorsError`].
 pub type Result<T, E = SensorsError> = std::result::Result<T, E>;
+
+impl SensorsError {
+    /// What kind of fault this is: that of the wrapped [`CoreError`] or
+    /// [`ShapesError`](impactcal_shapes::ShapesError); [`ErrorKind::Numerical`] for a
+    /// factorisation that failed; [`ErrorKind::BadInput`] for the rest (targets, labels and
+    /// shape matrices that cannot give a placement).
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            SensorsError::Core(e) => e.kind(),
+            SensorsError::Shapes(e) => e.kind(),
+            SensorsError::Numerical(_) => ErrorKind::Numerical,
+            _ => ErrorKind::BadInput,
+        }
+    }
+}
+
+/// An [`InvalidOption`](CoreError::InvalidOption) error as a [`SensorsError`].
+pub(crate) fn invalid_option(
+    name: &str,
+    value: impl std::fmt::Display,
+    message: impl Into<String>,
+) -> SensorsError {
+    CoreError::invalid_option(name, value, message).into()
+}

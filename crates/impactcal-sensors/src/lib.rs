@@ -10,21 +10,21 @@
 //!   `[0, 1]`, the values sum to `k`, and removing DOF `i` multiplies `det(Phi^T Phi)` by
 //!   exactly `1 - E_D,i`. It is computed from an orthonormal basis (QR), never from an
 //!   explicit inverse, and does not change when `Phi` becomes `Phi T` (`T` invertible).
-//! - Backward elimination ([`Method::Backward`], Kammer 1991) removes the DOF of smallest
+//! - Backward elimination ([`PlacementMethod::Backward`], Kammer 1991) removes the DOF of smallest
 //!   `E_D` until `N` remain, updating every `E_D` by Sherman-Morrison in `O(s k)` per step,
 //!   with a fresh QR every 100 steps against drift. Ties go to the lowest candidate index.
 //! - Triaxial sensors ([`Grouping::Node`]): a node is scored by `1 - det(I - E_bb)` over its
 //!   `3 x 3` block of the projector, the exact fraction of `det` lost with it; blocks are
 //!   updated by Woodbury.
-//! - Options ([`PlacementOptions`]): DOFs to keep, DOFs to exclude, noise per DOF
-//!   (prewhitening), a forward greedy method started by QR with column pivoting, and a swap
-//!   refinement.
+//! - Options ([`PlacementOptions`], whose setters check their values): DOFs to keep, DOFs
+//!   to exclude, noise per DOF (prewhitening), a forward greedy method started by QR with
+//!   column pivoting, and a swap refinement.
 //! - Straight from simulations ([`place_from_histories`]): the runs of an ensemble are
 //!   concatenated in time, their impact shapes computed (`impactcal-shapes`) and the
 //!   placement made on those shapes, as the source paper does.
 //! - The [`Placement`] carries the chosen DOFs, the removal order with each score, the
 //!   retained information `det(A_kept)/det(A_full)`, the condition number, the largest
-//!   off-diagonal of the normalised Gram matrix and the counts per direction.
+//!   off-diagonal of the normalised Gram matrix and the counts per axis.
 //!
 //! ```
 //! use impactcal_sensors::{CandidateShapes, PlacementOptions, place};
@@ -55,10 +55,10 @@ mod linalg;
 mod options;
 mod place;
 
-pub use candidates::{CandidateShapes, Direction, split_label};
+pub use candidates::{Axis, CandidateShapes, split_label};
 pub use elimination::{ESSENTIAL, Elimination};
 pub use ensemble::{EnsemblePlacement, concatenate_runs, place_from_histories};
 pub use error::{Result, SensorsError};
 pub use linalg::leverage_scores;
-pub use options::{Grouping, Method, PlacementOptions};
-pub use place::{DirectionCounts, Placement, Step, Swap, place};
+pub use options::{Grouping, PlacementMethod, PlacementOptions};
+pub use place::{AxisCounts, Placement, Step, Swap, place};

@@ -55,8 +55,9 @@ pub(crate) fn singular_values(m: MatRef<'_, f64>) -> Result<Vec<f64>> {
 /// change when `Phi` is replaced by `Phi T` for an invertible `T`.
 ///
 /// # Errors
-/// [`SensorsError::Numerical`] if the SVD fails, [`SensorsError::InvalidOption`] for an empty
-/// matrix or non-finite values.
+/// [`SensorsError::Numerical`] if the SVD fails;
+/// [`CoreError::Empty`](impactcal_core::CoreError::Empty) for an empty matrix,
+/// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for non-finite values.
 ///
 /// ```
 /// use faer::mat;
@@ -68,21 +69,12 @@ pub(crate) fn singular_values(m: MatRef<'_, f64>) -> Result<Vec<f64>> {
 /// ```
 pub fn leverage_scores(phi: MatRef<'_, f64>) -> Result<Vec<f64>> {
     if phi.nrows() == 0 || phi.ncols() == 0 {
-        return Err(SensorsError::InvalidOption(
-            "leverage scores of an empty matrix".into(),
-        ));
-    }
-    for i in 0..phi.nrows() {
-        for j in 0..phi.ncols() {
-            if !phi[(i, j)].is_finite() {
-                return Err(SensorsError::InvalidOption(format!(
-                    "non-finite value at row {}, column {}",
-                    i + 1,
-                    j + 1
-                )));
-            }
+        return Err(impactcal_core::CoreError::Empty {
+            what: "the shape matrix of the leverage scores".into(),
         }
+        .into());
     }
+    impactcal_core::check_finite_mat("shape matrix", phi)?;
     let svd = phi
         .thin_svd()
         .map_err(|e| SensorsError::Numerical(format!("SVD did not converge: {e:?}")))?;

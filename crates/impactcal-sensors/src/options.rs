@@ -1,13 +1,14 @@
 //! Placement options.
 
-use crate::candidates::CandidateShapes;
-use crate::error::{Result, SensorsError};
 use serde::{Deserialize, Serialize};
+
+use crate::candidates::CandidateShapes;
+use crate::error::{Result, SensorsError, invalid_option};
 
 /// How the sensor set is built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Method {
+pub enum PlacementMethod {
     /// Kammer's backward elimination: start from every usable candidate and remove, one at
     /// a time, the candidate (or node) whose removal loses the smallest fraction of
     /// `det(Phi^T Phi)`, recomputing the scores after every removal.
@@ -33,45 +34,69 @@ pub enum Grouping {
     Node,
 }
 
-/// Options of [`place`](crate::place). Build with [`PlacementOptions::new`] and the
-/// setters; [`place`](crate::place) checks them against the candidates.
+/// Options of [`place`](crate::place): build with [`PlacementOptions::new`] and the
+/// setters, which check their values (argmin style: a setter that can refuse its value
+/// returns a `Result`), so that an options value is always valid on its own.
+/// [`place`](crate::place) then checks them against the candidates (labels that exist, one
+/// noise level per candidate).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "OptionsData")]
 pub struct PlacementOptions {
-    /// Number of sensors to keep: DOFs, or nodes with [`Grouping::Node`].
-    pub target: usize,
-    /// Per DOF or per node.
-    pub grouping: Grouping,
-    /// Backward elimination (Kammer) or forward greedy.
-    pub method: Method,
-    /// Labels of DOFs that must stay in the set (with [`Grouping::Node`], their nodes stay).
-    pub keep: Vec<String>,
-    /// Labels of DOFs that may not be used.
-    pub exclude: Vec<String>,
-    /// Noise standard deviation per candidate DOF (same order as the candidates); row `i`
-    /// of the shape matrix is divided by `noise[i]` before placement (prewhitening), so
-    /// quieter DOFs count more. `None`: equal noise everywhere.
-    pub noise: Option<Vec<f64>>,
-    /// After the greedy pass, exchange a chosen candidate for an unchosen one while that
-    /// raises `det(Phi^T Phi)` (Fedorov-type swaps, best swap first).
-    pub swap_refinement: bool,
-    /// Most swaps made by the refinement.
-    pub max_swaps: usize,
-    /// Steps between fresh recomputations (QR) of the scores; 0 never refreshes.
-    pub refresh_every: usize,
-    /// Relative singular-value threshold below which the shape matrix counts as rank
-    /// deficient.
-    pub rank_tolerance: f64,
+    pub(crate) target: usize,
+    pub(crate) grouping: Grouping,
+    pub(crate) method: PlacementMethod,
+    pub(crate) keep: Vec<String>,
+    pub(crate) exclude: Vec<String>,
+    pub(crate) noise: Option<Vec<f64>>,
+    pub(crate) swap_refinement: bool,
+    pub(crate) max_swaps: usize,
+    pub(crate) refresh_every: usize,
+    pub(crate) rank_tolerance: f64,
+}
+
+/// The unchecked serialised form of [`PlacementOptions`].
+#[derive(Deserialize)]
+struct OptionsData {
+    target: usize,
+    grouping: Grouping,
+    method: PlacementMethod,
+    keep: Vec<String>,
+    exclude: Vec<String>,
+    noise: Option<Vec<f64>>,
+    swap_refinement: bool,
+    max_swaps: usize,
+    refresh_every: usize,
+    rank_tolerance: f64,
+}
+
+impl TryFrom<OptionsData> for PlacementOptions {
+    type Error = SensorsError;
+    fn try_from(d: OptionsData) -> Result<Self> {
+        let mut o = PlacementOptions::new(d.target)
+            .grouping(d.grouping)
+            .method(d.method)
+            .keep(d.keep)?
+            .exclude(d.exclude)?
+            .swap_refinement(d.swap_refinement)
+            .max_swaps(d.max_swaps)
+            .refresh_every(d.refresh_every)
+            .rank_tolerance(d.rank_tolerance)?;
+        if let Some(sigma) = d.noise {
+            o = o.noise(sigma)?;
+        }
+        Ok(o)
+    }
 }
 
 impl PlacementOptions {
     /// Options for `target` sensors with the defaults: per DOF, backward elimination, no
-    /// constraints, equal noise, no swaps, a fresh recomputation every 100 steps, rank
-    /// tolerance `1e-10`.
+    /// constraints, equal noise, no swaps (at most 1000 when turned on), a fresh
+    /// recomputation every 100 steps, rank tolerance `1e-10`.
     pub fn new(target: usize) -> Self {
         PlacementOptions {
             target,
             grouping: Grouping::Dof,
-            method: Method::Backward,
+            method: PlacementMethod::Backward,
             keep: Vec::new(),
             exclude: Vec::new(),
             noise: None,
@@ -83,81 +108,212 @@ impl PlacementOptions {
     }
 
     /// Per DOF or per node.
+    #[must_use]
     pub fn grouping(mut self, grouping: Grouping) -> Self {
         self.grouping = grouping;
         self
     }
 
     /// Backward elimination or forward greedy.
-    pub fn method(mut self, method: Method) -> Self {
+    #[must_use]
+    pub fn method(mut self, method: PlacementMethod) -> Self {
         self.method = method;
         self
     }
 
-    /// DOFs that must stay.
-    pub fn keep<S: Into<String>>(mut self, labels: impl IntoIterator<Item = S>) -> Self {
-        self.keep = labels.into_iter().map(Into::into).collect();
-        self
+    /// DOFs that must stay (with [`Grouping::Node`], their nodes stay).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for an empty
+    /// label; [`SensorsError::KeepExcludeConflict`] for a label that is also excluded.
+    pub fn keep<S: Into<String>>(mut self, labels: impl IntoIterator<Item = S>) -> Result<Self> {
+        self.keep = checked_labels("keep", labels)?;
+        self.check_conflict()?;
+        Ok(self)
     }
 
     /// DOFs that may not be used.
-    pub fn exclude<S: Into<String>>(mut self, labels: impl IntoIterator<Item = S>) -> Self {
-        self.exclude = labels.into_iter().map(Into::into).collect();
-        self
+    ///
+    /// # Errors
+    /// As [`keep`](Self::keep).
+    pub fn exclude<S: Into<String>>(
+        mut self,
+        labels: impl IntoIterator<Item = S>,
+    ) -> Result<Self> {
+        self.exclude = checked_labels("exclude", labels)?;
+        self.check_conflict()?;
+        Ok(self)
     }
 
-    /// Noise standard deviation per candidate DOF.
-    pub fn noise(mut self, sigma: Vec<f64>) -> Self {
+    /// Noise standard deviation per candidate DOF (same order as the candidates); row `i`
+    /// of the shape matrix is divided by `sigma[i]` before placement (prewhitening), so
+    /// quieter DOFs count more.
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a level
+    /// that is not finite and positive, naming its position.
+    pub fn noise(mut self, sigma: Vec<f64>) -> Result<Self> {
+        if let Some(i) = sigma.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(invalid_option(
+                &format!("noise level {i} (0-based)"),
+                sigma[i],
+                "must be finite and positive",
+            ));
+        }
         self.noise = Some(sigma);
-        self
+        Ok(self)
     }
 
     /// Noise standard deviations given by label, as read from a `label,sigma` table (see
     /// [`CandidateShapes::read_csv`]), put in the order of the candidates `labels`.
     ///
     /// # Errors
-    /// [`SensorsError::InvalidOption`] when the table has not exactly one value column,
-    /// names a label that is not a candidate (a typo would otherwise go unnoticed), or
-    /// lacks a level for a candidate; the message names the label.
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) when the
+    /// table has not exactly one value column, names a label that is not a candidate (a
+    /// typo would otherwise go unnoticed), lacks a level for a candidate, or holds a level
+    /// that is not finite and positive; the message names the label.
     pub fn noise_by_label(self, labels: &[String], table: &CandidateShapes) -> Result<Self> {
         if table.shapes_count() != 1 {
-            return Err(SensorsError::InvalidOption(format!(
-                "a noise table has one value column (label,sigma); found {}",
-                table.shapes_count()
-            )));
+            return Err(invalid_option(
+                "noise table",
+                format!("{} value columns", table.shapes_count()),
+                "a noise table has one value column (label,sigma)",
+            ));
         }
         if let Some(unknown) = table
             .labels()
             .iter()
             .find(|l| !labels.iter().any(|c| c == *l))
         {
-            return Err(SensorsError::InvalidOption(format!(
-                "noise level for `{unknown}`, which is not a candidate"
-            )));
+            return Err(invalid_option(
+                "noise table",
+                format!("`{unknown}`"),
+                format!("noise level for `{unknown}`, which is not a candidate"),
+            ));
         }
         let sigma = labels
             .iter()
             .map(|l| {
-                table
+                let level = table
                     .index_of(l)
                     .map(|i| table.shapes()[(i, 0)])
                     .ok_or_else(|| {
-                        SensorsError::InvalidOption(format!("no noise level for candidate `{l}`"))
-                    })
+                        invalid_option(
+                            "noise table",
+                            format!("`{l}`"),
+                            format!("no noise level for candidate `{l}`"),
+                        )
+                    })?;
+                if level.is_finite() && level > 0.0 {
+                    Ok(level)
+                } else {
+                    Err(invalid_option(
+                        &format!("noise level of `{l}`"),
+                        level,
+                        "must be finite and positive",
+                    ))
+                }
             })
             .collect::<Result<Vec<f64>>>()?;
-        Ok(self.noise(sigma))
+        self.noise(sigma)
     }
 
-    /// Turns the swap refinement on or off.
+    /// Turns the swap refinement on or off: after the greedy pass, exchange a chosen
+    /// candidate for an unchosen one while that raises `det(Phi^T Phi)` (Fedorov-type
+    /// swaps, best swap first).
+    #[must_use]
     pub fn swap_refinement(mut self, on: bool) -> Self {
         self.swap_refinement = on;
         self
     }
 
-    /// Steps between fresh recomputations of the scores (0: never).
+    /// Most swaps made by the refinement.
+    #[must_use]
+    pub fn max_swaps(mut self, swaps: usize) -> Self {
+        self.max_swaps = swaps;
+        self
+    }
+
+    /// Steps between fresh recomputations (QR) of the scores (0: never).
+    #[must_use]
     pub fn refresh_every(mut self, steps: usize) -> Self {
         self.refresh_every = steps;
         self
     }
+
+    /// Relative singular-value threshold below which the shape matrix counts as rank
+    /// deficient.
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a value
+    /// that is negative or not finite.
+    pub fn rank_tolerance(mut self, tolerance: f64) -> Result<Self> {
+        if !(tolerance.is_finite() && tolerance >= 0.0) {
+            return Err(invalid_option(
+                "rank tolerance",
+                tolerance,
+                "must be finite and non-negative",
+            ));
+        }
+        self.rank_tolerance = tolerance;
+        Ok(self)
+    }
+
+    /// Number of sensors to keep: DOFs, or nodes with [`Grouping::Node`].
+    pub fn target(&self) -> usize {
+        self.target
+    }
+
+    /// Per DOF or per node.
+    pub fn grouping_kind(&self) -> Grouping {
+        self.grouping
+    }
+
+    /// Backward elimination or forward greedy.
+    pub fn placement_method(&self) -> PlacementMethod {
+        self.method
+    }
+
+    /// Labels of the DOFs that must stay.
+    pub fn kept(&self) -> &[String] {
+        &self.keep
+    }
+
+    /// Labels of the DOFs that may not be used.
+    pub fn excluded(&self) -> &[String] {
+        &self.exclude
+    }
+
+    /// Noise standard deviation per candidate DOF, if given.
+    pub fn noise_levels(&self) -> Option<&[f64]> {
+        self.noise.as_deref()
+    }
+
+    /// Fails when a label is both kept and excluded.
+    fn check_conflict(&self) -> Result<()> {
+        match self.keep.iter().find(|l| self.exclude.contains(l)) {
+            Some(label) => Err(SensorsError::KeepExcludeConflict {
+                label: label.clone(),
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Labels checked to be non-empty.
+fn checked_labels<S: Into<String>>(
+    option: &str,
+    labels: impl IntoIterator<Item = S>,
+) -> Result<Vec<String>> {
+    labels
+        .into_iter()
+        .map(|l| {
+            let l: String = l.into();
+            if l.trim().is_empty() {
+                Err(invalid_option(option, "\"\"", "labels must not be empty"))
+            } else {
+                Ok(l)
+            }
+        })
+        .collect()
 }

@@ -2,12 +2,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::candidates::{CandidateShapes, Direction, split_label};
+use crate::candidates::{Axis, CandidateShapes, split_label};
 use crate::elimination::{ESSENTIAL, check_rank};
 use crate::engine::{self, Engine};
-use crate::error::{Result, SensorsError};
+use crate::error::{Result, SensorsError, invalid_option};
 use crate::linalg::{dot, gather, log_det_gram, r_factor, singular_values, small_det, whiten_row};
-use crate::options::{Grouping, Method, PlacementOptions};
+use crate::options::{Grouping, PlacementMethod, PlacementOptions};
 
 /// One step of the greedy pass: the DOF or node moved and its score at that moment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -33,16 +33,16 @@ pub struct Swap {
     pub ratio: f64,
 }
 
-/// Number of chosen DOFs per direction (labels `<node>.<x|y|z>`; `other` counts the rest).
+/// Number of chosen DOFs per axis (labels `<node>.<x|y|z>`; `other` counts the rest).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct DirectionCounts {
+pub struct AxisCounts {
     /// DOFs along x.
     pub x: usize,
     /// DOFs along y.
     pub y: usize,
     /// DOFs along z.
     pub z: usize,
-    /// DOFs whose label has no direction.
+    /// DOFs whose label has no axis.
     pub other: usize,
 }
 
@@ -73,8 +73,8 @@ pub struct Placement {
     pub max_off_diagonal: f64,
     /// `max_off_diagonal^2`: the largest off-diagonal AutoMAC of the chosen shapes.
     pub max_auto_mac: f64,
-    /// Chosen DOFs per direction.
-    pub counts_by_direction: DirectionCounts,
+    /// Chosen DOFs per axis (direction of measurement).
+    pub counts_by_direction: AxisCounts,
     /// Notes that did not stop the placement (for example all-zero rows dropped).
     pub warnings: Vec<String>,
 }
@@ -89,9 +89,11 @@ pub struct Placement {
 /// The result is the same for `Phi` and `Phi T` with `T` invertible.
 ///
 /// # Errors
-/// [`SensorsError::UnknownLabel`] / [`SensorsError::KeepExcludeConflict`] for bad `keep` or
-/// `exclude` labels; [`SensorsError::InvalidOption`] for noise levels of the wrong length or
-/// not finite and positive, or a forward start larger than the target;
+/// [`SensorsError::UnknownLabel`] for `keep` or `exclude` labels that are not candidates;
+/// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) for noise
+/// levels of the wrong length;
+/// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a forward
+/// start larger than the target or a node of more than three DOFs;
 /// [`SensorsError::BadNodeLabel`] for a label without `<node>.<x|y|z>` in node mode;
 /// [`SensorsError::TooFewCandidates`], [`SensorsError::TargetBelowShapes`],
 /// [`SensorsError::TargetAboveCandidates`], [`SensorsError::TooManyKept`] for impossible
@@ -107,7 +109,7 @@ pub fn place(candidates: &CandidateShapes, options: &PlacementOptions) -> Result
     let mut addition_order = Vec::new();
     let mut in_set;
     match options.method {
-        Method::Backward => {
+        PlacementMethod::Backward => {
             let tracked: Vec<usize> = (0..nblocks).filter(|&b| !problem.forced[b]).collect();
             let mut eng = Engine::new(
                 k,
@@ -115,7 +117,7 @@ pub fn place(candidates: &CandidateShapes, options: &PlacementOptions) -> Result
                 problem.blocks.clone(),
                 vec![true; nblocks],
                 tracked,
-                engine::Direction::Remove,
+                engine::Sweep::Remove,
                 options.refresh_every,
             );
             let mut count = nblocks;
@@ -136,14 +138,18 @@ pub fn place(candidates: &CandidateShapes, options: &PlacementOptions) -> Result
             }
             in_set = eng.in_set().to_vec();
         }
-        Method::Forward => {
+        PlacementMethod::Forward => {
             let start = problem.forward_start()?;
             if start.iter().filter(|s| **s).count() > options.target {
-                return Err(SensorsError::InvalidOption(format!(
-                    "the forward start (DOFs that must stay plus {k} pivoted rows) holds {} {unit}, more than the target {}",
-                    start.iter().filter(|s| **s).count(),
-                    options.target
-                )));
+                return Err(invalid_option(
+                    "target",
+                    options.target,
+                    format!(
+                        "the forward start (DOFs that must stay plus {k} pivoted rows) holds {} \
+                         {unit}, more than the target",
+                        start.iter().filter(|s| **s).count()
+                    ),
+                ));
             }
             for (b, s) in start.iter().enumerate() {
                 if *s {
@@ -158,7 +164,7 @@ pub fn place(candidates: &CandidateShapes, options: &PlacementOptions) -> Result
                 problem.blocks.clone(),
                 start,
                 tracked,
-                engine::Direction::Add,
+                engine::Sweep::Add,
                 options.refresh_every,
             );
             while count < options.target {
@@ -224,27 +230,16 @@ impl Problem {
             None => vec![1.0; s],
             Some(sigma) => {
                 if sigma.len() != s {
-                    return Err(SensorsError::InvalidOption(format!(
-                        "{} noise levels for {s} candidates",
-                        sigma.len()
-                    )));
-                }
-                if let Some(i) = sigma.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
-                    return Err(SensorsError::InvalidOption(format!(
-                        "noise level {} of candidate `{}` must be finite and positive",
-                        sigma[i],
-                        c.labels()[i]
-                    )));
+                    return Err(impactcal_core::CoreError::DimensionMismatch {
+                        what: "noise levels (one per candidate)".into(),
+                        expected: s,
+                        found: sigma.len(),
+                    }
+                    .into());
                 }
                 sigma.iter().map(|v| 1.0 / v).collect()
             }
         };
-        if !(o.rank_tolerance.is_finite() && o.rank_tolerance >= 0.0) {
-            return Err(SensorsError::InvalidOption(format!(
-                "rank tolerance {} must be finite and non-negative",
-                o.rank_tolerance
-            )));
-        }
         let shapes = c.shapes();
         let mut phi = Vec::with_capacity(s * k);
         let mut cand = Vec::with_capacity(s);
@@ -307,11 +302,15 @@ impl Problem {
                     blocks[b].push(r);
                 }
                 if let Some(b) = blocks.iter().position(|b| b.len() > 3) {
-                    return Err(SensorsError::InvalidOption(format!(
-                        "node `{}` has {} candidate DOFs (at most 3: x, y, z)",
-                        names[b],
-                        blocks[b].len()
-                    )));
+                    return Err(invalid_option(
+                        "grouping",
+                        "node",
+                        format!(
+                            "node `{}` has {} candidate DOFs (at most 3: x, y, z)",
+                            names[b],
+                            blocks[b].len()
+                        ),
+                    ));
                 }
                 (blocks, names)
             }
@@ -482,15 +481,15 @@ impl Problem {
             .map(|&i| c.labels()[i].clone())
             .collect();
         let (condition_number, max_off_diagonal) = quality(c, &selected_indices)?;
-        let mut counts = DirectionCounts::default();
+        let mut counts = AxisCounts::default();
         let mut nodes: Vec<String> = Vec::new();
         for l in &selected {
             match split_label(l) {
                 Some((node, dir)) => {
                     match dir {
-                        Direction::X => counts.x += 1,
-                        Direction::Y => counts.y += 1,
-                        Direction::Z => counts.z += 1,
+                        Axis::X => counts.x += 1,
+                        Axis::Y => counts.y += 1,
+                        Axis::Z => counts.z += 1,
                     }
                     if !nodes.iter().any(|n| n == node) {
                         nodes.push(node.to_string());

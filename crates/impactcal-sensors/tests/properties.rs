@@ -7,8 +7,9 @@ mod common;
 use approx::assert_abs_diff_eq;
 use common::*;
 use faer::Mat;
+use impactcal_core::CoreError;
 use impactcal_sensors::{
-    CandidateShapes, Elimination, Grouping, Method, PlacementOptions, SensorsError,
+    CandidateShapes, Elimination, Grouping, PlacementMethod, PlacementOptions, SensorsError,
     leverage_scores, place,
 };
 use proptest::prelude::*;
@@ -120,7 +121,7 @@ proptest! {
         sigma[row] = 1.0 / factor;
         let c = CandidateShapes::new(labels(20), phi.as_ref()).unwrap();
         let cs = CandidateShapes::new(labels(20), scaled.as_ref()).unwrap();
-        let pw = place(&c, &PlacementOptions::new(6).noise(sigma)).unwrap();
+        let pw = place(&c, &PlacementOptions::new(6).noise(sigma).unwrap()).unwrap();
         let ps = place(&cs, &PlacementOptions::new(6)).unwrap();
         prop_assert_eq!(pw.selected, ps.selected);
     }
@@ -280,7 +281,7 @@ fn forward_and_swaps_never_lose_to_their_start() {
             &c,
             &PlacementOptions::new(n)
                 .grouping(grouping)
-                .method(Method::Forward),
+                .method(PlacementMethod::Forward),
         )
         .unwrap();
         let bwd = place(&c, &PlacementOptions::new(n).grouping(grouping)).unwrap();
@@ -328,7 +329,11 @@ fn keep_and_exclude_are_respected() {
     let c = chain_candidates();
     let p = place(
         &c,
-        &PlacementOptions::new(3).keep(["1.x"]).exclude(["10.x"]),
+        &PlacementOptions::new(3)
+            .keep(["1.x"])
+            .unwrap()
+            .exclude(["10.x"])
+            .unwrap(),
     )
     .unwrap();
     assert!(p.selected.contains(&"1.x".to_string()));
@@ -362,27 +367,35 @@ fn typed_errors() {
         SensorsError::TargetAboveCandidates { .. }
     ));
     assert!(matches!(
-        err(PlacementOptions::new(3).keep(["11.x"])),
+        err(PlacementOptions::new(3).keep(["11.x"]).unwrap()),
         SensorsError::UnknownLabel { option: "keep", .. }
     ));
     assert!(matches!(
-        err(PlacementOptions::new(3).keep(["1.x"]).exclude(["1.x"])),
+        PlacementOptions::new(3)
+            .keep(["1.x"])
+            .unwrap()
+            .exclude(["1.x"])
+            .unwrap_err(),
         SensorsError::KeepExcludeConflict { .. }
     ));
     assert!(matches!(
-        err(PlacementOptions::new(3).keep(["1.x", "2.x", "3.x", "4.x"])),
+        err(PlacementOptions::new(3)
+            .keep(["1.x", "2.x", "3.x", "4.x"])
+            .unwrap()),
         SensorsError::TooManyKept { kept: 4, .. }
     ));
     assert!(matches!(
-        err(PlacementOptions::new(3).noise(vec![1.0; 9])),
-        SensorsError::InvalidOption(_)
+        err(PlacementOptions::new(3).noise(vec![1.0; 9]).unwrap()),
+        SensorsError::Core(CoreError::DimensionMismatch { .. })
     ));
     assert!(matches!(
-        err(PlacementOptions::new(3).noise(vec![0.0; 10])),
-        SensorsError::InvalidOption(_)
+        PlacementOptions::new(3).noise(vec![0.0; 10]).unwrap_err(),
+        SensorsError::Core(CoreError::InvalidOption { .. })
     ));
     assert!(matches!(
-        err(PlacementOptions::new(3).exclude((1..=8).map(|i| format!("{i}.x")))),
+        err(PlacementOptions::new(3)
+            .exclude((1..=8).map(|i| format!("{i}.x")))
+            .unwrap()),
         SensorsError::TooFewCandidates {
             candidates: 2,
             shapes: 3
@@ -404,8 +417,8 @@ fn typed_errors() {
     let mut bad = chain();
     bad[(4, 1)] = f64::NAN;
     match CandidateShapes::new(labels(10), bad.as_ref()).unwrap_err() {
-        SensorsError::NonFinite { label, shape, .. } => {
-            assert_eq!((label.as_str(), shape), ("2.y", 2))
+        SensorsError::Core(CoreError::NonFinite { location, .. }) => {
+            assert_eq!(location, "candidate `2.y`, shape 2")
         }
         e => panic!("unexpected {e}"),
     }
