@@ -4,13 +4,18 @@
 //! `cargo run --release --example cors_dixon_szego -- [--seeds 30] [--budget 300]
 //! [--functions branin,hartmann3] [--transform identity|log|shifted-log|median-cap]
 //! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]
-//! [--restart-patience N | --no-restart]`
+//! [--restart-patience N | --no-restart] [--points]`
+//!
+//! `--points` adds every chosen point to each line (`"points":[[x1, x2, ...], ...]`, shortest
+//! round-trip decimals), so that two builds can be checked to choose the same points bit for
+//! bit.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::time::Instant;
 
-use impactcal::cors::{Cors, CorsOptions, Restart, SurrogateKernel, Transform, test_functions};
+use impactcal::core::test_functions;
+use impactcal::cors::{Cors, CorsOptions, Restart, SurrogateKernel, Transform};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -77,11 +82,14 @@ fn main() {
             let mut hit: Option<usize> = None;
             let mut best = f64::INFINITY;
             let mut suggest_s = Vec::new();
+            let mut chosen: Vec<String> = Vec::new();
             for k in 0..budget {
                 let t = Instant::now();
                 let s = study.suggest(1).unwrap().pop().unwrap();
                 suggest_s.push(t.elapsed().as_secs_f64());
                 let v = f.eval(&s.x);
+                let coordinates: Vec<String> = s.x.iter().map(|c| format!("{c:?}")).collect();
+                chosen.push(format!("[{}]", coordinates.join(",")));
                 study.tell(s.id, v).unwrap();
                 best = best.min(v);
                 if hit.is_none() && f.relative_error(best) < 0.01 {
@@ -98,10 +106,15 @@ fn main() {
                 adaptive.iter().sum::<f64>() / adaptive.len() as f64
             };
             println!(
-                "{{\"tool\":\"impactcal-cors\",\"function\":\"{name}\",\"seed\":{seed},\"evals_to_1pct\":{},\"best\":{best},\"evaluations\":{},\"overhead_s\":{mean},\"restarts\":{}}}",
+                "{{\"tool\":\"impactcal-cors\",\"function\":\"{name}\",\"seed\":{seed},\"evals_to_1pct\":{},\"best\":{best},\"evaluations\":{},\"overhead_s\":{mean},\"restarts\":{}{}}}",
                 hit.map_or("null".to_string(), |h| h.to_string()),
                 study.evaluations().len(),
-                study.restarts()
+                study.restarts(),
+                if args.iter().any(|a| a == "--points") {
+                    format!(",\"points\":[{}]", chosen.join(","))
+                } else {
+                    String::new()
+                }
             );
         }
     }

@@ -1,38 +1,24 @@
 //! The error type of `impactcal-cors`.
 
-use impactcal_core::CoreError;
+use impactcal_core::{CoreError, ErrorKind};
 use impactcal_erbf::ErbfError;
 
 /// Everything that can go wrong while setting up or running a CORS-RBF study.
+///
+/// Faults shared with the other crates are [`CoreError`]s under [`CorsError::Core`]: an
+/// option out of range ([`CoreError::InvalidOption`]), a point or list of the wrong length
+/// ([`CoreError::DimensionMismatch`]), a NaN or infinite coordinate
+/// ([`CoreError::NonFinite`], naming the point and the parameter) and file I/O
+/// ([`CoreError::Io`]).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum CorsError {
-    /// A fault of the parameter space, a point or a file (from `impactcal-core`).
+    /// A fault of a kind shared by every crate, or of the parameter space or a file.
     #[error(transparent)]
     Core(#[from] CoreError),
     /// A fault of the RBF surrogate that could not be worked around.
     #[error("RBF surrogate: {0}")]
     Rbf(#[from] ErbfError),
-    /// An option outside its admissible range.
-    #[error("option `{name}` = {value}: {message}")]
-    InvalidOption {
-        /// The option.
-        name: &'static str,
-        /// The value given, as text.
-        value: String,
-        /// What is required.
-        message: String,
-    },
-    /// A point or list whose length is not what the parameter space requires.
-    #[error("{what}: expected {expected}, found {found}")]
-    DimensionMismatch {
-        /// The quantity whose size is wrong.
-        what: String,
-        /// The size required.
-        expected: usize,
-        /// The size given.
-        found: usize,
-    },
     /// A point outside the bounds of the parameter space.
     #[error("{what}: parameter `{parameter}` = {value} lies outside [{lower}, {upper}]")]
     OutOfBounds {
@@ -46,16 +32,6 @@ pub enum CorsError {
         lower: f64,
         /// Upper bound.
         upper: f64,
-    },
-    /// A NaN or infinite coordinate.
-    #[error("{what}: non-finite coordinate {value} for parameter `{parameter}`")]
-    NonFinitePoint {
-        /// Which point.
-        what: String,
-        /// The parameter's name.
-        parameter: String,
-        /// The coordinate given.
-        value: f64,
     },
     /// Two evaluated points that (nearly) coincide, which an interpolant cannot fit.
     #[error(
@@ -112,3 +88,15 @@ pub enum CorsError {
 
 /// `Result` with [`CorsError`].
 pub type Result<T, E = CorsError> = std::result::Result<T, E>;
+
+impl CorsError {
+    /// What kind of fault this is: that of the wrapped [`CoreError`] or [`ErbfError`], else
+    /// [`ErrorKind::BadInput`] (points, values, ids or a saved state the study cannot take).
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            CorsError::Core(e) => e.kind(),
+            CorsError::Rbf(e) => e.kind(),
+            _ => ErrorKind::BadInput,
+        }
+    }
+}

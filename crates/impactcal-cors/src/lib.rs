@@ -10,16 +10,22 @@
 //! through `<0.9, 0.75, 0.25, 0.05, 0.03, 0>` once per evaluation: global search at the
 //! start of a cycle, local search at its end.
 //!
-//! - [`Cors`]: the study. Ask and tell ([`Cors::suggest`] one or a batch of `q` distinct
-//!   points, [`Cors::tell`] results, NaN for a failed run), or the closed loop
-//!   [`Cors::minimize`]. State to and from JSON ([`Cors::save`], [`Cors::load`]), and
-//!   [`Cors::from_history`] for stateless drivers.
+//! - [`Cors`]: the study, split as argmin splits a solver: a serialisable [`CorsState`],
+//!   a step that is a pure function of it, and this driver. Ask and tell
+//!   ([`Cors::suggest`] one or a batch of `q` distinct points, [`Cors::tell`] results, NaN
+//!   for a failed run), or the closed loop [`Cors::minimize`]. State to and from JSON
+//!   ([`Cors::save`], [`Cors::load`]), and [`Cors::from_history`] for stateless drivers.
+//!   A point that had to be space-filling says why ([`FillReason`]).
 //! - [`CorsOptions`]: kernel, pattern, initial design, objective [`Transform`], stopping
-//!   rules, seed.
-//! - [`test_functions`]: the Dixon-Szego benchmark set.
+//!   and restart rules (one stall rule for both), seed; checked into [`ValidCorsOptions`].
+//!
+//! Points are in the units of the parameter space; sets of points (a warm start, a history)
+//! are faer matrices with one point per row. The Dixon-Szego test set is
+//! [`impactcal_core::test_functions`].
 //!
 //! ```
-//! use impactcal_cors::{Cors, CorsOptions, test_functions};
+//! use impactcal_core::test_functions;
+//! use impactcal_cors::{Cors, CorsOptions};
 //!
 //! let branin = test_functions::by_name("branin").unwrap();
 //! let mut study = Cors::new(branin.space()?, CorsOptions::with_seed(1))?;
@@ -38,12 +44,16 @@ pub mod error;
 mod geometry;
 pub mod optimizer;
 pub mod options;
-pub mod subproblem;
+mod stall;
+pub mod state;
+mod step;
+mod subproblem;
 pub mod surrogate;
-pub mod test_functions;
 
 pub use error::{CorsError, Result};
-pub use optimizer::{Cors, Evaluation, Mode, Origin, Outcome, StopReason, Suggestion};
+pub use optimizer::{Cors, Outcome, StopReason};
 pub use options::{
     CorsOptions, DEFAULT_PATTERN, InitialDesign, Restart, Stopping, SurrogateKernel, Transform,
+    ValidCorsOptions,
 };
+pub use state::{CorsState, Evaluation, FillReason, Mode, Origin, Suggestion};

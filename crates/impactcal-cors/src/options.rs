@@ -1,5 +1,6 @@
-//! Options of the CORS-RBF optimiser, checked once by [`CorsOptions::validate`].
+//! Options of the CORS-RBF optimiser, checked once into [`ValidCorsOptions`].
 
+use impactcal_core::{CoreError, ParamGuard};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CorsError, Result};
@@ -147,7 +148,10 @@ impl Restart {
     }
 }
 
-/// Options of [`Cors`](crate::Cors).
+/// Options of [`Cors`](crate::Cors), checked into [`ValidCorsOptions`] (by
+/// [`ParamGuard::check`], or by [`Cors::new`](crate::Cors::new) itself) before a study uses
+/// them. Every check but one needs no dimension; the design size is checked against the
+/// dimension when the study is made.
 ///
 /// All distances are in the unit box `[0, 1]^d` of the parameter space. The defaults are
 /// those of Regis & Shoemaker (2005) where the reference gives one.
@@ -231,21 +235,21 @@ impl CorsOptions {
     pub fn design_size_for(&self, dim: usize) -> usize {
         self.design_size.unwrap_or(2 * (dim + 1))
     }
+}
 
-    /// Checks every option for a space of `dim` parameters.
+impl ParamGuard for CorsOptions {
+    type Checked = ValidCorsOptions;
+
+    /// Checks every option that does not depend on the dimension.
     ///
     /// # Errors
-    /// [`CorsError::InvalidOption`] for an empty pattern or a `beta` outside `[0, 1]`, a
-    /// design smaller than `dim + 1`, no candidates, no polishing start, or a distance that
-    /// is negative or not finite, a zero patience (stopping or restart) or a negative or
+    /// [`CoreError::InvalidOption`] for an empty pattern or a `beta` outside `[0, 1]`, a
+    /// design of fewer than 2 points, no candidates, no polishing start, a distance that is
+    /// negative or not finite, a zero patience (stopping or restart) or a negative or
     /// non-finite improvement threshold.
-    pub fn validate(&self, dim: usize) -> Result<()> {
+    fn check_ref(&self) -> impactcal_core::Result<()> {
         let bad = |name: &'static str, value: String, message: &str| {
-            Err(CorsError::InvalidOption {
-                name,
-                value,
-                message: message.into(),
-            })
+            Err(CoreError::invalid_option(name, value, message))
         };
         if self.pattern.is_empty() {
             return bad("pattern", "[]".into(), "needs at least one beta");
@@ -253,12 +257,13 @@ impl CorsOptions {
         if let Some(b) = self.pattern.iter().find(|b| !(**b >= 0.0 && **b <= 1.0)) {
             return bad("pattern", b.to_string(), "every beta must lie in [0, 1]");
         }
-        let n0 = self.design_size_for(dim);
-        if n0 < dim + 1 {
+        if let Some(n0) = self.design_size
+            && n0 < 2
+        {
             return bad(
                 "design_size",
                 n0.to_string(),
-                &format!("must be at least d + 1 = {}", dim + 1),
+                "must be at least d + 1, and so at least 2",
             );
         }
         if self.candidates_per_dim == 0 {
@@ -316,5 +321,72 @@ impl CorsOptions {
             }
         }
         Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<ValidCorsOptions> {
+        self.check_ref()?;
+        Ok(ValidCorsOptions(self))
+    }
+}
+
+/// [`CorsOptions`] that passed their checks: the only form a study works with. Read the
+/// options through `Deref`; serialises as the plain options and is checked again when read.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "CorsOptions", into = "CorsOptions")]
+pub struct ValidCorsOptions(CorsOptions);
+
+impl ValidCorsOptions {
+    /// Checks the one option bound to the dimension: a design of at least `dim + 1` points.
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] (as a [`CorsError`]) for a smaller design.
+    pub fn check_dim(&self, dim: usize) -> Result<()> {
+        let n0 = self.design_size_for(dim);
+        if n0 < dim + 1 {
+            return Err(CoreError::invalid_option(
+                "design_size",
+                n0,
+                format!("must be at least d + 1 = {}", dim + 1),
+            )
+            .into());
+        }
+        Ok(())
+    }
+}
+
+impl Default for ValidCorsOptions {
+    /// The defaults of [`CorsOptions::default`], which are valid.
+    fn default() -> Self {
+        ValidCorsOptions(CorsOptions::default())
+    }
+}
+
+impl std::ops::Deref for ValidCorsOptions {
+    type Target = CorsOptions;
+    fn deref(&self) -> &CorsOptions {
+        &self.0
+    }
+}
+
+impl TryFrom<CorsOptions> for ValidCorsOptions {
+    type Error = CoreError;
+    fn try_from(options: CorsOptions) -> impactcal_core::Result<Self> {
+        options.check()
+    }
+}
+
+impl From<ValidCorsOptions> for CorsOptions {
+    fn from(valid: ValidCorsOptions) -> Self {
+        valid.0
+    }
+}
+
+impl ParamGuard for ValidCorsOptions {
+    type Checked = ValidCorsOptions;
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        Ok(())
+    }
+    fn check(self) -> impactcal_core::Result<ValidCorsOptions> {
+        Ok(self)
     }
 }

@@ -25,7 +25,7 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
 use crate::geometry::{Columns, distance};
-use crate::surrogate::Surrogate;
+use crate::surrogate::RbfSurrogate;
 
 /// Candidates per parallel task: small batches cost more in scheduling than they save.
 const PAR_CHUNK: usize = 1024;
@@ -270,7 +270,7 @@ fn argmax(v: &[f64]) -> usize {
 /// One CORS step: the feasible point of lowest surrogate value found by the multistart.
 /// `best` is the best successful point (centre of the local candidates).
 pub fn cors_step(
-    surrogate: &Surrogate,
+    surrogate: &RbfSurrogate,
     best: &[f64],
     blockers: &Blockers,
     settings: &StepSettings,
@@ -399,7 +399,7 @@ fn project(blockers: &Blockers, region: &Region, radii: Radii, y: &mut [f64]) {
 /// Projected-gradient descent of `s` from the feasible `x0`; returns the end point and its
 /// value. Every accepted iterate is feasible.
 fn polish(
-    s: &Surrogate,
+    s: &RbfSurrogate,
     blockers: &Blockers,
     region: &Region,
     radii: Radii,

@@ -7,16 +7,17 @@
 //! allocation, which the candidate screening (thousands of points) and the local polish
 //! (hundreds of gradient steps) need.
 
-use faer::MatRef;
+use faer::{ColRef, MatRef};
 use impactcal_erbf::{RadialFunction, RbfInterpolant, RbfOptions};
 
 use crate::error::Result;
 use crate::geometry::Columns;
 use crate::options::SurrogateKernel;
 
-/// A fitted cubic or thin-plate RBF with a linear tail on the unit box.
+/// A fitted cubic or thin-plate RBF with a linear tail on the unit box: the surrogate of
+/// one CORS step, as a compact copy of the coefficients of an `impactcal-erbf` interpolant.
 #[derive(Debug, Clone)]
-pub struct Surrogate {
+pub struct RbfSurrogate {
     kernel: RadialFunction,
     dim: usize,
     /// Centres, row-major `N x d`.
@@ -28,24 +29,26 @@ pub struct Surrogate {
     a: Vec<f64>,
 }
 
-impl Surrogate {
-    /// Fits the interpolant to `points` (rows of length `d`, distinct, affinely spanning)
-    /// and `values`. When the system is numerically singular, a smoothing of `1e-10` of the
-    /// largest kernel entry is tried once before giving up.
+impl RbfSurrogate {
+    /// Fits the interpolant to `points` (`N x d`, one point of the unit box per row,
+    /// distinct, affinely spanning) and `values` (length `N`). When the system is
+    /// numerically singular, a smoothing of `1e-10` of the largest radial-function value is
+    /// tried once before giving up.
     ///
     /// # Errors
     /// The error of `impactcal-erbf` ([`impactcal_erbf::ErbfError`]) when the fit fails.
-    pub fn fit(points: &[Vec<f64>], values: &[f64], kernel: SurrogateKernel) -> Result<Self> {
+    pub fn fit(points: MatRef<'_, f64>, values: &[f64], kernel: SurrogateKernel) -> Result<Self> {
         let options = match kernel {
             SurrogateKernel::Cubic => RbfOptions::cubic(),
             SurrogateKernel::ThinPlate => RbfOptions::thin_plate(),
         };
-        let rbf = match RbfInterpolant::fit_rows(points, values, options) {
+        let f = ColRef::from_slice(values).as_mat();
+        let rbf = match RbfInterpolant::fit(points, f, options) {
             Ok(r) => r,
             Err(first) => {
-                let d = points.first().map_or(1, Vec::len) as f64;
+                let d = if points.nrows() == 0 { 1 } else { points.ncols() } as f64;
                 let kmax = options.radial.value(d.sqrt()).abs().max(1.0);
-                RbfInterpolant::fit_rows(points, values, options.with_smoothing(1e-10 * kmax))
+                RbfInterpolant::fit(points, f, options.with_smoothing(1e-10 * kmax))
                     .map_err(|_| first)?
             }
         };
@@ -55,8 +58,8 @@ impl Surrogate {
     /// Copies the coefficients of a single-output interpolant with a linear tail.
     ///
     /// # Errors
-    /// [`impactcal_erbf::ErbfError::DimensionMismatch`] when the interpolant has no linear
-    /// tail or no output.
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when
+    /// the interpolant has no linear tail or no output.
     pub fn from_interpolant(rbf: &RbfInterpolant) -> Result<Self> {
         let dim = rbf.dim();
         let n = rbf.n_samples();
@@ -76,7 +79,7 @@ impl Surrogate {
             .into());
         }
         let columns = Columns::new(&centres, dim);
-        Ok(Surrogate {
+        Ok(RbfSurrogate {
             kernel: rbf.options().radial,
             dim,
             centres,

@@ -4,7 +4,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use impactcal_cors::{Cors, CorsOptions, Stopping, Transform, test_functions};
+use impactcal_core::test_functions;
+use impactcal_cors::{Cors, CorsOptions, Stopping, Transform};
 
 /// Evaluations until the best value is within 1% of the minimum, or `None` within `budget`.
 fn evaluations_to_1pct(

@@ -3,11 +3,13 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use impactcal_core::{Parameter, ParameterSpace};
+use impactcal_core::points::{from_rows, to_rows};
+use impactcal_core::test_functions;
+use impactcal_core::{CoreError, Parameter, ParameterSpace};
 use impactcal_cors::design::{affine_rank, symmetric_design};
 use impactcal_cors::{
-    Cors, CorsError, CorsOptions, InitialDesign, Mode, Origin, Restart, StopReason, Stopping,
-    Transform, test_functions,
+    Cors, CorsError, CorsOptions, FillReason, InitialDesign, Mode, Origin, Restart, StopReason,
+    Stopping, Transform,
 };
 
 fn unit_distance(space: &ParameterSpace, a: &[f64], b: &[f64]) -> f64 {
@@ -23,9 +25,10 @@ fn unit_distance(space: &ParameterSpace, a: &[f64], b: &[f64]) -> f64 {
 fn design_is_a_spanning_symmetric_latin_hypercube() {
     for d in [1, 2, 3, 6] {
         let n = 2 * (d + 1);
-        let pts = symmetric_design(n, d, 5).unwrap();
+        let design = symmetric_design(n, d, 5).unwrap();
+        assert_eq!(affine_rank(design.as_ref()), d + 1);
+        let pts = to_rows(design.as_ref());
         assert_eq!(pts.len(), n);
-        assert_eq!(affine_rank(&pts), d + 1);
         for j in 0..d {
             // One point per stratum, at the centres, mirrored in pairs.
             let mut col: Vec<f64> = pts.iter().map(|p| p[j]).collect();
@@ -45,10 +48,10 @@ fn affine_rank_sees_collinear_points() {
     let line: Vec<Vec<f64>> = (0..5)
         .map(|k| vec![0.1 * k as f64, 0.2 * k as f64])
         .collect();
-    assert_eq!(affine_rank(&line), 2);
+    assert_eq!(affine_rank(from_rows(&line, "line").unwrap().as_ref()), 2);
     let mut tri = line.clone();
     tri.push(vec![0.9, 0.1]);
-    assert_eq!(affine_rank(&tri), 3);
+    assert_eq!(affine_rank(from_rows(&tri, "tri").unwrap().as_ref()), 3);
 }
 
 #[test]
@@ -160,7 +163,7 @@ fn restarts_start_a_new_design_and_keep_the_history() {
         .map(|e| e.value.unwrap())
         .collect();
     for n in [start - 1, start, start + 4, start + 12, 69] {
-        let mut rebuilt = Cors::from_history(
+        let mut rebuilt = Cors::from_history_rows(
             f.space().unwrap(),
             options.clone(),
             &xs[..n],
@@ -178,18 +181,18 @@ fn warm_start_replaces_the_design_and_improves() {
     // The source study: 50 existing runs, then 60 more.
     let f = test_functions::by_name("hartmann6").unwrap();
     let space = f.space().unwrap();
-    let existing = impactcal_core::points::to_rows(
-        impactcal_core::sampling::sample(
-            &space,
-            impactcal_core::SamplingMethod::LatinHypercube,
-            50,
-            11,
-        )
-        .unwrap()
-        .points
-        .as_ref(),
-    );
-    let values: Vec<f64> = existing.iter().map(|x| f.eval(x)).collect();
+    let existing = impactcal_core::sampling::sample(
+        &space,
+        impactcal_core::SamplingMethod::LatinHypercube,
+        50,
+        11,
+    )
+    .unwrap()
+    .points;
+    let values: Vec<f64> = to_rows(existing.as_ref())
+        .iter()
+        .map(|x| f.eval(x))
+        .collect();
     let best_existing = values.iter().copied().fold(f64::INFINITY, f64::min);
     // The source study's method: the 2005 pattern over the whole box in every cycle.
     let options = CorsOptions {
@@ -197,7 +200,7 @@ fn warm_start_replaces_the_design_and_improves() {
         ..CorsOptions::with_seed(2)
     };
     let mut study = Cors::new(space, options).unwrap();
-    study.warm_start(&existing, &values).unwrap();
+    study.warm_start(existing.as_ref(), &values).unwrap();
     let out = study.minimize(|x| f.eval(x), 60).unwrap();
     assert_eq!(study.mode(), Some(Mode::Existing));
     assert_eq!(out.evaluations, 60);
@@ -218,7 +221,7 @@ fn warm_start_replaces_the_design_and_improves() {
 fn warm_start_checks_its_input() {
     let space = test_functions::by_name("branin").unwrap().space().unwrap();
     let mut study = Cors::new(space.clone(), CorsOptions::default()).unwrap();
-    let dup = study.warm_start(
+    let dup = study.warm_start_rows(
         &[vec![1.0, 2.0], vec![3.0, 4.0], vec![1.0, 2.0 + 1e-12]],
         &[1.0, 2.0, 3.0],
     );
@@ -231,11 +234,11 @@ fn warm_start_checks_its_input() {
         })
     ));
     assert!(matches!(
-        study.warm_start(&[vec![1.0]], &[1.0]),
-        Err(CorsError::DimensionMismatch { .. })
+        study.warm_start_rows(&[vec![1.0]], &[1.0]),
+        Err(CorsError::Core(CoreError::DimensionMismatch { .. }))
     ));
     assert!(matches!(
-        study.warm_start(&[vec![11.0, 2.0]], &[1.0]),
+        study.warm_start_rows(&[vec![11.0, 2.0]], &[1.0]),
         Err(CorsError::OutOfBounds { .. })
     ));
     assert!(study.evaluations().is_empty());
@@ -245,7 +248,7 @@ fn warm_start_checks_its_input() {
         ..CorsOptions::default()
     };
     let mut only = Cors::new(space.clone(), options).unwrap();
-    only.warm_start(
+    only.warm_start_rows(
         &[
             vec![0.0, 0.0],
             vec![1.0, 1.0],
@@ -266,7 +269,7 @@ fn warm_start_checks_its_input() {
     ));
     // The same set under Auto: the design is run as well.
     let mut auto = Cors::new(space, CorsOptions::default()).unwrap();
-    auto.warm_start(
+    auto.warm_start_rows(
         &[
             vec![0.0, 0.0],
             vec![1.0, 1.0],
@@ -345,7 +348,7 @@ fn from_history_matches_the_library_loop() {
         .map(|e| e.value.unwrap())
         .collect();
     for n in [0, 3, 10, 11, 24] {
-        let mut rebuilt = Cors::from_history(
+        let mut rebuilt = Cors::from_history_rows(
             f.space().unwrap(),
             options.clone(),
             &xs[..n],
@@ -391,6 +394,54 @@ fn batches_hold_distinct_points_with_consecutive_betas() {
         study.tell(12345, 1.0),
         Err(CorsError::UnknownSuggestion(12345))
     ));
+}
+
+/// A fill point says why it is one: too few successes while the design is still pending
+/// (expected), or a surrogate that cannot be fitted, here because the shifted-log transform
+/// of values spanning -1e308 to 1e308 overflows. The failure is reported in the suggestion
+/// and in the outcome of the loop, not hidden behind a space-filling point.
+#[test]
+fn fill_points_say_why() {
+    let space = test_functions::by_name("branin").unwrap().space().unwrap();
+    let options = CorsOptions {
+        transform: Transform::ShiftedLog,
+        ..CorsOptions::with_seed(1)
+    };
+    let mut study = Cors::new(space, options).unwrap();
+    let batch = study.suggest(8).unwrap();
+    assert_eq!(batch[..6].iter().filter(|s| s.origin == Origin::Design).count(), 6);
+    for s in &batch[6..] {
+        assert_eq!(s.origin, Origin::Fill);
+        assert_eq!(
+            s.fill_reason,
+            Some(FillReason::TooFewSuccesses {
+                successes: 0,
+                needed: 3
+            })
+        );
+        assert!(!s.fill_reason.as_ref().unwrap().is_failure());
+    }
+    assert!(batch[..6].iter().all(|s| s.fill_reason.is_none()));
+    for (k, s) in batch.iter().enumerate() {
+        let v = if k % 2 == 0 { 1e308 } else { -1e308 };
+        study.tell(s.id, v).unwrap();
+    }
+    let out = study.minimize(|_| 1.0, 2).unwrap();
+    assert_eq!(
+        out.failed_fits,
+        vec![FillReason::TransformNotFinite, FillReason::TransformNotFinite]
+    );
+    let last = &study.evaluations()[8..];
+    assert!(last.iter().all(|e| e.origin == Origin::Fill));
+    // The reason travels with a pending suggestion through the saved state.
+    let pending = study.suggest(1).unwrap().pop().unwrap();
+    assert_eq!(pending.fill_reason, Some(FillReason::TransformNotFinite));
+    let again = Cors::from_json(&study.to_json().unwrap(), "state").unwrap();
+    assert_eq!(again.pending(), study.pending());
+    // A study that can fit reports nothing.
+    let f = test_functions::by_name("branin").unwrap();
+    let mut plain = Cors::new(f.space().unwrap(), CorsOptions::with_seed(1)).unwrap();
+    assert!(plain.minimize(|x| f.eval(x), 12).unwrap().failed_fits.is_empty());
 }
 
 #[test]
@@ -510,7 +561,7 @@ fn options_are_validated() {
     for o in bad {
         assert!(matches!(
             Cors::new(space.clone(), o),
-            Err(CorsError::InvalidOption { .. })
+            Err(CorsError::Core(CoreError::InvalidOption { .. }))
         ));
     }
     let text = Cors::new(space, CorsOptions::default())

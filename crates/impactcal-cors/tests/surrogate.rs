@@ -2,8 +2,9 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use impactcal_core::points::from_rows;
 use impactcal_cors::SurrogateKernel;
-use impactcal_cors::surrogate::Surrogate;
+use impactcal_cors::surrogate::RbfSurrogate;
 use impactcal_erbf::{RbfInterpolant, RbfOptions};
 use proptest::prelude::*;
 
@@ -25,7 +26,8 @@ proptest! {
             return Ok(()); // random points can be nearly degenerate
         };
         prop_assume!(rbf.pivot_ratio() > 1e-10);
-        let s = Surrogate::fit(&pts, &vals, kernel).unwrap();
+        let x = from_rows(&pts, "points").unwrap();
+        let s = RbfSurrogate::fit(x.as_ref(), &vals, kernel).unwrap();
         let scale = vals.iter().map(|v| v.abs()).fold(1.0, f64::max);
         let v = rbf.predict(&q).unwrap()[0];
         prop_assert!((s.value(&q) - v).abs() < 1e-8 * scale, "{} vs {v}", s.value(&q));
@@ -61,7 +63,8 @@ fn value_matches_erbf_with_many_centres() {
         .map(|p| (3.0 * p[0]).sin() + p[1] * p[2])
         .collect();
     let rbf = RbfInterpolant::fit_rows(&pts, &vals, RbfOptions::cubic()).unwrap();
-    let s = Surrogate::fit(&pts, &vals, SurrogateKernel::Cubic).unwrap();
+    let x = from_rows(&pts, "points").unwrap();
+    let s = RbfSurrogate::fit(x.as_ref(), &vals, SurrogateKernel::Cubic).unwrap();
     for q in [[0.5, 0.5, 0.5], [0.01, 0.99, 0.3], [0.9, 0.1, 0.75]] {
         let v = rbf.predict(&q).unwrap()[0];
         assert!((s.value(&q) - v).abs() < 1e-9, "{} vs {v}", s.value(&q));

@@ -1,0 +1,264 @@
+//! The step of a CORS-RBF study, as a pure function of its state: which points to evaluate
+//! next, and the plan of the run they belong to. The driver ([`Cors`](crate::Cors)) applies
+//! the proposal; nothing here changes the state.
+//!
+//! The restart decision is [`advance_plan`], the only place that decides it: the step calls
+//! it before proposing, and rebuilding a study from its history
+//! ([`Cors::from_history`](crate::Cors::from_history)) calls it at every row.
+
+use faer::Mat;
+use impactcal_core::points::from_rows;
+
+use crate::design::affine_rank_of_rows;
+use crate::error::Result;
+use crate::geometry::{distance, stream};
+use crate::options::InitialDesign;
+use crate::state::{
+    CorsState, DUPLICATE_TOL, FillReason, MATCH_TOL, Mode, Origin, Plan, Suggestion,
+};
+use crate::subproblem::{Blockers, Region, StepSettings, cors_step, maximin};
+use crate::surrogate::RbfSurrogate;
+
+/// What a step proposes: the plan of the run (new at the first suggestion or a restart)
+/// and the suggestions, in order, with consecutive ids from the state's next id.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Proposal {
+    pub(crate) plan: Plan,
+    pub(crate) suggestions: Vec<Suggestion>,
+}
+
+/// The plan fixed at the first suggestion: the mode (design or existing evaluations, by
+/// [`InitialDesign`]) and the start of the `beta` cycle after the initial set.
+///
+/// # Errors
+/// [`CorsError::InsufficientInitialSet`](crate::CorsError::InsufficientInitialSet) under
+/// [`InitialDesign::Existing`] when the evaluations do not span.
+pub(crate) fn initial_plan(state: &CorsState) -> Result<Plan> {
+    let design = state.run_design(0)?;
+    let spans = state.successes_span()?;
+    let mode = match state.options.initial {
+        InitialDesign::Design => Mode::Design,
+        InitialDesign::Existing => {
+            state.require_span()?;
+            Mode::Existing
+        }
+        InitialDesign::Auto if spans => Mode::Existing,
+        InitialDesign::Auto => Mode::Design,
+    };
+    let n = state.evaluations.len() + state.pending.len();
+    let cycle_origin = match mode {
+        Mode::Existing => n,
+        Mode::Design => n + design.len(),
+    };
+    Ok(Plan {
+        mode,
+        design,
+        cycle_origin,
+        run_start: 0,
+        restarts: 0,
+    })
+}
+
+/// The restart decision before the point at history index `index`, seeing the first `upto`
+/// evaluations: when a restart rule is set, the point lies past the run's initial set and
+/// the run stagnates, `plan` becomes a new run starting at `index` (a new design drawn from
+/// the seed and the restart count, the cycle after it). Returns whether it restarted.
+///
+/// # Errors
+/// Those of the sampler (not expected for a checked state).
+pub(crate) fn advance_plan(
+    state: &CorsState,
+    plan: &mut Plan,
+    index: usize,
+    upto: usize,
+) -> Result<bool> {
+    let due = index >= plan.cycle_origin
+        && state.options.restart.as_ref().is_some_and(|rule| {
+            plan.stagnates(&state.evaluations, upto, rule, state.space.dim())
+        });
+    if due {
+        plan.restarts += 1;
+        plan.design = state.run_design(plan.restarts)?;
+        plan.mode = Mode::Design;
+        plan.run_start = index;
+        plan.cycle_origin = index + plan.design.len();
+    }
+    Ok(due)
+}
+
+/// Proposes `q` distinct points to evaluate next (see [`Cors::suggest`](crate::Cors::suggest)).
+///
+/// # Errors
+/// As [`initial_plan`]; mapping errors of the parameter space (not expected).
+pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
+    let mut plan = match &state.plan {
+        Some(p) => p.clone(),
+        None => initial_plan(state)?,
+    };
+    let evaluated = state.evaluations.len();
+    advance_plan(state, &mut plan, evaluated + state.pending.len(), evaluated)?;
+    let d = state.space.dim();
+    let mut out: Vec<Suggestion> = Vec::with_capacity(q);
+    let next_id = |out: &Vec<Suggestion>| state.next_id + out.len() as u64;
+    if plan.mode == Mode::Design {
+        let tol = MATCH_TOL * (d as f64).sqrt();
+        let mut seen = state.units(
+            state.evaluations[plan.run_start.min(evaluated)..]
+                .iter()
+                .map(|e| e.x.as_slice()),
+        )?;
+        seen.extend(state.units(state.pending.iter().map(|p| p.x.as_slice()))?);
+        for u in &plan.design {
+            if out.len() == q {
+                break;
+            }
+            if seen.iter().any(|s| distance(s, u) <= tol) {
+                continue;
+            }
+            out.push(Suggestion {
+                id: next_id(&out),
+                x: state.unit_to_space(u)?,
+                origin: Origin::Design,
+                beta: None,
+                delta: None,
+                predicted: None,
+                fill_reason: None,
+            });
+        }
+    }
+    if out.len() == q {
+        return Ok(Proposal {
+            plan,
+            suggestions: out,
+        });
+    }
+    let fitted = fit_surrogate(state, plan.run_start)?;
+    let root_d = (d as f64).sqrt();
+    while out.len() < q {
+        let index = evaluated + state.pending.len() + out.len();
+        let mut rng = stream(state.options.seed, index);
+        let blockers = blockers(state, plan.run_start, &out)?;
+        let n_cand = state.options.candidates_per_dim * d;
+        let s = match &fitted {
+            Ok((surrogate, best)) => {
+                let k = state.options.pattern.len();
+                let beta = state.options.pattern[index.saturating_sub(plan.cycle_origin) % k];
+                let settings = StepSettings {
+                    beta,
+                    floor: state.options.min_distance * root_d,
+                    failure_radius: state.options.failure_radius * root_d,
+                    candidates: n_cand,
+                    local_candidates: state.options.local_candidates_per_dim * d,
+                    polish_starts: state.options.polish_starts,
+                };
+                let cycle = index.saturating_sub(plan.cycle_origin) / k;
+                let region = match state.options.local_region {
+                    Some(half) if cycle % 2 == 1 => Region::around(best, half),
+                    _ => Region::unit(d),
+                };
+                let c = cors_step(surrogate, best, &blockers, &settings, &region, &mut rng);
+                Suggestion {
+                    id: next_id(&out),
+                    x: state.unit_to_space(&c.x)?,
+                    origin: Origin::Cors,
+                    beta: Some(beta),
+                    delta: Some(c.delta),
+                    predicted: Some(c.predicted),
+                    fill_reason: None,
+                }
+            }
+            Err(reason) => {
+                let (u, delta) = if blockers.is_empty() {
+                    (vec![0.5; d], f64::INFINITY)
+                } else {
+                    maximin(&blockers, n_cand, &mut rng)
+                };
+                Suggestion {
+                    id: next_id(&out),
+                    x: state.unit_to_space(&u)?,
+                    origin: Origin::Fill,
+                    beta: None,
+                    delta: delta.is_finite().then_some(delta),
+                    predicted: None,
+                    fill_reason: Some(reason.clone()),
+                }
+            }
+        };
+        out.push(s);
+    }
+    Ok(Proposal {
+        plan,
+        suggestions: out,
+    })
+}
+
+/// The surrogate fitted to the successes of the run starting at `run_start` (near-duplicates
+/// merged, lower value kept, values transformed) and the best successful point in the unit
+/// box; or why none can be fitted.
+///
+/// # Errors
+/// Mapping errors of the parameter space (not expected).
+fn fit_surrogate(
+    state: &CorsState,
+    run_start: usize,
+) -> Result<std::result::Result<(RbfSurrogate, Vec<f64>), FillReason>> {
+    let d = state.space.dim();
+    let tol = DUPLICATE_TOL * (d as f64).sqrt();
+    let mut pts: Vec<Vec<f64>> = Vec::new();
+    let mut vals: Vec<f64> = Vec::new();
+    let start = run_start.min(state.evaluations.len());
+    for e in &state.evaluations[start..] {
+        let Some(v) = e.value else { continue };
+        let u = state.space.to_unit(&e.x)?;
+        match pts.iter().position(|p| distance(p, &u) <= tol) {
+            Some(k) => vals[k] = vals[k].min(v),
+            None => {
+                pts.push(u);
+                vals.push(v);
+            }
+        }
+    }
+    if pts.len() < d + 1 || affine_rank_of_rows(&pts) < d + 1 {
+        return Ok(Err(FillReason::TooFewSuccesses {
+            successes: pts.len(),
+            needed: d + 1,
+        }));
+    }
+    let best = vals
+        .iter()
+        .enumerate()
+        .fold(0, |k, (i, v)| if *v < vals[k] { i } else { k });
+    let best_x = pts[best].clone();
+    state.options.transform.apply(&mut vals);
+    if vals.iter().any(|v| !v.is_finite()) {
+        return Ok(Err(FillReason::TransformNotFinite));
+    }
+    let x: Mat<f64> = from_rows(&pts, "surrogate points")?;
+    Ok(
+        match RbfSurrogate::fit(x.as_ref(), &vals, state.options.kernel) {
+            Ok(s) => Ok((s, best_x)),
+            Err(e) => Err(FillReason::SurrogateFailed {
+                message: e.to_string(),
+            }),
+        },
+    )
+}
+
+/// The points to keep away from: successes of the current run, pending points and the
+/// points already proposed, and failures of every run.
+fn blockers(state: &CorsState, run_start: usize, proposed: &[Suggestion]) -> Result<Blockers> {
+    let mut b = Blockers::new(state.space.dim());
+    for (k, e) in state.evaluations.iter().enumerate() {
+        if e.is_success() {
+            if k >= run_start {
+                b.ok.extend(state.space.to_unit(&e.x)?);
+            }
+        } else {
+            b.failed.extend(state.space.to_unit(&e.x)?);
+        }
+    }
+    for p in state.pending.iter().chain(proposed) {
+        b.ok.extend(state.space.to_unit(&p.x)?);
+    }
+    Ok(b)
+}
