@@ -1,18 +1,22 @@
 //! impactcal: multi-dimensional calibration of impact dynamics models.
 //!
-//! This facade re-exports the workspace crates under short names:
+//! This facade re-exports the workspace crates under short names, adds one error type for
+//! all of them ([`Error`], with [`Error::kind`]) and a [`prelude`].
 //!
-//! | module | crate | what |
-//! |---|---|---|
-//! | [`core`] | `impactcal-core` | histories, parameter spaces, the `Model` trait, CSV input |
-//! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion |
-//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
-//! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) |
-//! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) |
-//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks |
-//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
-//! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals |
-//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe |
+//! | module | crate | what | depends on (of ours) |
+//! |---|---|---|---|
+//! | [`core`] | `impactcal-core` | histories, parameter spaces and their unit-cube map, point sets (faer matrices, one point per row), the `Model` trait, sampling, CSV input, test functions, the shared error kinds | nothing |
+//! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion | core |
+//! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) | core, shapes |
+//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories | core |
+//! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals | core |
+//! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) | core, erbf |
+//! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe | core |
+//!
+//! The calibration path runs through them in this order: histories of an ensemble
+//! ([`core`], [`shell`]) give impact shapes ([`shapes`]), which place sensors ([`sensors`]);
+//! surrogates of the histories ([`erbf`]) make sensitivity ([`sobol`]) and optimisation
+//! ([`cors`]) affordable. The `examples/` directory walks that path step by step.
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -22,9 +26,12 @@
 //! // Two proportional channels: one shape carries everything.
 //! assert_eq!(shapes.len(), 1);
 //! assert!((shapes.contributions()[0] - 1.0).abs() < 1e-12);
-//! # Ok::<(), Box<dyn std::error::Error>>(())
-//! ```
 //!
+//! // Every crate's error converts into `impactcal::Error`, which says its kind.
+//! let e: Error = Histories::parse_csv("time,a\n0,x\n", "bad.csv").unwrap_err().into();
+//! assert_eq!(e.kind(), ErrorKind::BadInput);
+//! # Ok::<(), impactcal::Error>(())
+//! ```
 
 pub use impactcal_core as core;
 pub use impactcal_cors as cors;
@@ -34,21 +41,102 @@ pub use impactcal_shapes as shapes;
 pub use impactcal_shell as shell;
 pub use impactcal_sobol as sobol;
 
-/// The types most programs need, in one import.
+pub use impactcal_core::ErrorKind;
+
+use impactcal_core::CoreError;
+use impactcal_cors::CorsError;
+use impactcal_erbf::ErbfError;
+use impactcal_sensors::SensorsError;
+use impactcal_shapes::ShapesError;
+use impactcal_shell::ShellError;
+use impactcal_sobol::SobolError;
+
+/// An error of any impactcal crate, with the [`ErrorKind`] that says what to do about it:
+/// fix the input, or look at a numerical or I/O failure.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// From `impactcal-core`: files, histories, parameter spaces, and the kinds of fault
+    /// shared by every crate.
+    #[error(transparent)]
+    Core(#[from] CoreError),
+    /// From `impactcal-shapes`.
+    #[error(transparent)]
+    Shapes(#[from] ShapesError),
+    /// From `impactcal-sensors`.
+    #[error(transparent)]
+    Sensors(#[from] SensorsError),
+    /// From `impactcal-erbf`.
+    #[error(transparent)]
+    Erbf(#[from] ErbfError),
+    /// From `impactcal-sobol`.
+    #[error(transparent)]
+    Sobol(#[from] SobolError),
+    /// From `impactcal-cors`.
+    #[error(transparent)]
+    Cors(#[from] CorsError),
+    /// From `impactcal-shell`.
+    #[error(transparent)]
+    Shell(#[from] ShellError),
+}
+
+impl Error {
+    /// What kind of fault this is: [`ErrorKind::BadInput`] for input the user can fix,
+    /// [`ErrorKind::Numerical`] for a computation (or a model run) that failed on valid
+    /// input, [`ErrorKind::Io`] for a file that could not be read or written.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            Error::Core(e) => e.kind(),
+            Error::Shapes(e) => e.kind(),
+            Error::Sensors(e) => e.kind(),
+            Error::Erbf(e) => e.kind(),
+            Error::Sobol(e) => e.kind(),
+            Error::Cors(e) => e.kind(),
+            Error::Shell(e) => shell_kind(e),
+        }
+    }
+}
+
+/// The kind of a solver error: a deck, model or value that cannot be used is bad input, an
+/// unstable run is a numerical failure, a file is I/O. A variant this classification does
+/// not know yet counts as a failure.
+fn shell_kind(e: &ShellError) -> ErrorKind {
+    match e {
+        ShellError::Core(c) => c.kind(),
+        ShellError::Keyword { .. }
+        | ShellError::UnsupportedKeyword { .. }
+        | ShellError::Reference { .. }
+        | ShellError::Element { .. }
+        | ShellError::Value { .. } => ErrorKind::BadInput,
+        ShellError::Io { .. } => ErrorKind::Io,
+        ShellError::Unstable { .. } => ErrorKind::Numerical,
+        _ => ErrorKind::Numerical,
+    }
+}
+
+/// `Result` with [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// The types most programs need, in one import. Names are unique across the crates:
+/// sampling methods are `SamplingMethod`, sensor-placement methods `PlacementMethod`.
 pub mod prelude {
+    pub use crate::{Error, ErrorKind};
+    pub use impactcal_core::sampling::{Sample, latin_hypercube, sample};
     pub use impactcal_core::{
-        BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
-        TableOptions,
+        BatchResults, CoreError, Histories, Model, ParamGuard, Parameter, ParameterSpace,
+        RunFailure, SamplingMethod, Table, TableOptions, read_samples,
     };
     pub use impactcal_cors::{
-        Cors, CorsError, CorsOptions, InitialDesign, Outcome, StopReason, Suggestion, Transform,
+        Cors, CorsError, CorsOptions, FillReason, InitialDesign, Outcome, StopReason, Suggestion,
+        Transform,
     };
     pub use impactcal_erbf::{
-        Accuracy, ErbfError, LooMethod, PolyDegree, RadialFunction, RbfInterpolant, RbfOptions,
+        Accuracy, Erbf, ErbfError, ErbfOptions, LooMethod, PolyDegree, RadialFunction,
+        RbfInterpolant, RbfOptions, ResponseSurrogate, SurrogateKind,
     };
     pub use impactcal_sensors::{
-        CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,
-        place_from_histories,
+        CandidateShapes, Grouping, Placement, PlacementMethod, PlacementOptions, SensorsError,
+        place, place_from_histories,
     };
     pub use impactcal_shapes::{
         Expansion, ImpactShapes, Orthogonality, ShapeOptions, ShapesError, SvdMethod, Truncation,
@@ -58,6 +146,63 @@ pub mod prelude {
     };
     pub use impactcal_shell::{ShellError, ShellModel, Simulation};
     pub use impactcal_sobol::{
-        DesignLayout, SaltelliDesign, SobolError, SobolIndices, SobolOptions,
+        DesignLayout, SaltelliDesign, SobolError, SobolIndices, SobolOptions, analyze,
     };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every crate's error converts into `Error` and keeps its kind.
+    #[test]
+    fn kinds_survive_the_conversion() {
+        let io = CoreError::Io {
+            path: "x".into(),
+            source: std::io::Error::from(std::io::ErrorKind::NotFound),
+        };
+        assert_eq!(Error::from(io).kind(), ErrorKind::Io);
+        let singular = ErbfError::Singular {
+            ratio: 0.0,
+            threshold: 1e-15,
+        };
+        assert_eq!(Error::from(singular).kind(), ErrorKind::Numerical);
+        let unstable = ShellError::Unstable {
+            time: 0.0,
+            cycle: 1,
+            element: 2,
+            cause: "energy growth".into(),
+        };
+        assert_eq!(Error::from(unstable).kind(), ErrorKind::Numerical);
+        let bad_deck = ShellError::Reference {
+            what: "node",
+            id: 3,
+            message: "not defined".into(),
+        };
+        assert_eq!(Error::from(bad_deck).kind(), ErrorKind::BadInput);
+        // A wrong length is the same kind whichever crate finds it.
+        let mismatch = || CoreError::DimensionMismatch {
+            what: "x".into(),
+            expected: 2,
+            found: 1,
+        };
+        for e in [
+            Error::from(ErbfError::from(mismatch())),
+            Error::from(CorsError::from(mismatch())),
+            Error::from(SobolError::from(mismatch())),
+            Error::from(SensorsError::from(mismatch())),
+            Error::from(ShapesError::from(mismatch())),
+        ] {
+            assert_eq!(e.kind(), ErrorKind::BadInput);
+            assert_eq!(e.to_string(), "x: expected 2, found 1");
+        }
+        assert_eq!(
+            Error::from(ShapesError::NoConvergence).kind(),
+            ErrorKind::Numerical
+        );
+        assert_eq!(
+            Error::from(SensorsError::Numerical("SVD".into())).kind(),
+            ErrorKind::Numerical
+        );
+    }
 }

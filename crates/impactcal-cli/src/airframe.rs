@@ -46,14 +46,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         write_text(&catalogue_csv(), None)?;
     }
     if let Some(name) = &args.preset {
-        let preset = Preset::parse(name).map_err(CliError::input)?;
-        let space = preset.space().map_err(CliError::input)?;
+        let preset = Preset::parse(name)?;
+        let space = preset.space()?;
         write_text(&space.to_csv_string(), None)?;
     }
     if args.out.is_none() && args.svg.is_none() {
         if !args.list && args.preset.is_none() {
-            return Err(CliError::Input(
-                "nothing to do: give --out, --svg, --list or --preset".into(),
+            return Err(CliError::input(
+                "nothing to do: give --out, --svg, --list or --preset",
             ));
         }
         return Ok(());
@@ -63,14 +63,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         options.end_time = t;
         options.output_interval = options.output_interval.min(t);
     }
-    let airframe = Airframe::new(options).map_err(CliError::input)?;
+    let airframe = Airframe::new(options)?;
     let mut values = AirframeValues::nominal();
     for a in &args.set {
-        values.assign(a).map_err(CliError::input)?;
+        values.assign(a)?;
     }
     if let Some(path) = &args.out {
-        let model = airframe.model(&values).map_err(CliError::input)?;
-        write_deck_file(&model, path).map_err(|e| CliError::Failure(e.to_string()))?;
+        let model = airframe.model(&values)?;
+        write_deck_file(&model, path)?;
         eprintln!(
             "impactcal: wrote {} ({} shells, {} nodes, {} sensor nodes, total mass {:.4} lbf s^2/in)",
             path.display(),

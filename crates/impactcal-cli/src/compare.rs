@@ -46,8 +46,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let t = decompose(&test, &opts, &args.test.display().to_string())?;
     let a = decompose(&analysis, &opts, &args.analysis.display().to_string())?;
     let m2 = Orthogonality::between(&a, &t).map_err(|e| {
-        CliError::input(format!(
-            "{} vs {}: {e}",
+        CliError::from(e).context(format!(
+            "{} vs {}",
             args.analysis.display(),
             args.test.display()
         ))

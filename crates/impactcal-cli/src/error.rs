@@ -1,45 +1,131 @@
-//! The command's error type and exit codes.
+//! The command's error type, and the one place where a fault becomes an exit code.
 
 use std::fmt;
 
-/// A failure of the command, printed as one line on stderr.
+use impactcal::ErrorKind;
+
+/// A failure of the command, printed as one line on stderr: a message and the kind of
+/// fault, which alone decides the exit code ([`CliError::exit_code`]).
 #[derive(Debug)]
-pub enum CliError {
-    /// Bad input (a malformed file, an impossible option): exit code 2.
-    Input(String),
-    /// Anything else (a numerical failure, an output file that cannot be written): exit 1.
-    Failure(String),
+pub struct CliError {
+    message: String,
+    kind: ErrorKind,
 }
 
 impl CliError {
-    /// The process exit code for this error.
+    /// The process exit code: 2 for bad input (a malformed file, an impossible option), 1
+    /// for any other failure (a numerical failure, a file that cannot be read or written).
     pub fn exit_code(&self) -> u8 {
-        match self {
-            CliError::Input(_) => 2,
-            CliError::Failure(_) => 1,
+        match self.kind {
+            ErrorKind::BadInput => 2,
+            _ => 1,
         }
     }
 
-    /// An input error from anything printable.
-    pub fn input(e: impl fmt::Display) -> Self {
-        CliError::Input(e.to_string())
+    /// Bad input found by the command itself (its arguments, files that do not fit
+    /// together).
+    pub fn input(message: impl fmt::Display) -> Self {
+        CliError {
+            message: message.to_string(),
+            kind: ErrorKind::BadInput,
+        }
+    }
+
+    /// A file or stream that could not be read or written.
+    pub fn io(message: impl fmt::Display) -> Self {
+        CliError {
+            message: message.to_string(),
+            kind: ErrorKind::Io,
+        }
+    }
+
+    /// A failure that is not the input's fault.
+    pub fn failure(message: impl fmt::Display) -> Self {
+        CliError {
+            message: message.to_string(),
+            kind: ErrorKind::Numerical,
+        }
+    }
+
+    /// The same error, its message prefixed by `context` (for example the file it
+    /// concerns) unless the message already starts with it.
+    #[must_use]
+    pub fn context(mut self, context: impl fmt::Display) -> Self {
+        let context = context.to_string();
+        if !self.message.starts_with(&context) {
+            self.message = format!("{context}: {}", self.message);
+        }
+        self
+    }
+}
+
+impl CliError {
+    /// The same error with a hint appended in parentheses.
+    #[must_use]
+    pub fn hint(mut self, hint: impl fmt::Display) -> Self {
+        self.message = format!("{} ({hint})", self.message);
+        self
     }
 }
 
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            CliError::Input(m) | CliError::Failure(m) => f.write_str(m),
+        f.write_str(&self.message)
+    }
+}
+
+impl From<impactcal::Error> for CliError {
+    fn from(e: impactcal::Error) -> Self {
+        CliError {
+            message: e.to_string(),
+            kind: e.kind(),
         }
     }
 }
 
-impl From<impactcal::core::CoreError> for CliError {
-    fn from(e: impactcal::core::CoreError) -> Self {
-        use impactcal::core::CoreError as E;
-        match e {
-            E::Io { .. } => CliError::Failure(e.to_string()),
-            _ => CliError::Input(e.to_string()),
-        }
+/// Every library error becomes a command error through [`impactcal::Error`] and its kind.
+macro_rules! from_library_error {
+    ($($t:ty),*) => {
+        $(impl From<$t> for CliError {
+            fn from(e: $t) -> Self {
+                impactcal::Error::from(e).into()
+            }
+        })*
+    };
+}
+
+from_library_error!(
+    impactcal::core::CoreError,
+    impactcal::shapes::ShapesError,
+    impactcal::sensors::SensorsError,
+    impactcal::erbf::ErbfError,
+    impactcal::sobol::SobolError,
+    impactcal::cors::CorsError,
+    impactcal::shell::ShellError
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use impactcal::core::CoreError;
+
+    #[test]
+    fn kinds_decide_the_exit_code() {
+        assert_eq!(CliError::input("bad").exit_code(), 2);
+        assert_eq!(CliError::io("disk").exit_code(), 1);
+        assert_eq!(CliError::failure("svd").exit_code(), 1);
+        let io = CoreError::Io {
+            path: "a.csv".into(),
+            source: std::io::Error::from(std::io::ErrorKind::NotFound),
+        };
+        assert_eq!(CliError::from(io).exit_code(), 1);
+        let e = CliError::from(CoreError::invalid_option("n", 0, "must be positive"));
+        assert_eq!(e.exit_code(), 2);
+        assert_eq!(
+            e.context("p.csv").to_string(),
+            "p.csv: option `n` = 0: must be positive"
+        );
+        let e = CliError::input("p.csv: row 2").context("p.csv");
+        assert_eq!(e.to_string(), "p.csv: row 2");
     }
 }

@@ -37,8 +37,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &args.model.display().to_string(),
     )?;
     let e = Expansion::compute(&shapes, &measured, None).map_err(|e| {
-        CliError::input(format!(
-            "{} with {}: {e}",
+        CliError::from(e).context(format!(
+            "{} with {}",
             args.measured.display(),
             args.model.display()
         ))

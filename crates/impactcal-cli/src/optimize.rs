@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
 use faer::Mat;
 use impactcal::core::{CoreError, ParameterSpace, Table, TableOptions, read_samples};
+use impactcal::core::ParamGuard;
 use impactcal::cors::{Cors, CorsOptions, InitialDesign, Restart, SurrogateKernel, Transform};
 
 use crate::error::CliError;
@@ -155,7 +156,6 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
         return Err(CliError::input("--batch must be at least 1"));
     }
     let (points, values) = read_history(&space, &args.history)?;
-    let points = impactcal::core::points::to_rows(points.as_ref());
     let options = CorsOptions {
         kernel: match args.kernel {
             KernelArg::Cubic => SurrogateKernel::Cubic,
@@ -187,15 +187,29 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
         }),
         ..options
     };
-    options
-        .validate(space.dim())
-        .map_err(|e| CliError::input(format!("option: {e}")))?;
+    let options = options
+        .check()
+        .map_err(|e| CliError::from(e).context("option"))?;
     let history = args.history.display().to_string();
-    let mut study = Cors::from_history(space.clone(), options, &points, &values, args.initial_rows)
-        .map_err(|e| CliError::input(format!("{history}: {e}")))?;
+    let mut study = Cors::from_history(
+        space.clone(),
+        options,
+        points.as_ref(),
+        &values,
+        args.initial_rows,
+    )
+    .map_err(|e| CliError::from(e).context(&history))?;
     let next = study
         .suggest(args.batch)
-        .map_err(|e| CliError::input(format!("{history}: {e}")))?;
+        .map_err(|e| CliError::from(e).context(&history))?;
+    for (k, s) in next.iter().enumerate() {
+        if let Some(reason) = s.fill_reason.as_ref().filter(|r| r.is_failure()) {
+            eprintln!(
+                "impactcal: warning: point {} is space-filling, not a CORS point: {reason}",
+                k + 1
+            );
+        }
+    }
     let table = Table::new(
         space.names().iter().map(|s| s.to_string()).collect(),
         next.iter().map(|s| s.x.clone()).collect(),

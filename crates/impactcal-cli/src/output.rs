@@ -8,7 +8,7 @@ use crate::error::CliError;
 /// Writes `value` as pretty JSON to `out`, or to stdout when `out` is `None`.
 pub fn write_json(value: &impl serde::Serialize, out: Option<&Path>) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(value)
-        .map_err(|e| CliError::Failure(format!("cannot encode the result as JSON: {e}")))?;
+        .map_err(|e| CliError::failure(format!("cannot encode the result as JSON: {e}")))?;
     write_text(&(text + "\n"), out)
 }
 
@@ -16,11 +16,11 @@ pub fn write_json(value: &impl serde::Serialize, out: Option<&Path>) -> Result<(
 pub fn write_text(text: &str, out: Option<&Path>) -> Result<(), CliError> {
     match out {
         Some(path) => std::fs::write(path, text)
-            .map_err(|e| CliError::Failure(format!("{}: {e}", path.display()))),
+            .map_err(|e| CliError::io(format!("{}: {e}", path.display()))),
         None => std::io::stdout()
             .lock()
             .write_all(text.as_bytes())
-            .map_err(|e| CliError::Failure(format!("stdout: {e}"))),
+            .map_err(|e| CliError::io(format!("stdout: {e}"))),
     }
 }
 
@@ -29,7 +29,7 @@ pub fn writer(out: Option<&Path>) -> Result<(Box<dyn Write>, String), CliError> 
     match out {
         Some(path) => {
             let file = std::fs::File::create(path)
-                .map_err(|e| CliError::Failure(format!("{}: {e}", path.display())))?;
+                .map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
             Ok((
                 Box::new(std::io::BufWriter::new(file)),
                 path.display().to_string(),

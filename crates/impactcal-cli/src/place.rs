@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::{Args as ClapArgs, ValueEnum};
 use impactcal::core::Histories;
 use impactcal::sensors::{
-    CandidateShapes, Grouping, Method, Placement, PlacementOptions, SensorsError, place,
+    CandidateShapes, Grouping, Placement, PlacementMethod, PlacementOptions, SensorsError, place,
     place_from_histories,
 };
 use serde::Serialize;
@@ -78,25 +78,24 @@ struct Report<'a> {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let mut opts = PlacementOptions::new(args.sensors)
+    let opts = PlacementOptions::new(args.sensors)
         .grouping(if args.nodes {
             Grouping::Node
         } else {
             Grouping::Dof
         })
         .method(match args.method {
-            MethodArg::Backward => Method::Backward,
-            MethodArg::Forward => Method::Forward,
+            MethodArg::Backward => PlacementMethod::Backward,
+            MethodArg::Forward => PlacementMethod::Forward,
         })
-        .swap_refinement(args.swaps);
-    opts.keep = args.keep.iter().map(|s| s.trim().to_string()).collect();
-    opts.exclude = args.exclude.iter().map(|s| s.trim().to_string()).collect();
+        .swap_refinement(args.swaps)
+        .keep(args.keep.iter().map(|s| s.trim().to_string()))?
+        .exclude(args.exclude.iter().map(|s| s.trim().to_string()))?;
     let noise = args
         .noise
         .as_ref()
         .map(|path| CandidateShapes::read_csv(path).map(|t| (path, t)))
-        .transpose()
-        .map_err(sensors_error)?;
+        .transpose()?;
     let with_noise = |opts: PlacementOptions, labels: &[String]| match &noise {
         Some((path, table)) => opts
             .noise_by_label(labels, table)
@@ -104,7 +103,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         None => Ok(opts),
     };
     let (placement, candidates, shapes) = if let Some(path) = &args.shape_matrix {
-        let c = CandidateShapes::read_csv(path).map_err(sensors_error)?;
+        let c = CandidateShapes::read_csv(path)?;
         let opts = with_noise(opts, c.labels())?;
         let p = place(&c, &opts).map_err(|e| in_file(path, e))?;
         (p, c.candidates(), c.shapes_count())
@@ -136,19 +135,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )
 }
 
-/// A library error as a command error: numerical failures and I/O exit 1, the rest 2.
-fn sensors_error(e: SensorsError) -> CliError {
-    match e {
-        SensorsError::Core(c) => c.into(),
-        SensorsError::Numerical(_) => CliError::Failure(e.to_string()),
-        e => CliError::input(e),
-    }
-}
-
-/// As [`sensors_error`], naming the input file for errors that do not already.
+/// A placement error as a command error naming the input file it concerns.
 fn in_file(path: &std::path::Path, e: SensorsError) -> CliError {
-    match e {
-        SensorsError::Core(_) | SensorsError::Numerical(_) => sensors_error(e),
-        e => CliError::input(format!("{}: {e}", path.display())),
-    }
+    CliError::from(e).context(path.display())
 }

@@ -82,8 +82,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (points, warnings) = match args.method {
         SampleMethod::Saltelli => {
             let method = core_method(args.base, args.no_scramble);
-            let d = SaltelliDesign::generate(&space, args.n, method, args.second_order, args.seed)
-                .map_err(CliError::input)?;
+            let d =
+                SaltelliDesign::generate(&space, args.n, method, args.second_order, args.seed)?;
             (d.points, d.warnings)
         }
         other => {

@@ -59,7 +59,7 @@ pub fn decompose(
     options: &ShapeOptions,
     file: &str,
 ) -> Result<ImpactShapes, CliError> {
-    ImpactShapes::from_histories(h, options).map_err(|e| CliError::input(format!("{file}: {e}")))
+    ImpactShapes::from_histories(h, options).map_err(|e| CliError::from(e).context(file))
 }
 
 /// Columns of a matrix as vectors (one per shape).

@@ -87,18 +87,11 @@ pub struct Args {
     pub threads: Option<usize>,
 }
 
-fn shell_error(e: ShellError) -> CliError {
-    match e {
-        ShellError::Unstable { .. } | ShellError::Io { .. } => CliError::Failure(e.to_string()),
-        _ => CliError::Input(e.to_string()),
-    }
-}
-
 /// The model to run and a name for messages: the deck, or the built-in airframe with the
 /// `--set` values.
 fn load(args: &Args) -> Result<(ShellModel, String), CliError> {
     if let Some(path) = &args.deck {
-        let deck = read_deck(path).map_err(shell_error)?;
+        let deck = read_deck(path)?;
         for w in &deck.warnings {
             eprintln!("impactcal: warning: {w}");
         }
@@ -109,12 +102,12 @@ fn load(args: &Args) -> Result<(ShellModel, String), CliError> {
         options.end_time = t;
         options.output_interval = options.output_interval.min(t);
     }
-    let airframe = Airframe::new(options).map_err(shell_error)?;
+    let airframe = Airframe::new(options)?;
     let mut values = AirframeValues::nominal();
     for a in &args.set {
-        values.assign(a).map_err(shell_error)?;
+        values.assign(a)?;
     }
-    let model = airframe.model(&values).map_err(shell_error)?;
+    let model = airframe.model(&values)?;
     Ok((model, "the airframe".into()))
 }
 
@@ -124,13 +117,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(n) = args.threads {
         if n == 0 {
-            return Err(CliError::Input("--threads must be at least 1".into()));
+            return Err(CliError::input("--threads must be at least 1"));
         }
         builder = builder.num_threads(n);
     }
     let pool = builder
         .build()
-        .map_err(|e| CliError::Failure(format!("cannot start the thread pool: {e}")))?;
+        .map_err(|e| CliError::failure(format!("cannot start the thread pool: {e}")))?;
     let started = std::time::Instant::now();
     let result = pool.install(|| -> Result<_, ShellError> {
         let mut sim = Simulation::new(&model)?;
@@ -152,7 +145,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             sim.run()
         }
     });
-    let result = result.map_err(shell_error)?;
+    let result = result?;
     let wall = started.elapsed().as_secs_f64();
     let q = match args.quantity {
         QuantityArg::Velocity => Quantity::Velocity,
@@ -161,7 +154,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     if let Some(path) = &args.out {
         let h = result.histories(q).ok_or_else(|| {
-            CliError::Input(format!(
+            CliError::input(format!(
                 "{name}: --out needs history nodes (*DATABASE_HISTORY_NODE)"
             ))
         })?;

@@ -7,21 +7,12 @@ use clap::{Args as ClapArgs, ValueEnum};
 use faer::MatRef;
 use impactcal::core::{ParameterSpace, Table, TableOptions, read_samples};
 use impactcal::sobol::{
-    DesignLayout, FirstOrderEstimator, GivenDataOptions, SobolError, SobolOptions, TotalEstimator,
-    analyze, given_data_first_order,
+    DesignLayout, FirstOrderEstimator, GivenDataOptions, SobolOptions, TotalEstimator, analyze,
+    given_data_first_order,
 };
 
 use crate::error::CliError;
 use crate::output::write_json;
-
-impl From<SobolError> for CliError {
-    fn from(e: SobolError) -> Self {
-        match e {
-            SobolError::Core(core) => core.into(),
-            other => CliError::Input(other.to_string()),
-        }
-    }
-}
 
 /// Arguments of `impactcal sobol`.
 #[derive(ClapArgs, Debug)]
@@ -91,7 +82,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let x = read_samples(&args.params, &space, &[], TableOptions::default())?.points;
     let y = Table::read(&args.outputs, TableOptions::default())?;
     if y.len() != x.nrows() {
-        return Err(CliError::Input(format!(
+        return Err(CliError::input(format!(
             "{}: {} rows, but {params_name} has {} runs",
             args.outputs.display(),
             y.len(),
@@ -116,9 +107,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let layout = DesignLayout::from_rows(x.nrows(), space.dim(), args.second_order)?;
     layout.check_points(x.as_ref()).map_err(|e| {
-        CliError::Input(format!(
-            "{params_name}: {e} (use --given-data for any other sample)"
-        ))
+        CliError::from(e)
+            .context(&params_name)
+            .hint("use --given-data for any other sample")
     })?;
     let options = SobolOptions {
         first_order: match args.first_estimator {

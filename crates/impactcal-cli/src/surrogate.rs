@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
-use impactcal::core::{ParameterSpace, Samples, Table, TableOptions, read_samples};
+use impactcal::core::{ParameterSpace, Samples, Table, TableOptions, read_samples, read_text};
 use impactcal::erbf::{ErbfError, ErrorSummary, LooMethod, ResponseSurrogate, SurrogateKind};
 
 use crate::error::CliError;
@@ -101,7 +101,7 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
     let params = read_samples(&a.params, &space, &[], TableOptions::default())?;
     let outputs = Table::read(&a.outputs, TableOptions::default())?;
     if outputs.len() != params.points.nrows() {
-        return Err(CliError::Input(format!(
+        return Err(CliError::input(format!(
             "{}: {} sample rows, but {} has {}; one response row per sample is required",
             a.outputs.display(),
             outputs.len(),
@@ -142,12 +142,10 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
 }
 
 fn predict(a: PredictArgs) -> Result<(), CliError> {
-    let text = std::fs::read_to_string(&a.model)
-        .map_err(|e| CliError::Input(format!("{}: {e}", a.model.display())))?;
+    let (text, name) = read_text(&a.model)?;
     let model: ResponseSurrogate = serde_json::from_str(&text).map_err(|e| {
-        CliError::Input(format!(
-            "{}: not a surrogate model written by `impactcal surrogate fit`: {e}",
-            a.model.display()
+        CliError::input(format!(
+            "{name}: not a surrogate model written by `impactcal surrogate fit`: {e}"
         ))
     })?;
     let params = read_samples(&a.params, model.space(), &[], TableOptions::default())?;
@@ -170,12 +168,10 @@ fn predict(a: PredictArgs) -> Result<(), CliError> {
     }
     let y = model
         .predict_batch(x.as_ref())
-        .map_err(|e| CliError::Input(format!("{}: {e}", a.params.display())))?;
+        .map_err(|e| CliError::from(e).context(a.params.display()))?;
     let table = Table::from_matrix(model.output_names().to_vec(), y.as_ref())?;
     let (out, name) = writer(a.out.as_deref())?;
-    table
-        .write(out, &name)
-        .map_err(|e| CliError::Failure(e.to_string()))
+    Ok(table.write(out, &name)?)
 }
 
 /// Maps sample indices in a fit error to lines of the samples file.
@@ -187,14 +183,13 @@ fn fit_error(e: ErbfError, params: &Samples, path: &Path) -> CliError {
             second,
             distance,
             ..
-        } => CliError::Input(format!(
+        } => CliError::input(format!(
             "{}: the samples on lines {} and {} are duplicates (scaled distance {distance:.3e}); \
              remove or merge one of them",
             path.display(),
             line(first),
             line(second)
         )),
-        ErbfError::Singular { .. } => CliError::Failure(e.to_string()),
-        other => CliError::input(other),
+        other => other.into(),
     }
 }

@@ -9,8 +9,9 @@ use common::impactcal;
 use std::io::Write;
 use std::path::Path;
 
-use impactcal::core::{Table, TableOptions};
-use impactcal::cors::{Cors, CorsOptions, Restart, test_functions};
+use impactcal::core::points::to_rows;
+use impactcal::core::{Table, TableOptions, test_functions};
+use impactcal::cors::{Cors, CorsOptions, Restart};
 
 /// Runs `impactcal optimize suggest` on the files with extra arguments.
 fn run_suggest(bounds: &Path, history: &Path, extra: &[&str]) -> std::process::Output {
@@ -157,10 +158,13 @@ fn batch_failures_and_empty_history() {
     // No history yet: the first three design points.
     let first = suggest(&bounds, &history, &["--batch", "3"]);
     assert_eq!(first.len(), 3);
-    let design = Cors::new(f.space().unwrap(), CorsOptions::with_seed(0))
-        .unwrap()
-        .design_points()
-        .unwrap();
+    let design = to_rows(
+        Cors::new(f.space().unwrap(), CorsOptions::with_seed(0))
+            .unwrap()
+            .design_points()
+            .unwrap()
+            .as_ref(),
+    );
     assert_eq!(first, design[..3].to_vec());
     // Run the whole design, one run failing; then a batch of four CORS points.
     for (k, x) in design.iter().enumerate() {
@@ -177,6 +181,49 @@ fn batch_failures_and_empty_history() {
             );
         }
     }
+}
+
+/// Only a history file that does not exist (in a directory that does) starts a new study;
+/// any other history that cannot be read is reported, never taken for "no evaluation yet".
+#[test]
+fn only_a_missing_history_starts_a_new_study() {
+    let dir = tempfile::tempdir().unwrap();
+    let bounds = branin_bounds(dir.path());
+    // Missing file in an existing directory: the first design point.
+    let fresh = suggest(&bounds, &dir.path().join("new.csv"), &[]);
+    assert_eq!(fresh.len(), 1);
+    // A header without rows is a history without evaluations: the same point.
+    let header = dir.path().join("header.csv");
+    std::fs::write(&header, "x1,x2,objective\n").unwrap();
+    assert_eq!(suggest(&bounds, &header, &[]), fresh);
+    // A mistyped directory (the history could never be appended to) and a directory where
+    // the file should be: I/O errors naming the path.
+    for path in [
+        dir.path().join("no_such_dir").join("history.csv"),
+        dir.path().to_path_buf(),
+    ] {
+        let out = run_suggest(&bounds, &path, &[]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{}: {err}", path.display());
+        assert!(out.stdout.is_empty(), "{}", path.display());
+        assert!(err.contains(&path.display().to_string()), "{err}");
+    }
+    // An empty file is not a history: reported, not a new study.
+    let empty = dir.path().join("empty.csv");
+    std::fs::write(&empty, "").unwrap();
+    let out = run_suggest(&bounds, &empty, &[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("empty.csv"));
+    // Extra columns are named, like missing ones.
+    let extra = dir.path().join("extra.csv");
+    std::fs::write(&extra, "x1,x2,objective,comment\n1,2,3,4\n").unwrap();
+    let out = run_suggest(&bounds, &extra, &[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("unexpected column `comment`"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
