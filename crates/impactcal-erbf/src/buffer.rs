@@ -17,9 +17,9 @@ use faer::{Mat, MatRef};
 /// threshold) every allocation is a fresh mapping whose pages fault on first touch.
 const HUGE_PAGE_THRESHOLD: usize = 32 << 20;
 
-/// A zero-filled `nrows x ncols` matrix; on Linux, buffers of 4 MiB or more are first
-/// advised to use transparent huge pages (`MADV_HUGEPAGE`), so that filling them costs a
-/// few hundred page faults rather than hundreds of thousands.
+/// A zero-filled `nrows x ncols` matrix; on Linux, buffers of 32 MiB or more (the
+/// threshold above) are first advised to use transparent huge pages (`MADV_HUGEPAGE`), so
+/// that filling them costs a few hundred page faults rather than hundreds of thousands.
 ///
 /// The advice is a hint: where the kernel ignores it (huge pages disabled, another
 /// operating system), the result is the same zero matrix, allocated as by
