@@ -6,7 +6,7 @@
 #   benches/shell_quiet_timing.sh [SECONDS] [BINARY]   (default 240 s; the timing example)
 #   then: the runs with others_cpu_s below 0.1 are the clean ones.
 #
-# Build the binary first: cargo build --release --example shell_timing
+# Build the binary first (benches/harness/shell_timing.rs): cargo build --release --example shell_timing
 set -eu
 end=$((SECONDS + ${1:-240}))
 bin=${2:-${CARGO_TARGET_DIR:-target}/release/examples/shell_timing}

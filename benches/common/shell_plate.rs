@@ -1,4 +1,4 @@
-//! The benchmark plate shared by `benches/shell.rs` and `examples/shell_timing.rs`: a
+//! The benchmark plate shared by `benches/shell.rs` and `benches/harness/shell_timing.rs`: a
 //! 150 x 140 mesh of 21,000 mildly warped Belytschko-Lin-Tsay quads, elastic-plastic
 //! aluminium, 5 Gauss points, driven by a velocity field that bends and stretches it into
 //! the plastic range.

@@ -1,4 +1,4 @@
-//! The surrogate benchmark data shared by `benches/erbf.rs` and `examples/erbf_peer.rs`, so
+//! The surrogate benchmark data shared by `benches/erbf.rs` and `benches/harness/erbf_peer.rs`, so
 //! that the criterion figures and the scipy comparison use the same input.
 
 use faer::Mat;

@@ -1,4 +1,4 @@
-//! The benchmark matrix shared by `benches/svd.rs` and `examples/svd_timing.rs`, so that the
+//! The benchmark matrix shared by `benches/svd.rs` and `benches/harness/svd_timing.rs`, so that the
 //! criterion figures and the numpy comparison use the same data.
 
 use faer::Mat;

@@ -1,7 +1,7 @@
 """pySOT (DYCORS and SRBF, cubic RBF with a linear tail) on the seven Dixon-Szego functions.
 
 Prints one JSON line per (strategy, function, seed), in the format of our
-`examples/cors_dixon_szego.rs`: evaluations until the relative error drops below 1% (null
+`benches/harness/cors_dixon_szego.rs`: evaluations until the relative error drops below 1% (null
 if not within the budget) and the mean time per adaptive iteration spent outside the
 objective (the optimiser's overhead). Run through cors_pysot.sh.
 """

@@ -5,6 +5,7 @@
 # docs/performance.md.
 #
 #   benches/peers/cors_pysot.sh [SEEDS=30] [BUDGET=300]
+# Our side is benches/harness/cors_dixon_szego.rs, built as the `cors_dixon_szego` example target.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 SEEDS="${1:-30}"

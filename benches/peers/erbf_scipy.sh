@@ -5,6 +5,7 @@
 # the two cubic (and the two Gaussian) interpolants, which are the same mathematical model.
 #
 # Usage: benches/peers/erbf_scipy.sh [reps]   (from the repository root)
+# Our side is benches/harness/erbf_peer.rs, built as the `erbf_peer` example target.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 REPS="${1:-5}"

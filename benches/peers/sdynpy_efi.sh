@@ -5,6 +5,7 @@
 # prints the median times and the ratio.
 #
 # Usage: benches/peers/sdynpy_efi.sh [REPEATS]   (from the repository root)
+# Our side is benches/harness/place_timing.rs, built as the `place_timing` example target.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 REPEATS="${1:-5}"

@@ -11,7 +11,7 @@ SALib has no vector outputs: users loop `sobol.analyze` over the columns. Loopin
 T columns would take tens of minutes, so the script times SALib on the first
 --salib-columns columns and extrapolates the median per-column time to T columns (SALib's
 cost per column does not depend on the others). impactcal analyses all T columns in one call
-(examples/sobol_peer.rs, median of --repeats runs), and the script checks that both give the
+(benches/harness/sobol_peer.rs, median of --repeats runs), and the script checks that both give the
 same point estimates on the columns SALib ran.
 
 Usage (from the repository root):

@@ -2,6 +2,7 @@
 # Times numpy.linalg.svd(full_matrices=False) against impactcal's thin SVD and its top-20
 # randomized solver on the same matrices, in the same run, and prints the ratios.
 # Usage: benches/peers/svd_numpy.sh [REPEATS]   (run from anywhere)
+# Our side is benches/harness/svd_timing.rs, built as the `svd_timing` example target.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$here/../.."

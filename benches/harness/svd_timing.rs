@@ -11,7 +11,7 @@ use std::io::Write;
 use std::time::Instant;
 
 use impactcal::shapes::{ImpactShapes, ShapeOptions, SvdMethod, Truncation};
-#[path = "../benches/common/svd_matrix.rs"]
+#[path = "../common/svd_matrix.rs"]
 mod svd_matrix;
 use svd_matrix::benchmark_matrix;
 

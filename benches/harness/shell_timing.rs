@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use impactcal::shell::Simulation;
 
-#[path = "../benches/common/shell_plate.rs"]
+#[path = "../common/shell_plate.rs"]
 mod shell_plate;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

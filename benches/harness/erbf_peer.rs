@@ -14,7 +14,7 @@ use std::time::Instant;
 use faer::MatRef;
 use impactcal::erbf::{Erbf, ErbfOptions, RadialFunction, RbfInterpolant, RbfOptions};
 
-#[path = "../benches/common/surrogate_data.rs"]
+#[path = "../common/surrogate_data.rs"]
 mod surrogate_data;
 use surrogate_data::{M, T, surrogate_data};
 
