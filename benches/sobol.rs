@@ -2,9 +2,9 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use impactcal::core::sampling::{Method, seeded_rng, symmetric_latin_hypercube, unit_sample};
 use faer::MatRef;
 use impactcal::core::points::to_rows;
+use impactcal::core::sampling::{Method, seeded_rng, symmetric_latin_hypercube, unit_sample};
 use impactcal::core::test_functions;
 use impactcal::core::{Parameter, ParameterSpace};
 use impactcal::sobol::{SaltelliDesign, SobolOptions, analyze};

@@ -45,9 +45,8 @@ pub fn calibrate() -> impactcal::Result<Vec<f64>> {
     // 2. The measured histories at the sensors, and the same channels of every run side by
     //    side (one row per run) for a surrogate of all of them at once.
     let measured: Vec<f64> = test.select(&channels)?.data().to_vec();
-    let at_sensors = |h: &Histories| -> impactcal::Result<Vec<f64>> {
-        Ok(h.select(&channels)?.data().to_vec())
-    };
+    let at_sensors =
+        |h: &Histories| -> impactcal::Result<Vec<f64>> { Ok(h.select(&channels)?.data().to_vec()) };
     let rows: Vec<Vec<f64>> = runs.iter().map(at_sensors).collect::<Result<_, _>>()?;
     let f = Mat::from_fn(rows.len(), measured.len(), |i, k| rows[i][k]);
     let surrogate = Erbf::fit(&space, x.as_ref(), f.as_ref(), ErbfOptions::default())?;

@@ -27,7 +27,8 @@ pub fn main() -> impactcal::Result<()> {
     let model = ImpactModel::new()?;
     let nominal = model.simulate(&model.space().nominal())?;
     // The z velocity of node 104 at 10 ms (sample 50), test against model.
-    let at_10ms = |h: &Histories| -> impactcal::Result<f64> { Ok(h.channel_by_label("104.z")?[50]) };
+    let at_10ms =
+        |h: &Histories| -> impactcal::Result<f64> { Ok(h.channel_by_label("104.z")?[50]) };
     println!(
         "104.z at 10 ms: test {:.1}, model at nominal {:.1} in/s",
         at_10ms(&test)?,
@@ -42,7 +43,9 @@ pub fn main() -> impactcal::Result<()> {
     let values: Vec<f64> = runs.iter().map(at_10ms).collect::<Result<_, _>>()?;
     let (lo, hi) = values
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
     println!(
         "ensemble of {}: 104.z at 10 ms from {lo:.1} to {hi:.1} in/s",
         runs.len()

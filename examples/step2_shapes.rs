@@ -18,7 +18,10 @@ pub fn main() -> impactcal::Result<()> {
         .iter()
         .map(|c| format!("{:.3}", c))
         .collect();
-    println!("contributions of the 3 analysis shapes: {}", share.join(", "));
+    println!(
+        "contributions of the 3 analysis shapes: {}",
+        share.join(", ")
+    );
     // M2: the cosine between each analysis shape and its test partner (1: same pattern).
     let m2 = Orthogonality::between(&a, &t)?;
     for p in m2.pairs() {

@@ -29,7 +29,12 @@ pub fn main() -> impactcal::Result<()> {
         .map(|h| h.channel_by_label("104.z"))
         .collect::<Result<_, _>>()?;
     let f = Mat::from_fn(runs.len(), SAMPLES, |i, k| histories[i][k]);
-    let erbf = Erbf::fit(model.space(), x.as_ref(), f.as_ref(), ErbfOptions::default())?;
+    let erbf = Erbf::fit(
+        model.space(),
+        x.as_ref(),
+        f.as_ref(),
+        ErbfOptions::default(),
+    )?;
     let loo = ErrorSummary::new(erbf.loo_errors(LooMethod::Auto)?.as_ref(), f.as_ref());
     println!(
         "ERBF of {} runs x {} samples; leave-one-out rms error / std = {:.3}",

@@ -26,7 +26,14 @@ pub fn main() -> impactcal::Result<()> {
     let norms: Vec<Vec<f64>> = runs.iter().map(Histories::norm_history).collect();
     let outputs = Mat::from_fn(runs.len(), SAMPLES, |i, k| norms[i][k]);
     let options = SobolOptions {
-        parameter_names: Some(model.space().names().iter().map(|s| s.to_string()).collect()),
+        parameter_names: Some(
+            model
+                .space()
+                .names()
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
+        ),
         ..SobolOptions::default()
     };
     let s = analyze(&design.layout, outputs.as_ref(), &options)?;

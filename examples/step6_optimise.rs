@@ -19,7 +19,12 @@ pub fn main() -> impactcal::Result<()> {
     let misfit = |x: &[f64]| match model.simulate(x) {
         Ok(h) => {
             let n = h.data().len() as f64;
-            let sum: f64 = h.data().iter().zip(test.data()).map(|(a, b)| (a - b).powi(2)).sum();
+            let sum: f64 = h
+                .data()
+                .iter()
+                .zip(test.data())
+                .map(|(a, b)| (a - b).powi(2))
+                .sum();
             (sum / n).sqrt()
         }
         Err(_) => f64::NAN,

@@ -3,7 +3,15 @@
 //! example recovers the parameters of the test.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
+// Every example includes the toy model itself, as it is its own crate.
+#![allow(clippy::duplicate_mod)]
 
+#[path = "../examples/calibration.rs"]
+#[allow(dead_code)]
+mod calibration;
+#[path = "../examples/common/impact_model.rs"]
+#[allow(dead_code)]
+mod impact_model;
 #[path = "../examples/step1_histories.rs"]
 mod step1_histories;
 #[path = "../examples/step2_shapes.rs"]
@@ -16,12 +24,6 @@ mod step4_surrogate;
 mod step5_sensitivity;
 #[path = "../examples/step6_optimise.rs"]
 mod step6_optimise;
-#[path = "../examples/calibration.rs"]
-#[allow(dead_code)]
-mod calibration;
-#[path = "../examples/common/impact_model.rs"]
-#[allow(dead_code)]
-mod impact_model;
 
 use impactcal::prelude::*;
 
@@ -53,7 +55,10 @@ fn shipped_data_are_the_model() {
     // The files carry no unit; the data and labels are the model's, bit for bit.
     for (file, model) in [
         (&analysis, impact(NODES, SAMPLES, DT, 1.0, 1.0)),
-        (&test, impact(NODES, SAMPLES, DT, TEST_POINT[0], TEST_POINT[1])),
+        (
+            &test,
+            impact(NODES, SAMPLES, DT, TEST_POINT[0], TEST_POINT[1]),
+        ),
     ] {
         assert_eq!(file.labels(), model.labels());
         assert_eq!(file.dt(), model.dt());

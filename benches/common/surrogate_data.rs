@@ -2,8 +2,8 @@
 //! that the criterion figures and the scipy comparison use the same input.
 
 use faer::Mat;
-use impactcal::core::{Parameter, ParameterSpace};
 use impactcal::core::sampling::latin_hypercube;
+use impactcal::core::{Parameter, ParameterSpace};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

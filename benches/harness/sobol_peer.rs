@@ -9,10 +9,10 @@
 
 use std::time::Instant;
 
-use impactcal::core::sampling::Method;
-use impactcal::core::{Parameter, ParameterSpace};
 use faer::MatRef;
 use impactcal::core::points::to_rows;
+use impactcal::core::sampling::Method;
+use impactcal::core::{Parameter, ParameterSpace};
 use impactcal::sobol::{SaltelliDesign, SobolOptions, analyze};
 
 /// The output of run `x` at column `t` of `cols`: a G-function whose weights drift with t,

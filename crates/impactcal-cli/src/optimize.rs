@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
 use faer::Mat;
-use impactcal::core::{CoreError, ParameterSpace, Table, TableOptions, read_samples};
 use impactcal::core::ParamGuard;
+use impactcal::core::{CoreError, ParameterSpace, Table, TableOptions, read_samples};
 use impactcal::cors::{Cors, CorsOptions, InitialDesign, Restart, SurrogateKernel, Transform};
 
 use crate::error::CliError;

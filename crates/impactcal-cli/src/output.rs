@@ -15,8 +15,9 @@ pub fn write_json(value: &impl serde::Serialize, out: Option<&Path>) -> Result<(
 /// Writes `text` to `out`, or to stdout when `out` is `None`.
 pub fn write_text(text: &str, out: Option<&Path>) -> Result<(), CliError> {
     match out {
-        Some(path) => std::fs::write(path, text)
-            .map_err(|e| CliError::io(format!("{}: {e}", path.display()))),
+        Some(path) => {
+            std::fs::write(path, text).map_err(|e| CliError::io(format!("{}: {e}", path.display())))
+        }
         None => std::io::stdout()
             .lock()
             .write_all(text.as_bytes())

@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
-use impactcal::core::{ParameterSpace, Table};
 use impactcal::core::sampling::{self, Method};
+use impactcal::core::{ParameterSpace, Table};
 use impactcal::sobol::SaltelliDesign;
 
 use crate::error::CliError;
@@ -82,8 +82,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (points, warnings) = match args.method {
         SampleMethod::Saltelli => {
             let method = core_method(args.base, args.no_scramble);
-            let d =
-                SaltelliDesign::generate(&space, args.n, method, args.second_order, args.seed)?;
+            let d = SaltelliDesign::generate(&space, args.n, method, args.second_order, args.seed)?;
             (d.points, d.warnings)
         }
         other => {

@@ -34,8 +34,8 @@ pub mod error;
 pub mod histories;
 pub mod model;
 pub mod points;
-pub mod sampling;
 pub mod samples;
+pub mod sampling;
 pub mod space;
 pub mod table;
 pub mod test_functions;
@@ -44,7 +44,7 @@ pub use error::{CoreError, ErrorKind, ParamGuard, Result, check_finite, check_fi
 pub use histories::Histories;
 pub use model::{BatchResults, Model, RunFailure};
 pub use points::PointRows;
+pub use samples::{Samples, read_samples};
 pub use sampling::Method as SamplingMethod;
 pub use space::{Parameter, ParameterSpace};
-pub use samples::{Samples, read_samples};
 pub use table::{Table, TableOptions, read_text};

@@ -495,12 +495,22 @@ mod tests {
             let expected = s.to_unit(&row).unwrap();
             let got: Vec<f64> = u.row(i).iter().copied().collect();
             assert_eq!(got, expected);
-            let back: Vec<f64> = s.from_unit_matrix(u.as_ref()).unwrap().row(i).iter().copied().collect();
+            let back: Vec<f64> = s
+                .from_unit_matrix(u.as_ref())
+                .unwrap()
+                .row(i)
+                .iter()
+                .copied()
+                .collect();
             assert_eq!(back, s.from_unit(&expected).unwrap());
         }
         assert!(matches!(
             s.to_unit_matrix(faer::Mat::<f64>::zeros(2, 3).as_ref()),
-            Err(CoreError::DimensionMismatch { expected: 2, found: 3, .. })
+            Err(CoreError::DimensionMismatch {
+                expected: 2,
+                found: 3,
+                ..
+            })
         ));
         let mut bad = x.clone();
         bad[(3, 1)] = f64::NAN;

@@ -50,7 +50,9 @@ impl Table {
     /// written as an empty cell).
     pub fn new(header: Vec<String>, rows: Vec<Vec<f64>>) -> Result<Table> {
         if header.is_empty() {
-            return Err(CoreError::Invalid("a table needs at least one column".into()));
+            return Err(CoreError::Invalid(
+                "a table needs at least one column".into(),
+            ));
         }
         for (j, name) in header.iter().enumerate() {
             if name.trim().is_empty() {
@@ -431,7 +433,10 @@ mod tests {
         let mut buf = Vec::new();
         t.write(&mut buf, "mem").unwrap();
         let back = parse(std::str::from_utf8(&buf).unwrap()).unwrap();
-        assert_eq!((back.header(), back.rows(), back.lines()), (t.header(), t.rows(), t.lines()));
+        assert_eq!(
+            (back.header(), back.rows(), back.lines()),
+            (t.header(), t.rows(), t.lines())
+        );
     }
 
     #[test]
@@ -442,7 +447,11 @@ mod tests {
         assert!(Table::new(h(&["a", " "]), vec![]).is_err());
         assert!(matches!(
             Table::new(h(&["a", "b"]), vec![vec![1.0]]),
-            Err(CoreError::DimensionMismatch { expected: 2, found: 1, .. })
+            Err(CoreError::DimensionMismatch {
+                expected: 2,
+                found: 1,
+                ..
+            })
         ));
         assert!(Table::new(h(&["a"]), vec![vec![f64::INFINITY]]).is_err());
         assert!(Table::new(h(&["a"]), vec![vec![f64::NAN]]).is_ok());
@@ -452,5 +461,4 @@ mod tests {
         assert_eq!(t.to_matrix(), m);
         assert!(Table::from_matrix(h(&["p"]), m.as_ref()).is_err());
     }
-
 }

@@ -436,8 +436,7 @@ mod tests {
         assert_relative_eq!(gp, 3.0, epsilon = 1e-12);
         let h3 = HARTMANN3.eval_unit(&[0.114614, 0.555649, 0.852547]);
         assert_relative_eq!(h3, -3.86278, epsilon = 1e-5);
-        let h6 =
-            HARTMANN6.eval_unit(&[0.20169, 0.150011, 0.476874, 0.275332, 0.311652, 0.6573]);
+        let h6 = HARTMANN6.eval_unit(&[0.20169, 0.150011, 0.476874, 0.275332, 0.311652, 0.6573]);
         assert_relative_eq!(h6, -3.32237, epsilon = 1e-5);
         let u: Vec<f64> = (1..=10)
             .map(|i| {
@@ -446,7 +445,11 @@ mod tests {
             })
             .collect();
         assert!(DIXON_PRICE10.eval_unit(&u).abs() < 1e-10);
-        for (f, m) in [(SHEKEL5, -10.1532), (SHEKEL7, -10.4029), (SHEKEL10, -10.5364)] {
+        for (f, m) in [
+            (SHEKEL5, -10.1532),
+            (SHEKEL7, -10.4029),
+            (SHEKEL10, -10.5364),
+        ] {
             // The minimisers lie within 0.01 of (4, 4, 4, 4).
             assert_relative_eq!(f.eval(&[4.0; 4]), m, epsilon = 2e-3);
             assert_relative_eq!(f.minimum, m, epsilon = 1e-4);
@@ -466,7 +469,12 @@ mod tests {
                     f.eval_unit(&u)
                 })
                 .fold(f64::INFINITY, f64::min);
-            assert!(best >= f.minimum - 1e-9, "{}: {best} < {}", f.name, f.minimum);
+            assert!(
+                best >= f.minimum - 1e-9,
+                "{}: {best} < {}",
+                f.name,
+                f.minimum
+            );
             assert!(f.relative_error(best) >= -1e-12);
         }
     }

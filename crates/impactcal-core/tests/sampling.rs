@@ -1,12 +1,12 @@
 //! Sampling against scipy's sequences, stratification invariants and decorrelation.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
+use faer::Mat;
+use impactcal_core::points::{column, row, to_rows};
 use impactcal_core::sampling::{
     Halton, Method, SamplingWarning, Sobol, latin_hypercube, sample, seeded_rng,
     symmetric_latin_hypercube, unit_sample,
 };
-use faer::Mat;
-use impactcal_core::points::{column, row, to_rows};
 use impactcal_core::{Parameter, ParameterSpace};
 use proptest::prelude::*;
 

@@ -1,5 +1,5 @@
 //! The CORS-RBF driver: ask and tell, the closed loop, history replay and persistence, over
-//! the state of [`crate::state`] and the step of [`crate::step`].
+//! the state of [`crate::state`] and the pure step (the private `step` module).
 
 use std::path::Path;
 

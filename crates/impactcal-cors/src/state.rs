@@ -1,5 +1,5 @@
 //! The state of a CORS-RBF study: everything a study is, serialisable, and nothing that
-//! acts on it (the step is [`crate::step`], the driver [`Cors`](crate::Cors)).
+//! acts on it (the step is a pure function of it; the driver is [`Cors`](crate::Cors)).
 
 use faer::Mat;
 use impactcal_core::{CoreError, ParamGuard, ParameterSpace};

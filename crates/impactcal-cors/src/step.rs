@@ -72,10 +72,11 @@ pub(crate) fn advance_plan(
     index: usize,
     upto: usize,
 ) -> Result<bool> {
-    let due = index >= plan.cycle_origin
-        && state.options.restart.as_ref().is_some_and(|rule| {
-            plan.stagnates(&state.evaluations, upto, rule, state.space.dim())
-        });
+    let due =
+        index >= plan.cycle_origin
+            && state.options.restart.as_ref().is_some_and(|rule| {
+                plan.stagnates(&state.evaluations, upto, rule, state.space.dim())
+            });
     if due {
         plan.restarts += 1;
         plan.design = state.run_design(plan.restarts)?;

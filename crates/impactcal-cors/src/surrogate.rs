@@ -46,7 +46,11 @@ impl RbfSurrogate {
         let rbf = match RbfInterpolant::fit(points, f, options) {
             Ok(r) => r,
             Err(first) => {
-                let d = if points.nrows() == 0 { 1 } else { points.ncols() } as f64;
+                let d = if points.nrows() == 0 {
+                    1
+                } else {
+                    points.ncols()
+                } as f64;
                 let kmax = options.radial.value(d.sqrt()).abs().max(1.0);
                 RbfInterpolant::fit(points, f, options.with_smoothing(1e-10 * kmax))
                     .map_err(|_| first)?

@@ -409,7 +409,13 @@ fn fill_points_say_why() {
     };
     let mut study = Cors::new(space, options).unwrap();
     let batch = study.suggest(8).unwrap();
-    assert_eq!(batch[..6].iter().filter(|s| s.origin == Origin::Design).count(), 6);
+    assert_eq!(
+        batch[..6]
+            .iter()
+            .filter(|s| s.origin == Origin::Design)
+            .count(),
+        6
+    );
     for s in &batch[6..] {
         assert_eq!(s.origin, Origin::Fill);
         assert_eq!(
@@ -429,7 +435,10 @@ fn fill_points_say_why() {
     let out = study.minimize(|_| 1.0, 2).unwrap();
     assert_eq!(
         out.failed_fits,
-        vec![FillReason::TransformNotFinite, FillReason::TransformNotFinite]
+        vec![
+            FillReason::TransformNotFinite,
+            FillReason::TransformNotFinite
+        ]
     );
     let last = &study.evaluations()[8..];
     assert!(last.iter().all(|e| e.origin == Origin::Fill));
@@ -441,7 +450,13 @@ fn fill_points_say_why() {
     // A study that can fit reports nothing.
     let f = test_functions::by_name("branin").unwrap();
     let mut plain = Cors::new(f.space().unwrap(), CorsOptions::with_seed(1)).unwrap();
-    assert!(plain.minimize(|x| f.eval(x), 12).unwrap().failed_fits.is_empty());
+    assert!(
+        plain
+            .minimize(|x| f.eval(x), 12)
+            .unwrap()
+            .failed_fits
+            .is_empty()
+    );
 }
 
 #[test]

@@ -44,7 +44,13 @@ pub(crate) fn row_major(a: MatRef<'_, f64>) -> Vec<f64> {
 /// (row-major, `Q x m`) with respect to the scaled centres `c` (row-major, `N x m`):
 /// radial values first, then per centre and input `{phi_L, phi_R, xi}`, each family times
 /// its weight.
-pub(crate) fn fill_basis(u: &[f64], c: &[f64], m: usize, o: &ErbfOptions, mut out: faer::MatMut<'_, f64>) {
+pub(crate) fn fill_basis(
+    u: &[f64],
+    c: &[f64],
+    m: usize,
+    o: &ErbfOptions,
+    mut out: faer::MatMut<'_, f64>,
+) {
     let lr = LeftRight::new(o.order as i32, o.gamma);
     let inv2rc2 = 0.5 / (o.rc * o.rc);
     let w = o.weights;

@@ -13,7 +13,7 @@
 //! with `phi_L`, `phi_R` the non-radial functions of [`crate::nrbf`]: `M = N (3 m + 1)`
 //! coefficients for `N` interpolation conditions. Writing `b(x)` for the `M` basis values
 //! (radial first, then ordered by sample `i`, input `j` and `{L, R, beta}`, each family
-//! multiplied by its weight of [`FamilyWeights`]), the conditions read `A c = F` with
+//! multiplied by its weight of [`FamilyWeights`](crate::FamilyWeights)), the conditions read `A c = F` with
 //! `A` the `N x M` matrix whose row `k` is `b(x_k)^T`, and `F` the `N x T` responses.
 //!
 //! The system is under-determined; the fit takes its minimum-norm solution

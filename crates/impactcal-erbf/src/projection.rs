@@ -27,8 +27,8 @@ use faer::{Accum, ColMut, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
 use crate::buffer;
-use crate::options::ErbfOptions;
 use crate::nrbf::even_power;
+use crate::options::ErbfOptions;
 
 /// `Q_1^T` and the tables that give `Q_1^T b(x)`; see the module documentation.
 #[derive(Debug, Clone)]

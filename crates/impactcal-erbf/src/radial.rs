@@ -128,7 +128,7 @@ impl PolyDegree {
     /// The degree from an integer -1, 0 or 1.
     ///
     /// # Errors
-    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for any other
+    /// [`CoreError::InvalidOption`] for any other
     /// integer.
     pub fn from_i32(degree: i32) -> Result<Self> {
         match degree {

@@ -95,7 +95,6 @@ impl RbfOptions {
         self.smoothing = lambda;
         self
     }
-
 }
 
 impl ParamGuard for RbfOptions {

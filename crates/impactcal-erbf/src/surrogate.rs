@@ -38,9 +38,9 @@ impl SurrogateKind {
     pub fn rbf_options(self) -> Option<RbfOptions> {
         match self {
             SurrogateKind::Erbf => None,
-            SurrogateKind::Gaussian => Some(RbfOptions::new(RadialFunction::Gaussian {
-                width: 0.15,
-            })),
+            SurrogateKind::Gaussian => {
+                Some(RbfOptions::new(RadialFunction::Gaussian { width: 0.15 }))
+            }
             SurrogateKind::Cubic => Some(RbfOptions::cubic()),
             SurrogateKind::ThinPlate => Some(RbfOptions::thin_plate()),
             SurrogateKind::Multiquadric => {

@@ -136,10 +136,7 @@ impl PlacementOptions {
     ///
     /// # Errors
     /// As [`keep`](Self::keep).
-    pub fn exclude<S: Into<String>>(
-        mut self,
-        labels: impl IntoIterator<Item = S>,
-    ) -> Result<Self> {
+    pub fn exclude<S: Into<String>>(mut self, labels: impl IntoIterator<Item = S>) -> Result<Self> {
         self.exclude = checked_labels("exclude", labels)?;
         self.check_conflict()?;
         Ok(self)

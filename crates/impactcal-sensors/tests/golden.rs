@@ -6,7 +6,8 @@ mod common;
 use approx::assert_abs_diff_eq;
 use common::*;
 use impactcal_sensors::{
-    CandidateShapes, Elimination, Grouping, PlacementMethod, PlacementOptions, leverage_scores, place,
+    CandidateShapes, Elimination, Grouping, PlacementMethod, PlacementOptions, leverage_scores,
+    place,
 };
 
 const CHAIN_E0: [f64; 10] = [
@@ -90,13 +91,21 @@ fn chain_matches_exhaustive_search() {
 #[test]
 fn chain_forward_greedy_from_pivoted_qr() {
     let c = chain_candidates();
-    let p = place(&c, &PlacementOptions::new(3).method(PlacementMethod::Forward)).unwrap();
+    let p = place(
+        &c,
+        &PlacementOptions::new(3).method(PlacementMethod::Forward),
+    )
+    .unwrap();
     let mut start: Vec<&str> = p.addition_order.iter().map(|s| s.label.as_str()).collect();
     start.sort_unstable();
     assert_eq!(start, ["10.x", "3.x", "6.x"]);
     assert!(p.addition_order.iter().all(|s| s.score.is_none()));
     for n in 4..=6 {
-        let fwd = place(&c, &PlacementOptions::new(n).method(PlacementMethod::Forward)).unwrap();
+        let fwd = place(
+            &c,
+            &PlacementOptions::new(n).method(PlacementMethod::Forward),
+        )
+        .unwrap();
         let bwd = place(&c, &PlacementOptions::new(n)).unwrap();
         assert_eq!(fwd.selected, bwd.selected, "N = {n}");
         assert_abs_diff_eq!(

@@ -74,7 +74,7 @@ pub struct GivenDataIndices {
 /// (`n x T`, same rows). See [`GivenDataIndices`] for the estimator.
 ///
 /// # Errors
-/// Under [`SobolError::Core`]:
+/// Under [`SobolError::Core`](crate::SobolError::Core):
 /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when the
 /// row counts differ, there is no output column, or a name list has the wrong length;
 /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) when there are
@@ -114,11 +114,9 @@ pub fn given_data_first_order(
     }
     impactcal_core::check_finite_mat("parameter values", x)?;
     let names = |given: &Option<Vec<String>>, prefix: &str, count: usize, what: &str| match given {
-        Some(v) if v.len() != count => Err(mismatch(
-            format!("number of {what} names"),
-            count,
-            v.len(),
-        )),
+        Some(v) if v.len() != count => {
+            Err(mismatch(format!("number of {what} names"), count, v.len()))
+        }
         Some(v) => Ok(v.clone()),
         None => Ok((1..=count).map(|k| format!("{prefix}{k}")).collect()),
     };

@@ -190,8 +190,7 @@ fn linear_model_sums_to_one() {
         .unwrap()
         .points;
     let y: Vec<f64> = to_rows(lhs.as_ref()).iter().map(|x| f(x)).collect();
-    let g = given_data_first_order(lhs.as_ref(), column(&y), &GivenDataOptions::default())
-        .unwrap();
+    let g = given_data_first_order(lhs.as_ref(), column(&y), &GivenDataOptions::default()).unwrap();
     assert_eq!(g.bins, 16);
     assert_close("given-data S1", &g.first_order[0], &exact.first_order, 0.02);
     let sum: f64 = g.normalised_first_order_share[0].iter().sum();
@@ -210,8 +209,7 @@ fn given_data_on_ishigami() {
         .iter()
         .map(|x| ishigami(x, 7.0, 0.1))
         .collect();
-    let g =
-        given_data_first_order(x.as_ref(), column(&y), &GivenDataOptions::default()).unwrap();
+    let g = given_data_first_order(x.as_ref(), column(&y), &GivenDataOptions::default()).unwrap();
     assert_close("S1", &g.first_order[0], &exact.first_order, 0.03);
     assert!(g.first_order[0][2].abs() < 0.005);
     assert!(g.first_order_uncorrected[0][2] > g.first_order[0][2]);

@@ -7,9 +7,9 @@
     clippy::needless_range_loop
 )]
 
-use impactcal_core::sampling::Method;
 use faer::{ColRef, MatRef};
 use impactcal_core::points::{from_row_major, from_rows, to_rows};
+use impactcal_core::sampling::Method;
 use impactcal_core::{CoreError, Parameter, ParameterSpace};
 use impactcal_sobol::{DesignLayout, SaltelliDesign, SobolOptions, analyze};
 use serde_json::Value;

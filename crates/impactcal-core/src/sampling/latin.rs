@@ -3,8 +3,8 @@
 use rand::Rng;
 use rand::seq::SliceRandom;
 
-use faer::Mat;
 use crate::error::{CoreError, Result};
+use faer::Mat;
 
 fn check(n: usize, dim: usize) -> Result<()> {
     if n == 0 || dim == 0 {
