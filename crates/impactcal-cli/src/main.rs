@@ -11,6 +11,7 @@ mod optimize;
 mod output;
 mod place;
 mod sample;
+mod samples;
 mod shapes;
 mod simulate;
 mod sobol;

@@ -5,7 +5,6 @@ use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
 use faer::MatRef;
-use impactcal::core::{ParameterSpace, Table, TableOptions, read_samples};
 use impactcal::sobol::{
     DesignLayout, FirstOrderEstimator, GivenDataOptions, SobolOptions, TotalEstimator, analyze,
     given_data_first_order,
@@ -13,22 +12,15 @@ use impactcal::sobol::{
 
 use crate::error::CliError;
 use crate::output::write_json;
+use crate::samples::SampleFiles;
 
 /// Arguments of `impactcal sobol`.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// Bounds file: `name,lower,upper,nominal[,unit]`.
-    #[arg(long)]
-    bounds: PathBuf,
-    /// Parameter values, one row per run, header of parameter names (exactly the names of
-    /// the bounds file, in any order; as written by `impactcal sample --method saltelli`,
-    /// or SALib's design with that header).
-    #[arg(long)]
-    params: PathBuf,
-    /// Model outputs, one row per run in the same order, one named column per output
-    /// (for example one per time step).
-    #[arg(long)]
-    outputs: PathBuf,
+    /// The runs: bounds, parameter values (as written by `impactcal sample --method
+    /// saltelli`, or SALib's design with that header) and model outputs.
+    #[command(flatten)]
+    files: SampleFiles,
     /// Bootstrap resamples for the intervals (0: none).
     #[arg(long, default_value_t = 0)]
     bootstrap: usize,
@@ -77,18 +69,9 @@ enum TotalChoice {
 
 /// Runs `impactcal sobol`.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let space = ParameterSpace::read_csv(&args.bounds)?;
-    let params_name = args.params.display().to_string();
-    let x = read_samples(&args.params, &space, &[], TableOptions::default())?.points;
-    let y = Table::read(&args.outputs, TableOptions::default())?;
-    if y.len() != x.nrows() {
-        return Err(CliError::input(format!(
-            "{}: {} rows, but {params_name} has {} runs",
-            args.outputs.display(),
-            y.len(),
-            x.nrows()
-        )));
-    }
+    let (space, samples, y) = args.files.read()?;
+    let x = samples.points;
+    let params_name = args.files.params.display().to_string();
     let cols = y.header().len();
     let flat: Vec<f64> = y.rows().iter().flatten().copied().collect();
     let view = MatRef::from_row_major_slice(&flat, x.nrows(), cols);

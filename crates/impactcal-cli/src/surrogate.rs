@@ -3,11 +3,12 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
-use impactcal::core::{ParameterSpace, Samples, Table, TableOptions, read_samples, read_text};
+use impactcal::core::{Samples, Table, TableOptions, read_samples, read_text};
 use impactcal::erbf::{ErbfError, ErrorSummary, LooMethod, ResponseSurrogate, SurrogateKind};
 
 use crate::error::CliError;
 use crate::output::{write_json, writer};
+use crate::samples::SampleFiles;
 
 /// Fit a surrogate to samples, or predict with a saved one.
 #[derive(ClapArgs, Debug)]
@@ -54,17 +55,10 @@ impl From<Kind> for SurrogateKind {
 
 #[derive(ClapArgs, Debug)]
 struct FitArgs {
-    /// Bounds file: `name,lower,upper,nominal[,unit]`; inputs are scaled by these bounds.
-    #[arg(long)]
-    bounds: PathBuf,
-    /// Parameter samples: a header of parameter names (exactly the names of the bounds
-    /// file, in any order), one row per sample.
-    #[arg(long)]
-    params: PathBuf,
-    /// Responses: a header of output names, one row per sample (same order as --params),
-    /// any number of columns (for example the samples of a time history).
-    #[arg(long)]
-    outputs: PathBuf,
+    /// The training runs: bounds (which scale the inputs), parameter samples and responses
+    /// (for example the samples of a time history).
+    #[command(flatten)]
+    files: SampleFiles,
     /// Surrogate kind.
     #[arg(long, value_enum, default_value = "erbf")]
     kind: Kind,
@@ -97,18 +91,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
 }
 
 fn fit(a: FitArgs) -> Result<(), CliError> {
-    let space = ParameterSpace::read_csv(&a.bounds)?;
-    let params = read_samples(&a.params, &space, &[], TableOptions::default())?;
-    let outputs = Table::read(&a.outputs, TableOptions::default())?;
-    if outputs.len() != params.points.nrows() {
-        return Err(CliError::input(format!(
-            "{}: {} sample rows, but {} has {}; one response row per sample is required",
-            a.outputs.display(),
-            outputs.len(),
-            a.params.display(),
-            params.points.nrows()
-        )));
-    }
+    let (space, params, outputs) = a.files.read()?;
     let model = ResponseSurrogate::fit(
         &space,
         a.kind.into(),
@@ -116,7 +99,7 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
         outputs.to_matrix().as_ref(),
         outputs.header().to_vec(),
     )
-    .map_err(|e| fit_error(e, &params, &a.params))?;
+    .map_err(|e| fit_error(e, &params, &a.files.params))?;
     eprintln!(
         "surrogate ({:?}): {} samples, {} parameters, {} outputs",
         model.kind(),

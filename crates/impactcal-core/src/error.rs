@@ -261,6 +261,82 @@ pub trait ParamGuard {
     fn check(self) -> Result<Self::Checked>;
 }
 
+/// Defines the checked form of an options type that implements [`ParamGuard`]: a newtype
+/// that only a successful check creates, read through `Deref`, serialised as the plain
+/// options and checked again when deserialised, and itself a [`ParamGuard`] that checks
+/// nothing (so that functions taking `impl ParamGuard<Checked = ...>` accept both forms).
+///
+/// `valid_options!(#[derive(...)] pub struct ValidFoo(Foo));` expects `Foo` to implement
+/// `ParamGuard<Checked = ValidFoo>` with `check` written as `ValidFoo::checked(self)`, and
+/// the caller to depend on `serde` (the newtype is serialised as the plain options).
+#[macro_export]
+macro_rules! valid_options {
+    ($(#[$meta:meta])* $vis:vis struct $valid:ident($options:ty);) => {
+        $(#[$meta])*
+        $vis struct $valid($options);
+
+        impl ::serde::Serialize for $valid {
+            fn serialize<S: ::serde::Serializer>(
+                &self,
+                serializer: S,
+            ) -> ::std::result::Result<S::Ok, S::Error> {
+                ::serde::Serialize::serialize(&self.0, serializer)
+            }
+        }
+
+        impl<'de> ::serde::Deserialize<'de> for $valid {
+            fn deserialize<D: ::serde::Deserializer<'de>>(
+                deserializer: D,
+            ) -> ::std::result::Result<Self, D::Error> {
+                let options = <$options as ::serde::Deserialize>::deserialize(deserializer)?;
+                $valid::checked(options).map_err(::serde::de::Error::custom)
+            }
+        }
+
+        impl $valid {
+            /// Checks `options` ([`ParamGuard::check_ref`]) and wraps them.
+            ///
+            /// # Errors
+            /// [`CoreError::InvalidOption`]($crate::CoreError::InvalidOption) naming the
+            /// first option out of range.
+            pub fn checked(options: $options) -> $crate::Result<Self> {
+                $crate::ParamGuard::check_ref(&options)?;
+                Ok($valid(options))
+            }
+        }
+
+        impl ::std::ops::Deref for $valid {
+            type Target = $options;
+            fn deref(&self) -> &$options {
+                &self.0
+            }
+        }
+
+        impl ::std::convert::TryFrom<$options> for $valid {
+            type Error = $crate::CoreError;
+            fn try_from(options: $options) -> $crate::Result<Self> {
+                $valid::checked(options)
+            }
+        }
+
+        impl ::std::convert::From<$valid> for $options {
+            fn from(valid: $valid) -> Self {
+                valid.0
+            }
+        }
+
+        impl $crate::ParamGuard for $valid {
+            type Checked = $valid;
+            fn check_ref(&self) -> $crate::Result<()> {
+                Ok(())
+            }
+            fn check(self) -> $crate::Result<$valid> {
+                Ok(self)
+            }
+        }
+    };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

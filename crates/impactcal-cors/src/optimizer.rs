@@ -171,14 +171,7 @@ impl Cors {
     /// # Errors
     /// As [`warm_start`](Self::warm_start).
     pub fn warm_start_rows(&mut self, points: &[Vec<f64>], values: &[f64]) -> Result<()> {
-        if points.len() != values.len() {
-            return Err(CoreError::DimensionMismatch {
-                what: "existing evaluations: number of values (one per point)".into(),
-                expected: points.len(),
-                found: values.len(),
-            }
-            .into());
-        }
+        one_value_per_point("existing evaluations", points.len(), values.len())?;
         let state = &self.state;
         let mut new = Vec::with_capacity(points.len());
         for (k, (x, &v)) in points.iter().zip(values).enumerate() {
@@ -274,14 +267,7 @@ impl Cors {
         initial_rows: Option<usize>,
     ) -> Result<Self> {
         let mut cors = Cors::new(space, options)?;
-        if points.nrows() != values.len() {
-            return Err(CoreError::DimensionMismatch {
-                what: "history: number of values (one per point)".into(),
-                expected: points.nrows(),
-                found: values.len(),
-            }
-            .into());
-        }
+        one_value_per_point("history", points.nrows(), values.len())?;
         let state = &mut cors.state;
         for (k, (x, &v)) in to_rows(points).into_iter().zip(values).enumerate() {
             state.check_point(&format!("history row {}", k + 1), &x)?;
@@ -537,4 +523,17 @@ impl Cors {
         })?;
         Self::from_json(&text, &path.display().to_string())
     }
+}
+
+/// Fails unless there is one value per point.
+fn one_value_per_point(what: &str, points: usize, values: usize) -> Result<()> {
+    if points == values {
+        return Ok(());
+    }
+    Err(CoreError::DimensionMismatch {
+        what: format!("{what}: number of values (one per point)"),
+        expected: points,
+        found: values,
+    }
+    .into())
 }

@@ -324,16 +324,17 @@ impl ParamGuard for CorsOptions {
     }
 
     fn check(self) -> impactcal_core::Result<ValidCorsOptions> {
-        self.check_ref()?;
-        Ok(ValidCorsOptions(self))
+        ValidCorsOptions::checked(self)
     }
 }
 
-/// [`CorsOptions`] that passed their checks: the only form a study works with. Read the
-/// options through `Deref`; serialises as the plain options and is checked again when read.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "CorsOptions", into = "CorsOptions")]
-pub struct ValidCorsOptions(CorsOptions);
+impactcal_core::valid_options! {
+    /// [`CorsOptions`] that passed their checks: the only form a study works with. Read the
+    /// options through `Deref`; serialises as the plain options and is checked again when
+    /// read.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct ValidCorsOptions(CorsOptions);
+}
 
 impl ValidCorsOptions {
     /// Checks the one option bound to the dimension: a design of at least `dim + 1` points.
@@ -358,35 +359,5 @@ impl Default for ValidCorsOptions {
     /// The defaults of [`CorsOptions::default`], which are valid.
     fn default() -> Self {
         ValidCorsOptions(CorsOptions::default())
-    }
-}
-
-impl std::ops::Deref for ValidCorsOptions {
-    type Target = CorsOptions;
-    fn deref(&self) -> &CorsOptions {
-        &self.0
-    }
-}
-
-impl TryFrom<CorsOptions> for ValidCorsOptions {
-    type Error = CoreError;
-    fn try_from(options: CorsOptions) -> impactcal_core::Result<Self> {
-        options.check()
-    }
-}
-
-impl From<ValidCorsOptions> for CorsOptions {
-    fn from(valid: ValidCorsOptions) -> Self {
-        valid.0
-    }
-}
-
-impl ParamGuard for ValidCorsOptions {
-    type Checked = ValidCorsOptions;
-    fn check_ref(&self) -> impactcal_core::Result<()> {
-        Ok(())
-    }
-    fn check(self) -> impactcal_core::Result<ValidCorsOptions> {
-        Ok(self)
     }
 }

@@ -108,50 +108,21 @@ impl ParamGuard for ErbfOptions {
     }
 
     fn check(self) -> impactcal_core::Result<ValidErbfOptions> {
-        self.check_ref()?;
-        Ok(ValidErbfOptions(self))
+        ValidErbfOptions::checked(self)
     }
 }
 
-/// [`ErbfOptions`] that passed their checks: the only form a fit works with. Read the
-/// options through `Deref`; serialises as the plain options and is checked again when read.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "ErbfOptions", into = "ErbfOptions")]
-pub struct ValidErbfOptions(ErbfOptions);
+impactcal_core::valid_options! {
+    /// [`ErbfOptions`] that passed their checks: the only form a fit works with. Read the
+    /// options through `Deref`; serialises as the plain options and is checked again when
+    /// read.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct ValidErbfOptions(ErbfOptions);
+}
 
 impl Default for ValidErbfOptions {
     /// The defaults of [`ErbfOptions::default`], which are valid.
     fn default() -> Self {
         ValidErbfOptions(ErbfOptions::default())
-    }
-}
-
-impl std::ops::Deref for ValidErbfOptions {
-    type Target = ErbfOptions;
-    fn deref(&self) -> &ErbfOptions {
-        &self.0
-    }
-}
-
-impl TryFrom<ErbfOptions> for ValidErbfOptions {
-    type Error = CoreError;
-    fn try_from(options: ErbfOptions) -> impactcal_core::Result<Self> {
-        options.check()
-    }
-}
-
-impl From<ValidErbfOptions> for ErbfOptions {
-    fn from(valid: ValidErbfOptions) -> Self {
-        valid.0
-    }
-}
-
-impl ParamGuard for ValidErbfOptions {
-    type Checked = ValidErbfOptions;
-    fn check_ref(&self) -> impactcal_core::Result<()> {
-        Ok(())
-    }
-    fn check(self) -> impactcal_core::Result<ValidErbfOptions> {
-        Ok(self)
     }
 }

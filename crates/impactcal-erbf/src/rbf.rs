@@ -137,45 +137,16 @@ impl ParamGuard for RbfOptions {
     }
 
     fn check(self) -> impactcal_core::Result<ValidRbfOptions> {
-        self.check_ref()?;
-        Ok(ValidRbfOptions(self))
+        ValidRbfOptions::checked(self)
     }
 }
 
-/// [`RbfOptions`] that passed their checks: the only form a fit works with. Read the
-/// options through `Deref`; serialises as the plain options and is checked again when read.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "RbfOptions", into = "RbfOptions")]
-pub struct ValidRbfOptions(RbfOptions);
-
-impl std::ops::Deref for ValidRbfOptions {
-    type Target = RbfOptions;
-    fn deref(&self) -> &RbfOptions {
-        &self.0
-    }
-}
-
-impl TryFrom<RbfOptions> for ValidRbfOptions {
-    type Error = CoreError;
-    fn try_from(options: RbfOptions) -> impactcal_core::Result<Self> {
-        options.check()
-    }
-}
-
-impl From<ValidRbfOptions> for RbfOptions {
-    fn from(valid: ValidRbfOptions) -> Self {
-        valid.0
-    }
-}
-
-impl ParamGuard for ValidRbfOptions {
-    type Checked = ValidRbfOptions;
-    fn check_ref(&self) -> impactcal_core::Result<()> {
-        Ok(())
-    }
-    fn check(self) -> impactcal_core::Result<ValidRbfOptions> {
-        Ok(self)
-    }
+impactcal_core::valid_options! {
+    /// [`RbfOptions`] that passed their checks: the only form a fit works with. Read the
+    /// options through `Deref`; serialises as the plain options and is checked again when
+    /// read.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub struct ValidRbfOptions(RbfOptions);
 }
 
 /// A fitted classic RBF interpolant of `T` outputs over `R^d`.
