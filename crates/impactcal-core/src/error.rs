@@ -178,6 +178,31 @@ impl CoreError {
     }
 }
 
+/// An [`InvalidOption`](CoreError::InvalidOption) error as any error type that wraps
+/// [`CoreError`] (the error of the calling function, by inference).
+pub fn invalid_option<E: From<CoreError>>(
+    name: impl Into<String>,
+    value: impl fmt::Display,
+    message: impl Into<String>,
+) -> E {
+    CoreError::invalid_option(name, value, message).into()
+}
+
+/// A [`DimensionMismatch`](CoreError::DimensionMismatch) error as any error type that wraps
+/// [`CoreError`] (the error of the calling function, by inference).
+pub fn dimension_mismatch<E: From<CoreError>>(
+    what: impl Into<String>,
+    expected: usize,
+    found: usize,
+) -> E {
+    CoreError::DimensionMismatch {
+        what: what.into(),
+        expected,
+        found,
+    }
+    .into()
+}
+
 /// The message of [`CoreError::Columns`]: the missing columns, then the unexpected ones.
 fn columns_message(missing: &[String], unexpected: &[String], expected: &[String]) -> String {
     let list = |names: &[String]| {

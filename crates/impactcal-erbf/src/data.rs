@@ -4,7 +4,8 @@ use faer::{Mat, MatRef};
 use impactcal_core::check_finite_mat;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{ErbfError, Result, mismatch, no_samples};
+use crate::error::{ErbfError, Result, no_samples};
+use impactcal_core::error::dimension_mismatch;
 
 /// A dense matrix in serialisable form: its shape and its entries in column-major order
 /// (entry `(i, j)` at `data[i + j * nrows]`). faer 0.24 has no serde support, so fitted
@@ -78,28 +79,28 @@ pub(crate) fn check_training(
     if let Some(d) = expected_dim
         && points.ncols() != d
     {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "training points: number of columns (parameters)",
             d,
             points.ncols(),
         ));
     }
     if points.ncols() == 0 {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "training points: number of columns (parameters), at least",
             1,
             0,
         ));
     }
     if values.nrows() != points.nrows() {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "training values: number of rows (one per sample)",
             points.nrows(),
             values.nrows(),
         ));
     }
     if values.ncols() == 0 {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "training values: number of columns (outputs), at least",
             1,
             0,
@@ -113,7 +114,7 @@ pub(crate) fn check_training(
 /// Checks query points: `d` columns, all finite.
 pub(crate) fn check_queries(points: MatRef<'_, f64>, d: usize) -> Result<()> {
     if points.ncols() != d {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "query points: number of columns (parameters)",
             d,
             points.ncols(),

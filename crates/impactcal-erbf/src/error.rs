@@ -75,25 +75,6 @@ impl ErbfError {
     }
 }
 
-/// A [`DimensionMismatch`](CoreError::DimensionMismatch) error as an [`ErbfError`].
-pub(crate) fn mismatch(what: impl Into<String>, expected: usize, found: usize) -> ErbfError {
-    CoreError::DimensionMismatch {
-        what: what.into(),
-        expected,
-        found,
-    }
-    .into()
-}
-
-/// An [`InvalidOption`](CoreError::InvalidOption) error as an [`ErbfError`].
-pub(crate) fn invalid_option(
-    name: &str,
-    value: impl std::fmt::Display,
-    message: impl Into<String>,
-) -> ErbfError {
-    CoreError::invalid_option(name, value, message).into()
-}
-
 /// The empty training set.
 pub(crate) fn no_samples() -> ErbfError {
     CoreError::Empty {

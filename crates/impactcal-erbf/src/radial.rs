@@ -4,7 +4,8 @@ use serde::{Deserialize, Serialize};
 
 use impactcal_core::CoreError;
 
-use crate::error::{Result, invalid_option};
+use crate::error::Result;
+use impactcal_core::error::invalid_option;
 
 /// A radial function `phi(r)` of the distance `r = |x - x_i|` (the "kernel" of an RBF
 /// interpolant).

@@ -39,9 +39,10 @@ use crate::data::{
     StoredMat, check_queries, check_training, collect_rows, find_duplicate, mat_from_rows,
     stack_rows, without_row,
 };
-use crate::error::{ErbfError, Result, mismatch};
+use crate::error::{ErbfError, Result};
 use crate::loo::LooMethod;
 use crate::radial::{PolyDegree, RadialFunction};
+use impactcal_core::error::dimension_mismatch;
 
 /// Options of a classic RBF interpolant, checked into [`ValidRbfOptions`] (by
 /// [`ParamGuard::check`], or by [`RbfInterpolant::fit`] itself) before they reach a fit.
@@ -208,7 +209,7 @@ impl RbfInterpolant {
         let d = points.ncols();
         let q = options.degree.terms(d);
         if points.nrows() < q {
-            return Err(mismatch(
+            return Err(dimension_mismatch(
                 format!(
                     "number of samples for a tail of degree {} in {d} dimensions, at least",
                     options.degree.as_i32()
@@ -333,7 +334,7 @@ impl RbfInterpolant {
     pub fn add_points(&mut self, points: MatRef<'_, f64>, values: MatRef<'_, f64>) -> Result<()> {
         check_training(points, values, Some(self.dim()))?;
         if values.ncols() != self.n_outputs() {
-            return Err(mismatch(
+            return Err(dimension_mismatch(
                 "new values: number of columns (outputs)",
                 self.n_outputs(),
                 values.ncols(),

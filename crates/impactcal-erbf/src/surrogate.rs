@@ -11,11 +11,12 @@ use impactcal_core::ParameterSpace;
 use serde::{Deserialize, Serialize};
 
 use crate::erbf::Erbf;
-use crate::error::{Result, mismatch};
+use crate::error::Result;
 use crate::loo::LooMethod;
 use crate::options::ValidErbfOptions;
 use crate::radial::RadialFunction;
 use crate::rbf::{RbfInterpolant, RbfOptions};
+use impactcal_core::error::dimension_mismatch;
 
 /// The kinds of surrogate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -93,7 +94,7 @@ impl ResponseSurrogate {
         output_names: Vec<String>,
     ) -> Result<Self> {
         if output_names.len() != values.ncols() {
-            return Err(mismatch(
+            return Err(dimension_mismatch(
                 "output names (one per output column)",
                 values.ncols(),
                 output_names.len(),

@@ -5,8 +5,9 @@ use faer::MatRef;
 use crate::engine::{Engine, Sweep};
 use impactcal_core::CoreError;
 
-use crate::error::{Result, SensorsError, invalid_option};
+use crate::error::{Result, SensorsError};
 use crate::linalg::singular_values;
+use impactcal_core::error::invalid_option;
 
 /// Scores at or above `1 - ESSENTIAL` mark a block whose removal would make
 /// `Phi^T Phi` singular.
@@ -69,7 +70,7 @@ impl Elimination {
         for (b, rows) in blocks.iter().enumerate() {
             if rows.is_empty() || rows.len() > 3 {
                 return Err(invalid_option(
-                    &format!("block {b}"),
+                    format!("block {b}"),
                     format!("{} rows", rows.len()),
                     "a block has 1 to 3 rows",
                 ));
@@ -77,7 +78,7 @@ impl Elimination {
             for &r in rows {
                 if r >= s || seen[r] {
                     return Err(invalid_option(
-                        &format!("block {b}"),
+                        format!("block {b}"),
                         format!("row {r}"),
                         "the row is out of range or in two blocks",
                     ));

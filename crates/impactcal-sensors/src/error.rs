@@ -130,12 +130,3 @@ impl SensorsError {
         }
     }
 }
-
-/// An [`InvalidOption`](CoreError::InvalidOption) error as a [`SensorsError`].
-pub(crate) fn invalid_option(
-    name: &str,
-    value: impl std::fmt::Display,
-    message: impl Into<String>,
-) -> SensorsError {
-    CoreError::invalid_option(name, value, message).into()
-}

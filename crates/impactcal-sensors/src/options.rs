@@ -3,7 +3,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::candidates::CandidateShapes;
-use crate::error::{Result, SensorsError, invalid_option};
+use crate::error::{Result, SensorsError};
+use impactcal_core::error::invalid_option;
 
 /// How the sensor set is built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -152,7 +153,7 @@ impl PlacementOptions {
     pub fn noise(mut self, sigma: Vec<f64>) -> Result<Self> {
         if let Some(i) = sigma.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
             return Err(invalid_option(
-                &format!("noise level {i} (0-based)"),
+                format!("noise level {i} (0-based)"),
                 sigma[i],
                 "must be finite and positive",
             ));
@@ -194,7 +195,7 @@ impl PlacementOptions {
                 let level = table
                     .index_of(l)
                     .map(|i| table.shapes()[(i, 0)])
-                    .ok_or_else(|| {
+                    .ok_or_else(|| -> SensorsError {
                         invalid_option(
                             "noise table",
                             format!("`{l}`"),
@@ -205,7 +206,7 @@ impl PlacementOptions {
                     Ok(level)
                 } else {
                     Err(invalid_option(
-                        &format!("noise level of `{l}`"),
+                        format!("noise level of `{l}`"),
                         level,
                         "must be finite and positive",
                     ))

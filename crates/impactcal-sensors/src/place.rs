@@ -5,9 +5,10 @@ use serde::{Deserialize, Serialize};
 use crate::candidates::{Axis, CandidateShapes, split_label};
 use crate::elimination::{ESSENTIAL, check_rank};
 use crate::engine::{self, Engine};
-use crate::error::{Result, SensorsError, invalid_option};
+use crate::error::{Result, SensorsError};
 use crate::linalg::{dot, gather, log_det_gram, r_factor, singular_values, small_det, whiten_row};
 use crate::options::{Grouping, PlacementMethod, PlacementOptions};
+use impactcal_core::error::invalid_option;
 
 /// One step of the greedy pass: the DOF or node moved and its score at that moment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

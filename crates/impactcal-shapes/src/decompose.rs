@@ -6,8 +6,9 @@ use faer::{Col, Mat, MatRef};
 use impactcal_core::Histories;
 
 use crate::checks::{finite_nonempty, numerical_rank};
-use crate::error::{Result, ShapesError, invalid_option};
+use crate::error::{Result, ShapesError};
 use crate::randomized::{RandomizedSvd, randomized_svd};
+use impactcal_core::error::invalid_option;
 
 /// How many shapes to keep.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

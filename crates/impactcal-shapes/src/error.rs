@@ -67,22 +67,3 @@ impl ShapesError {
         }
     }
 }
-
-/// An [`InvalidOption`](CoreError::InvalidOption) error as a [`ShapesError`].
-pub(crate) fn invalid_option(
-    name: &str,
-    value: impl std::fmt::Display,
-    message: impl Into<String>,
-) -> ShapesError {
-    CoreError::invalid_option(name, value, message).into()
-}
-
-/// A [`DimensionMismatch`](CoreError::DimensionMismatch) error as a [`ShapesError`].
-pub(crate) fn mismatch(what: impl Into<String>, expected: usize, found: usize) -> ShapesError {
-    CoreError::DimensionMismatch {
-        what: what.into(),
-        expected,
-        found,
-    }
-    .into()
-}

@@ -6,7 +6,8 @@ use impactcal_core::Histories;
 
 use crate::checks::{finite_nonempty, numerical_rank};
 use crate::decompose::ImpactShapes;
-use crate::error::{Result, ShapesError, invalid_option, mismatch};
+use crate::error::{Result, ShapesError};
+use impactcal_core::error::{dimension_mismatch, invalid_option};
 
 /// Unmeasured responses estimated from measured ones.
 ///
@@ -146,14 +147,14 @@ pub fn expand_matrix(
     finite_nonempty("shapes at measured channels", phi)?;
     finite_nonempty("measured data", y)?;
     if k_rows.ncols() != phi.ncols() {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "shapes at unmeasured channels (columns)",
             phi.ncols(),
             k_rows.ncols(),
         ));
     }
     if y.nrows() != phi.nrows() {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "measured channels (rows of the data)",
             phi.nrows(),
             y.nrows(),

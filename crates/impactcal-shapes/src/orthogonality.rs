@@ -6,7 +6,8 @@ use faer::{Mat, MatRef};
 use crate::assignment::max_weight_assignment;
 use crate::checks::{finite_nonempty, numerical_rank};
 use crate::decompose::ImpactShapes;
-use crate::error::{Result, ShapesError, invalid_option, mismatch};
+use crate::error::{Result, ShapesError};
+use impactcal_core::error::{dimension_mismatch, invalid_option};
 
 /// One analysis shape paired with one test shape.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -59,7 +60,7 @@ impl Orthogonality {
         finite_nonempty("analysis shapes", analysis)?;
         finite_nonempty("test shapes", test)?;
         if analysis.nrows() != test.nrows() {
-            return Err(mismatch(
+            return Err(dimension_mismatch(
                 "channels of the analysis shapes (rows) vs test shapes",
                 test.nrows(),
                 analysis.nrows(),
@@ -130,7 +131,7 @@ fn normalise_columns(a: MatRef<'_, f64>, side: &str) -> Result<Mat<f64>> {
         let norm = out.col(j).norm_l2();
         if norm == 0.0 {
             return Err(invalid_option(
-                format!("{side} shape {j}").as_str(),
+                format!("{side} shape {j}"),
                 0,
                 "a shape of zero length cannot be normalised",
             ));

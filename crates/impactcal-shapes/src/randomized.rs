@@ -5,7 +5,8 @@ use faer::{Mat, MatRef};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::error::{Result, ShapesError, invalid_option};
+use crate::error::{Result, ShapesError};
+use impactcal_core::error::invalid_option;
 
 /// Settings of the randomized solver.
 ///

@@ -9,12 +9,13 @@ use serde::Serialize;
 
 use crate::accumulate::{self, Plan, Weights};
 use crate::design::DesignLayout;
-use crate::error::{Result, SobolError, invalid_option, mismatch};
+use crate::error::{Result, SobolError};
 use crate::estimators::{
     FirstOrderEstimator, ParamMoments, SharedMoments, TotalEstimator, first_order,
     needs_full_moments, total,
 };
 use crate::stats::{percentile_sorted, sample_sd};
+use impactcal_core::error::{dimension_mismatch, invalid_option};
 
 /// How to estimate: estimators, bootstrap, the low-variance threshold and names.
 #[derive(Debug, Clone, PartialEq)]
@@ -188,7 +189,7 @@ fn validate(layout: &DesignLayout, outputs: MatRef<'_, f64>, o: &SobolOptions) -
         });
     }
     if outputs.ncols() == 0 {
-        return Err(mismatch("output columns, at least", 1, 0));
+        return Err(dimension_mismatch("output columns, at least", 1, 0));
     }
     if !(o.confidence > 0.0 && o.confidence < 1.0) {
         return Err(invalid_option(
@@ -214,7 +215,7 @@ fn validate(layout: &DesignLayout, outputs: MatRef<'_, f64>, o: &SobolOptions) -
     if let Some(names) = &o.parameter_names
         && names.len() != layout.d()
     {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "number of parameter names",
             layout.d(),
             names.len(),
@@ -223,7 +224,7 @@ fn validate(layout: &DesignLayout, outputs: MatRef<'_, f64>, o: &SobolOptions) -
     if let Some(names) = &o.output_names
         && names.len() != outputs.ncols()
     {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "number of output names",
             outputs.ncols(),
             names.len(),

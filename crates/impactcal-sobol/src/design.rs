@@ -4,7 +4,8 @@ use faer::{Mat, MatRef};
 use impactcal_core::ParameterSpace;
 use impactcal_core::sampling::{Method, SamplingWarning, unit_sample};
 
-use crate::error::{Result, SobolError, invalid_option, mismatch};
+use crate::error::{Result, SobolError};
+use impactcal_core::error::{dimension_mismatch, invalid_option};
 
 /// Where each model run of a Saltelli design sits: the row layout shared with SALib's
 /// `sample.sobol` / `sample.saltelli` and `analyze.sobol`.
@@ -165,7 +166,7 @@ impl DesignLayout {
     pub fn assemble(&self, a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<Mat<f64>> {
         for (name, m) in [("A", a), ("B", b)] {
             if m.nrows() != self.n || m.ncols() != self.d {
-                return Err(mismatch(
+                return Err(dimension_mismatch(
                     format!("shape of base sample {name} (rows x parameters)"),
                     self.n * self.d,
                     m.nrows() * m.ncols(),
@@ -218,7 +219,7 @@ impl DesignLayout {
     /// break the pattern.
     pub fn check_points(&self, points: MatRef<'_, f64>) -> Result<()> {
         if points.nrows() != self.rows() || points.ncols() != self.d {
-            return Err(mismatch(
+            return Err(dimension_mismatch(
                 format!(
                     "parameter matrix shape (rows x parameters) for {} base rows",
                     self.n

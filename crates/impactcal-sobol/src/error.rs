@@ -59,22 +59,3 @@ impl SobolError {
         }
     }
 }
-
-/// An [`InvalidOption`](CoreError::InvalidOption) error as a [`SobolError`].
-pub(crate) fn invalid_option(
-    name: &str,
-    value: impl std::fmt::Display,
-    message: impl Into<String>,
-) -> SobolError {
-    CoreError::invalid_option(name, value, message).into()
-}
-
-/// A [`DimensionMismatch`](CoreError::DimensionMismatch) error as a [`SobolError`].
-pub(crate) fn mismatch(what: impl Into<String>, expected: usize, found: usize) -> SobolError {
-    CoreError::DimensionMismatch {
-        what: what.into(),
-        expected,
-        found,
-    }
-    .into()
-}

@@ -5,7 +5,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::analysis::non_finite_output;
-use crate::error::{Result, invalid_option, mismatch};
+use crate::error::{Result, SobolError};
+use impactcal_core::error::{dimension_mismatch, invalid_option};
 
 /// Options of [`given_data_first_order`].
 #[derive(Debug, Clone, PartialEq)]
@@ -88,14 +89,14 @@ pub fn given_data_first_order(
 ) -> Result<GivenDataIndices> {
     let (n, d, cols) = (x.nrows(), x.ncols(), outputs.ncols());
     if outputs.nrows() != n {
-        return Err(mismatch(
+        return Err(dimension_mismatch(
             "output rows (one per run of the sample)",
             n,
             outputs.nrows(),
         ));
     }
     if cols == 0 {
-        return Err(mismatch("output columns, at least", 1, 0));
+        return Err(dimension_mismatch("output columns, at least", 1, 0));
     }
     let bins = options
         .bins
@@ -114,9 +115,11 @@ pub fn given_data_first_order(
     }
     impactcal_core::check_finite_mat("parameter values", x)?;
     let names = |given: &Option<Vec<String>>, prefix: &str, count: usize, what: &str| match given {
-        Some(v) if v.len() != count => {
-            Err(mismatch(format!("number of {what} names"), count, v.len()))
-        }
+        Some(v) if v.len() != count => Err(dimension_mismatch::<SobolError>(
+            format!("number of {what} names"),
+            count,
+            v.len(),
+        )),
         Some(v) => Ok(v.clone()),
         None => Ok((1..=count).map(|k| format!("{prefix}{k}")).collect()),
     };

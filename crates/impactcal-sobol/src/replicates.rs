@@ -3,8 +3,9 @@
 use serde::Serialize;
 
 use crate::analysis::SobolIndices;
-use crate::error::{Result, invalid_option, mismatch};
+use crate::error::Result;
 use crate::stats::{sample_sd, student_t_quantile};
+use impactcal_core::error::{dimension_mismatch, invalid_option};
 
 /// The spread of first-order and total indices over `R` analyses of independently
 /// scrambled designs (same `N`, different seeds).
@@ -60,7 +61,7 @@ pub fn replicate_spread(results: &[SobolIndices], confidence: f64) -> Result<Rep
     let (cols, d) = (results[0].first_order.len(), results[0].parameters.len());
     for res in results {
         if res.first_order.len() != cols || res.parameters.len() != d {
-            return Err(mismatch(
+            return Err(dimension_mismatch(
                 "outputs x parameters of a replicate",
                 cols * d,
                 res.first_order.len() * res.parameters.len(),
