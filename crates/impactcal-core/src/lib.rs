@@ -30,6 +30,7 @@ pub mod error;
 pub mod histories;
 pub mod model;
 pub mod sampling;
+pub mod signal;
 pub mod space;
 pub mod table;
 
@@ -37,5 +38,6 @@ pub use error::{CoreError, Result, check_finite};
 pub use histories::Histories;
 pub use model::{BatchResults, Model, RunFailure};
 pub use sampling::{Method as SamplingMethod, Points};
+pub use signal::Cfc;
 pub use space::{Parameter, ParameterSpace};
 pub use table::{Table, TableOptions, read_text};
