@@ -218,15 +218,16 @@ mod tests {
             let y = cfc.filter(&[2.5; 300], dt, "constant").unwrap();
             assert!(y.iter().all(|v| (v - 2.5).abs() < 1e-12));
         }
-        // A line passes the zero-phase filter; starting each pass from the mean of ten
-        // points leaves a transient in the extension that has decayed to below 1e-4 of the
-        // record's range by the time it reaches the record.
+        // A line passes the zero-phase filter to 1e-6 away from the ends; starting each pass
+        // from the mean of ten points leaves a transient that the reflected extension mostly
+        // absorbs (below 2e-3 of the record's range at the ends).
         let line: Vec<f64> = (0..500).map(|k| 3.0 - 0.5 * k as f64 * dt).collect();
         let range = 0.5 * 499.0 * dt;
         for cfc in Cfc::ALL {
             let y = cfc.filter(&line, dt, "line").unwrap();
-            for (a, b) in y.iter().zip(&line) {
-                assert!((a - b).abs() < 1e-4 * range, "{cfc}: {a} vs {b}");
+            for (k, (a, b)) in y.iter().zip(&line).enumerate() {
+                let tol = if (100..400).contains(&k) { 1e-6 } else { 2e-3 } * range;
+                assert!((a - b).abs() < tol, "{cfc}, sample {k}: {a} vs {b}");
             }
         }
     }
