@@ -154,7 +154,9 @@ pub enum CoreError {
         model_end: f64,
     },
     /// A channel map names a label that the test or the model does not have.
-    #[error("{file}: line {line}: {side} label `{label}` is not a channel of the {side} (available: {available})")]
+    #[error(
+        "{file}: line {line}: {side} label `{label}` is not a channel of the {side} (available: {available})"
+    )]
     MapLabel {
         /// The map file.
         file: String,

@@ -33,6 +33,7 @@ pub mod sampling;
 pub mod signal;
 pub mod space;
 pub mod table;
+pub mod testdata;
 
 pub use error::{CoreError, Result, check_finite};
 pub use histories::Histories;
@@ -41,3 +42,4 @@ pub use sampling::{Method as SamplingMethod, Points};
 pub use signal::Cfc;
 pub use space::{Parameter, ParameterSpace};
 pub use table::{Table, TableOptions, read_text};
+pub use testdata::{ChannelMap, IsoMme, TestRecord};

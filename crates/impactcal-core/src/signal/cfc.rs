@@ -207,7 +207,11 @@ mod tests {
         let n = 40_000;
         let x = sine(freq, dt, n);
         let y = cfc.filter(&x, dt, "sine").unwrap();
-        let peak = |v: &[f64]| v[n / 4..3 * n / 4].iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let peak = |v: &[f64]| {
+            v[n / 4..3 * n / 4]
+                .iter()
+                .fold(0.0f64, |a, b| a.max(b.abs()))
+        };
         peak(&y) / peak(&x)
     }
 
