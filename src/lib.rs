@@ -13,6 +13,7 @@
 //! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
 //! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe |
+| [`calibrate`] | `impactcal-calibrate` | curve metrics (Sprague-Geers, Russell, ISO/TS 18571) of a model against a test |
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -26,6 +27,7 @@
 //! ```
 //!
 
+pub use impactcal_calibrate as calibrate;
 pub use impactcal_core as core;
 pub use impactcal_cors as cors;
 pub use impactcal_erbf as erbf;
@@ -36,9 +38,14 @@ pub use impactcal_sobol as sobol;
 
 /// The types most programs need, in one import.
 pub mod prelude {
+    pub use impactcal_calibrate::CalibrateError;
+    pub use impactcal_calibrate::metrics::{
+        ChannelPair, CompareOptions, Comparison, CurveMetrics, Grade, Iso18571, Russell,
+        SpragueGeers, compare,
+    };
     pub use impactcal_core::{
-        BatchResults, CoreError, Histories, Model, Parameter, ParameterSpace, RunFailure, Table,
-        TableOptions,
+        BatchResults, Cfc, ChannelMap, CoreError, Histories, IsoMme, Model, Parameter,
+        ParameterSpace, RunFailure, Table, TableOptions, TestRecord,
     };
     pub use impactcal_cors::{
         Cors, CorsError, CorsOptions, InitialDesign, Outcome, StopReason, Suggestion, Transform,
