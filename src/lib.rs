@@ -13,7 +13,7 @@
 //! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories |
 //! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe |
-| [`calibrate`] | `impactcal-calibrate` | curve metrics (Sprague-Geers, Russell, ISO/TS 18571) of a model against a test |
+//! | [`calibrate`] | `impactcal-calibrate` | curve metrics (Sprague-Geers, Russell, ISO/TS 18571) of a model against a test |
 //!
 //! ```
 //! use impactcal::prelude::*;
