@@ -371,6 +371,38 @@ impl Iso18571 {
         })
     }
 
+    /// Rates many `(reference, computed)` pairs sampled every `dt`, in parallel (each
+    /// worker reuses one warping table). The ratings come back in pair order and equal those of
+    /// [`Iso18571::rate`] bit for bit.
+    ///
+    /// # Errors
+    /// The first failing pair's error, as [`Iso18571::rate`], prefixed with its index.
+    pub fn rate_many<R, C>(&self, pairs: &[(R, C)], dt: f64) -> Result<Vec<Iso18571Rating>>
+    where
+        R: AsRef<[f64]> + Sync,
+        C: AsRef<[f64]> + Sync,
+    {
+        use rayon::prelude::*;
+        pairs
+            .par_iter()
+            .enumerate()
+            .map_init(Vec::new, |scratch, (k, (r, c))| {
+                self.rate_with(r.as_ref(), c.as_ref(), dt, scratch)
+                    .map_err(|e| match e {
+                        CalibrateError::Degenerate { what, reason } => CalibrateError::Degenerate {
+                            what: format!("{what}, pair {k}"),
+                            reason,
+                        },
+                        CalibrateError::Length { what, reason } => CalibrateError::Length {
+                            what: format!("{what}, pair {k}"),
+                            reason,
+                        },
+                        other => other,
+                    })
+            })
+            .collect()
+    }
+
     /// The corridor score, `None` for a reference that is identically zero.
     fn corridor(&self, t: &[f64], c: &[f64]) -> Option<f64> {
         let norm = t.iter().fold(0.0f64, |a, v| a.max(v.abs()));
