@@ -90,7 +90,8 @@ fn main() {
     }
 
     let bench = metric_pairs();
-    let mut file = std::io::BufWriter::new(std::fs::File::create(work.join("bench_pairs.bin")).unwrap());
+    let mut file =
+        std::io::BufWriter::new(std::fs::File::create(work.join("bench_pairs.bin")).unwrap());
     for (r, c) in &bench {
         for v in r.iter().chain(c) {
             file.write_all(&v.to_le_bytes()).unwrap();
