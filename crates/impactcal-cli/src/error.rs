@@ -43,3 +43,13 @@ impl From<impactcal::core::CoreError> for CliError {
         }
     }
 }
+
+impl From<impactcal::calibrate::CalibrateError> for CliError {
+    fn from(e: impactcal::calibrate::CalibrateError) -> Self {
+        if e.is_bad_input() {
+            CliError::Input(e.to_string())
+        } else {
+            CliError::Failure(e.to_string())
+        }
+    }
+}
