@@ -24,7 +24,7 @@ fn bench(c: &mut Criterion) {
             pairs
                 .iter()
                 .map(|(r, _)| Cfc::Cfc180.filter(r, DT, "bench").unwrap())
-                .count()
+                .collect::<Vec<_>>()
         })
     });
     g.finish();

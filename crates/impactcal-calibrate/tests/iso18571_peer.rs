@@ -2,7 +2,7 @@
 //! `tests/data/iso18571_pairs.json` (time shifts, scalings, noise, changed shapes, curves
 //! against themselves), written by `benches/peers/testdata_metrics.sh --write-fixtures`.
 
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 use impactcal_calibrate::metrics::Iso18571;
 use serde_json::Value;

@@ -2,7 +2,7 @@
 //! by pyisomme (the core crate's fixtures) and on small CSV files, including the bad input a
 //! user produces: each gives one line on stderr and exit code 2.
 
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 mod common;
 use common::{impactcal, json};

@@ -5,7 +5,7 @@
 //! malformed sets a user meets: a missing channel file, a non-numeric sample, a zero sampling
 //! interval, a truncated zip.
 
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 use std::path::{Path, PathBuf};
 

@@ -65,6 +65,7 @@ fn peak(v: &[f64]) -> (usize, f64) {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;

@@ -51,7 +51,10 @@ pub fn resample_uniform(
         ));
     }
     let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
-    if let Some(k) = steps.iter().position(|s| !(*s > 0.0)) {
+    if let Some(k) = steps
+        .iter()
+        .position(|s| s.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+    {
         return Err(CoreError::Invalid(format!(
             "time {} at point {} does not increase (previous {})",
             times[k + 1],
@@ -213,6 +216,7 @@ pub fn crop(h: &Histories, t0: f64, t1: f64) -> Result<Histories> {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;

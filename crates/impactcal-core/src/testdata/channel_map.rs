@@ -169,6 +169,7 @@ fn short_list<S: AsRef<str>>(labels: &[S]) -> (Vec<&str>, String) {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
 

@@ -46,7 +46,7 @@ impl TestRecord {
             message,
         };
         for k in 1..times.len() {
-            if times[k] == times[k - 1] {
+            if times[k].total_cmp(&times[k - 1]).is_eq() {
                 return Err(position(
                     k,
                     format!("time {} repeats the previous row's", times[k]),
@@ -95,6 +95,7 @@ impl TestRecord {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;

@@ -19,10 +19,9 @@ pub(crate) fn warped_l1(x: &[f64], y: &[f64], band: usize, scratch: &mut Vec<f64
     let d = scratch.as_mut_slice();
     // Cell (i, j) lives at d[i * width + j + band - i]: row i holds j in i-band..=i+band.
     let at = |i: usize, j: usize| i * width + j + band - i;
-    for i in 0..n {
+    for (i, &xi) in x.iter().enumerate() {
         let lo = i.saturating_sub(band);
         let hi = (i + band).min(n - 1);
-        let xi = x[i];
         let row = i * width + band - i;
         let mut left = f64::INFINITY;
         if i == 0 {
@@ -91,6 +90,7 @@ pub(crate) fn warped_l1(x: &[f64], y: &[f64], band: usize, scratch: &mut Vec<f64
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
 

@@ -213,7 +213,7 @@ impl Iso18571 {
     /// [`CalibrateError::InvalidOption`] for a negative weight or weights not summing to 1.
     pub fn weights(mut self, weights: [f64; 4]) -> Result<Self> {
         let sum: f64 = weights.iter().sum();
-        if weights.iter().any(|w| !(*w >= 0.0)) || (sum - 1.0).abs() > 1e-12 {
+        if weights.iter().any(|w| w.is_nan() || *w < 0.0) || (sum - 1.0).abs() > 1e-12 {
             return Err(CalibrateError::InvalidOption(format!(
                 "ISO 18571 weights must be non-negative and sum to 1, got {weights:?}"
             )));
@@ -444,6 +444,7 @@ fn resample(x: &[f64], dt: f64, target: f64) -> Vec<f64> {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;

@@ -121,6 +121,7 @@ pub(crate) fn best_shift(t: &[f64], c: &[f64], max_shift: usize) -> Shift {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
 

@@ -27,6 +27,7 @@ pub(crate) fn smoothed_derivative(x: &[f64]) -> Vec<f64> {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
 
