@@ -36,6 +36,23 @@ pub enum CalibrateError {
 pub type Result<T, E = CalibrateError> = std::result::Result<T, E>;
 
 impl CalibrateError {
+    /// The same error with its subject rewritten by `f` (for example to name the channel a
+    /// metric failed on); errors without a subject are returned unchanged.
+    #[must_use]
+    pub fn with_subject(self, f: impl FnOnce(&str) -> String) -> Self {
+        match self {
+            CalibrateError::Degenerate { what, reason } => CalibrateError::Degenerate {
+                what: f(&what),
+                reason,
+            },
+            CalibrateError::Length { what, reason } => CalibrateError::Length {
+                what: f(&what),
+                reason,
+            },
+            other => other,
+        }
+    }
+
     /// Whether the error is the user's input (a malformed file, an impossible option, a curve
     /// on which a metric is undefined) rather than a failure of the program.
     pub fn is_bad_input(&self) -> bool {

@@ -352,15 +352,5 @@ fn side(which: &str, e: CoreError) -> CalibrateError {
 
 /// Names the channel in a metric's error.
 fn name_channel(e: CalibrateError, label: &str) -> CalibrateError {
-    match e {
-        CalibrateError::Degenerate { what, reason } => CalibrateError::Degenerate {
-            what: format!("channel `{label}` ({what})"),
-            reason,
-        },
-        CalibrateError::Length { what, reason } => CalibrateError::Length {
-            what: format!("channel `{label}` ({what})"),
-            reason,
-        },
-        other => other,
-    }
+    e.with_subject(|what| format!("channel `{label}` ({what})"))
 }

@@ -388,17 +388,7 @@ impl Iso18571 {
             .enumerate()
             .map_init(Vec::new, |scratch, (k, (r, c))| {
                 self.rate_with(r.as_ref(), c.as_ref(), dt, scratch)
-                    .map_err(|e| match e {
-                        CalibrateError::Degenerate { what, reason } => CalibrateError::Degenerate {
-                            what: format!("{what}, pair {k}"),
-                            reason,
-                        },
-                        CalibrateError::Length { what, reason } => CalibrateError::Length {
-                            what: format!("{what}, pair {k}"),
-                            reason,
-                        },
-                        other => other,
-                    })
+                    .map_err(|e| e.with_subject(|what| format!("{what}, pair {k}")))
             })
             .collect()
     }
