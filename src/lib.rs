@@ -5,13 +5,14 @@
 //!
 //! | module | crate | what | depends on (of ours) |
 //! |---|---|---|---|
-//! | [`core`] | `impactcal-core` | histories, parameter spaces and their unit-cube map, point sets (faer matrices, one point per row), the `Model` trait, sampling, CSV input, test functions, the shared error kinds | nothing |
+//! | [`core`] | `impactcal-core` | histories, test data (CSV, ISO-MME, channel maps), CFC filters, parameter spaces and their unit-cube map, point sets (faer matrices, one point per row), the `Model` trait, sampling, CSV input, test functions, the shared error kinds | nothing |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion | core |
 //! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) | core, shapes |
 //! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories | core |
 //! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals | core |
 //! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) | core, erbf |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe | core |
+//! | [`calibrate`] | `impactcal-calibrate` | curve metrics (Sprague-Geers, Russell, ISO/TS 18571) of a model against a test | core |
 //!
 //! The calibration path runs through them in this order: histories of an ensemble
 //! ([`core`], [`shell`]) give impact shapes ([`shapes`]), which place sensors ([`sensors`]);
@@ -33,6 +34,7 @@
 //! # Ok::<(), impactcal::Error>(())
 //! ```
 
+pub use impactcal_calibrate as calibrate;
 pub use impactcal_core as core;
 pub use impactcal_cors as cors;
 pub use impactcal_erbf as erbf;
@@ -43,6 +45,7 @@ pub use impactcal_sobol as sobol;
 
 pub use impactcal_core::ErrorKind;
 
+use impactcal_calibrate::CalibrateError;
 use impactcal_core::CoreError;
 use impactcal_cors::CorsError;
 use impactcal_erbf::ErbfError;
@@ -78,6 +81,9 @@ pub enum Error {
     /// From `impactcal-shell`.
     #[error(transparent)]
     Shell(#[from] ShellError),
+    /// From `impactcal-calibrate`.
+    #[error(transparent)]
+    Calibrate(#[from] CalibrateError),
 }
 
 impl Error {
@@ -93,6 +99,7 @@ impl Error {
             Error::Sobol(e) => e.kind(),
             Error::Cors(e) => e.kind(),
             Error::Shell(e) => shell_kind(e),
+            Error::Calibrate(e) => e.kind(),
         }
     }
 }
@@ -121,10 +128,15 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 /// sampling methods are `SamplingMethod`, sensor-placement methods `PlacementMethod`.
 pub mod prelude {
     pub use crate::{Error, ErrorKind};
+    pub use impactcal_calibrate::CalibrateError;
+    pub use impactcal_calibrate::metrics::{
+        ChannelPair, CompareOptions, Comparison, CurveMetrics, Grade, Iso18571, Russell,
+        SpragueGeers, compare,
+    };
     pub use impactcal_core::sampling::{Sample, latin_hypercube, sample};
     pub use impactcal_core::{
-        BatchResults, CoreError, Histories, Model, ParamGuard, Parameter, ParameterSpace,
-        RunFailure, SamplingMethod, Table, TableOptions, read_samples,
+        BatchResults, Cfc, ChannelMap, CoreError, Histories, IsoMme, Model, ParamGuard, Parameter,
+        ParameterSpace, RunFailure, SamplingMethod, Table, TableOptions, TestRecord, read_samples,
     };
     pub use impactcal_cors::{
         Cors, CorsError, CorsOptions, FillReason, InitialDesign, Outcome, StopReason, Suggestion,

@@ -101,7 +101,8 @@ from_library_error!(
     impactcal::erbf::ErbfError,
     impactcal::sobol::SobolError,
     impactcal::cors::CorsError,
-    impactcal::shell::ShellError
+    impactcal::shell::ShellError,
+    impactcal::calibrate::CalibrateError
 );
 
 #[cfg(test)]

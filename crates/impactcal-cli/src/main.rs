@@ -5,8 +5,11 @@
 
 mod airframe;
 mod compare;
+mod convert;
 mod error;
 mod expand;
+mod filter;
+mod metrics;
 mod optimize;
 mod output;
 mod place;
@@ -54,6 +57,13 @@ enum Command {
     Sample(sample::Args),
     /// Sobol' sensitivity indices of every output column.
     Sobol(sobol::Args),
+    /// Measured data (an ISO-MME data set, or CSV on a non-uniform time base) into wide CSV.
+    Convert(convert::Args),
+    /// SAE J211 / ISO 6487 channel frequency class filter (CFC 60, 180, 600, 1000).
+    Filter(filter::Args),
+    /// Curve metrics of a model against a test: relative L2, RMS, peak, Sprague-Geers,
+    /// Russell and ISO/TS 18571, per channel, overall and on the norm history Q(t).
+    Metrics(metrics::Args),
     /// The built-in parametric helicopter airframe: write it as a keyword deck, list its
     /// adjustable quantities and presets, draw its parts.
     Airframe(airframe::Args),
@@ -71,6 +81,9 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Sample(a) => sample::run(a),
         Command::Sobol(a) => sobol::run(a),
         Command::Airframe(a) => airframe::run(a),
+        Command::Convert(a) => convert::run(a),
+        Command::Filter(a) => filter::run(a),
+        Command::Metrics(a) => metrics::run(a),
     }
 }
 

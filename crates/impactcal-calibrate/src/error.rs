@@ -1,0 +1,64 @@
+//! The error type of `impactcal-calibrate`.
+
+use impactcal_core::{CoreError, ErrorKind};
+
+/// Everything that can go wrong when judging a model against a test.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CalibrateError {
+    /// Reading, filtering or interpolating the data failed.
+    #[error(transparent)]
+    Core(#[from] CoreError),
+    /// A curve on which a metric is undefined: a reference that is identically zero (no
+    /// relative error exists), a computed curve that is identically zero (no phase exists),
+    /// or a reference that is constant (ISO/TS 18571 has no corridor or slope for it).
+    #[error("{what}: {reason}")]
+    Degenerate {
+        /// The channel or curve.
+        what: String,
+        /// Why the metric is undefined.
+        reason: String,
+    },
+    /// Two curves of different lengths, or too short for the metric.
+    #[error("{what}: {reason}")]
+    Length {
+        /// The channel or curve.
+        what: String,
+        /// What is wrong with the lengths.
+        reason: String,
+    },
+}
+
+/// `Result` with [`CalibrateError`].
+pub type Result<T, E = CalibrateError> = std::result::Result<T, E>;
+
+impl CalibrateError {
+    /// The same error with its subject rewritten by `f` (for example to name the channel a
+    /// metric failed on); errors without a subject are returned unchanged.
+    #[must_use]
+    pub fn with_subject(self, f: impl FnOnce(&str) -> String) -> Self {
+        match self {
+            CalibrateError::Degenerate { what, reason } => CalibrateError::Degenerate {
+                what: f(&what),
+                reason,
+            },
+            CalibrateError::Length { what, reason } => CalibrateError::Length {
+                what: f(&what),
+                reason,
+            },
+            other => other,
+        }
+    }
+
+    /// What kind of fault this is: the kind of a wrapped [`CoreError`], otherwise
+    /// [`ErrorKind::BadInput`] (a curve on which a metric is undefined, or lengths that do
+    /// not fit, are the input's fault).
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            CalibrateError::Core(e) => e.kind(),
+            CalibrateError::Degenerate { .. } | CalibrateError::Length { .. } => {
+                ErrorKind::BadInput
+            }
+        }
+    }
+}
