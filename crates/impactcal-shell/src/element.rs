@@ -65,6 +65,12 @@ pub struct PartProps {
     pub hg_form: HourglassForm,
     /// Hourglass coefficients (membrane, out-of-plane, rotation).
     pub hg: [f64; 3],
+    /// Stiffness-proportional damping coefficient in the sign convention of
+    /// [`crate::model::PartStiffnessDamping::coef`] (0: none).
+    pub stiffness_damping: f64,
+    /// Moments of the thickness rule `[sum w_k z_k, sum w_k z_k^2]` (physical heights), which
+    /// turn strain rates into the resultants of the stiffness damping.
+    pub z_moments: [f64; 2],
 }
 
 impl PartProps {
@@ -73,15 +79,41 @@ impl PartProps {
     /// positive thickness, 1 to 10 points, Lobatto with at least 2).
     pub fn new(section: &Section, material: &Material, hourglass: &Hourglass) -> Self {
         let (zeta, w) = thickness_rule(section.nip, section.rule == ThicknessRule::Lobatto);
+        let z: Vec<f64> = zeta.iter().map(|z| 0.5 * z * section.thickness).collect();
+        let z_moments = [
+            z.iter().zip(&w).map(|(z, w)| w * z).sum(),
+            z.iter().zip(&w).map(|(z, w)| w * z * z).sum(),
+        ];
         PartProps {
             t: section.thickness,
-            z: zeta.iter().map(|z| 0.5 * z * section.thickness).collect(),
+            z,
             w,
             shear_factor: section.shear_factor,
             mat: MaterialProps::new(material),
             hg_form: hourglass.form,
             hg: [hourglass.membrane, hourglass.transverse, hourglass.rotation],
+            stiffness_damping: 0.0,
+            z_moments,
         }
+    }
+
+    /// The same part with stiffness-proportional damping `coef` (see
+    /// [`crate::model::PartStiffnessDamping`]).
+    #[must_use]
+    pub fn with_stiffness_damping(mut self, coef: f64) -> Self {
+        self.stiffness_damping = coef;
+        self
+    }
+
+    /// The Rayleigh coefficient `beta` of an element whose undamped stable step is `dt_e`,
+    /// and its damped stable step `dt_e (sqrt(1 + zeta^2) - zeta)`, `zeta = beta / dt_e`
+    /// (the fraction of critical damping at the element's highest frequency `2 / dt_e`).
+    #[inline]
+    pub fn damping_beta(&self, dt_e: f64) -> (f64, f64) {
+        let c = self.stiffness_damping;
+        let beta = if c > 0.0 { c * dt_e } else { -c };
+        let zeta = beta / dt_e;
+        (beta, dt_e * ((1.0 + zeta * zeta).sqrt() - zeta))
     }
 }
 
@@ -97,6 +129,8 @@ pub struct ElementOutput {
     pub internal: f64,
     /// Hourglass energy increment of the cycle.
     pub hourglass: f64,
+    /// Energy removed by stiffness-proportional damping in the cycle.
+    pub damping: f64,
 }
 
 /// Why an element could not be evaluated.
@@ -302,15 +336,22 @@ pub fn triangle(
             u[i][3 + k] = dot(loc.rot[k], omega[i]);
         }
     }
-    let (f, internal, _) = resultant_forces(&loc, &u, props, state, dt);
     let d = |i: usize, j: usize| norm(sub(x[i], x[j]));
     let side = d(0, 1).max(d(1, 2)).max(d(2, 0));
+    let dt_e = 2.0 * loc.area / side / props.mat.wave_speed;
+    let (beta, dt_out) = if props.stiffness_damping == 0.0 {
+        (0.0, dt_e)
+    } else {
+        props.damping_beta(dt_e)
+    };
+    let (f, internal, damping) = resultant_forces(&loc, &u, props, state, dt, beta);
     let g = to_global(&loc.rot, &f);
     Ok(ElementOutput {
         f: [g[0], g[1], g[2], [0.0; 6]],
-        dt: 2.0 * loc.area / side / props.mat.wave_speed,
+        dt: dt_out,
         internal,
         hourglass: 0.0,
+        damping,
     })
 }
 
@@ -325,14 +366,16 @@ fn to_global<const N: usize>(rot: &[[f64; 3]; 3], f: &[[f64; 6]; N]) -> [[f64; 6
     g
 }
 
-/// Strain rates, material update through the thickness, resultants and local nodal forces.
-/// Returns the local forces, the internal energy increment and 0.
+/// Strain rates, material update through the thickness, resultants and local nodal forces,
+/// with stiffness-proportional damping `beta` (0: none). Returns the local forces, the
+/// internal energy increment and the damping energy increment.
 fn resultant_forces<const N: usize>(
     loc: &Local<N>,
     u: &[[f64; 6]; N],
     props: &PartProps,
     state: &mut [f64],
     dt: f64,
+    beta: f64,
 ) -> ([[f64; 6]; N], f64, f64) {
     let (b1, b2) = (&loc.b1, &loc.b2);
     let (mut dxx, mut dyy, mut gxy) = (0.0, 0.0, 0.0);
@@ -409,6 +452,41 @@ fn resultant_forces<const N: usize>(
     head[1] = qy;
     internal += 0.5 * a * dt * ((qx0 + qx) * gxz + (qy0 + qy) * gyz);
 
+    // Stiffness-proportional damping: beta times the elastic resultants of the rates.
+    let mut damping = 0.0;
+    let (mut qx, mut qy) = (qx, qy);
+    if beta > 0.0 {
+        let c12 = mat.nu * mat.c11;
+        let [z1, z2] = props.z_moments;
+        let sm = [
+            mat.c11 * dxx + c12 * dyy,
+            c12 * dxx + mat.c11 * dyy,
+            mat.g * gxy,
+        ];
+        let sb = [
+            mat.c11 * kxx + c12 * kyy,
+            c12 * kxx + mat.c11 * kyy,
+            mat.g * kxy,
+        ];
+        let n_d = [0, 1, 2].map(|k| beta * (sm[k] + z1 * sb[k]));
+        let m_d = [0, 1, 2].map(|k| beta * (z1 * sm[k] + z2 * sb[k]));
+        let qs = beta * props.shear_factor * mat.g * t;
+        let (qdx, qdy) = (qs * gxz, qs * gyz);
+        let power = t * (n_d[0] * dxx + n_d[1] * dyy + n_d[2] * gxy)
+            + t * (m_d[0] * kxx + m_d[1] * kyy + m_d[2] * kxy)
+            + qdx * gxz
+            + qdy * gyz;
+        damping = dt * a * power;
+        nxx += n_d[0];
+        nyy += n_d[1];
+        nxy += n_d[2];
+        mxx += m_d[0];
+        myy += m_d[1];
+        mxy += m_d[2];
+        qx += qdx;
+        qy += qdy;
+    }
+
     let (nxx, nyy, nxy) = (t * a * nxx, t * a * nyy, t * a * nxy);
     let (mxx, myy, mxy) = (t * a * mxx, t * a * myy, t * a * mxy);
     let (qxa, qya) = (a * qx * inv_n, a * qy * inv_n);
@@ -423,7 +501,7 @@ fn resultant_forces<const N: usize>(
             0.0,
         ];
     }
-    (f, internal, 0.0)
+    (f, internal, damping)
 }
 
 /// Area of the current geometry of a quad or triangle and whether it is usable, for

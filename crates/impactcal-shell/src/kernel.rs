@@ -295,6 +295,29 @@ pub(crate) fn quad_block(
         V::splat(1.0)
     };
 
+    // Characteristic length: sqrt is monotonic, so the longest length is the root of the
+    // largest square.
+    let sq = |a: V3| dot3(a, a);
+    let diag2 = sq(d31).max(sq(d42));
+    let len2 = if opts.isdo_diagonal {
+        diag2
+    } else {
+        sq(sub3(xs[1], xs[0]))
+            .max(sq(sub3(xs[2], xs[1])))
+            .max(sq(sub3(xs[3], xs[2])))
+            .max(sq(sub3(xs[0], xs[3])))
+            .max(diag2)
+    };
+    let mut dt_e = area / len2.sqrt() / mat.wave_speed;
+    // Stiffness-proportional damping: Rayleigh beta per lane and the damped stable step.
+    let beta = (props.stiffness_damping != 0.0).then(|| {
+        let mut beta = V::default();
+        for l in 0..LANES {
+            (beta.0[l], dt_e.0[l]) = props.damping_beta(dt_e.0[l]);
+        }
+        beta
+    });
+
     // Through the thickness.
     let base = blk.slot.map(|e| e * stride);
     let (c11, c12, g) = (mat.c11, mat.nu * mat.c11, mat.g);
@@ -367,16 +390,42 @@ pub(crate) fn quad_block(
     let qy = qy0 + ks * gyz;
     internal += 0.5 * area * dt * ((qx0 + qx) * gxz + (qy0 + qy) * gyz);
 
+    // Damping resultants beta C (rates), added to the forces, not to the state.
+    let mut damping = V::default();
+    let (mut qxf, mut qyf) = (qx, qy);
+    if let Some(beta) = beta {
+        let [z1, z2] = props.z_moments;
+        let sm = [c11 * dxx + c12 * dyy, c12 * dxx + c11 * dyy, g * gxy];
+        let sb = [c11 * kxx + c12 * kyy, c12 * kxx + c11 * kyy, g * kxy];
+        let n_d = [0, 1, 2].map(|k| beta * (sm[k] + z1 * sb[k]));
+        let m_d = [0, 1, 2].map(|k| beta * (z1 * sm[k] + z2 * sb[k]));
+        let qs = beta * (props.shear_factor * g * t);
+        let (qdx, qdy) = (qs * gxz, qs * gyz);
+        let power = t * (n_d[0] * dxx + n_d[1] * dyy + n_d[2] * gxy)
+            + t * (m_d[0] * kxx + m_d[1] * kyy + m_d[2] * kxy)
+            + qdx * gxz
+            + qdy * gyz;
+        damping = dt * area * power;
+        nxx += n_d[0];
+        nyy += n_d[1];
+        nxy += n_d[2];
+        mxx += m_d[0];
+        myy += m_d[1];
+        mxy += m_d[2];
+        qxf += qdx;
+        qyf += qdy;
+    }
+
     let ta = t * area;
     let (nxx, nyy, nxy) = (ta * nxx, ta * nyy, ta * nxy);
     let (mxx, myy, mxy) = (ta * mxx, ta * myy, ta * mxy);
-    let (qxa, qya) = (area * qx * 0.25, area * qy * 0.25);
+    let (qxa, qya) = (area * qxf * 0.25, area * qyf * 0.25);
     let mut f = [[V::default(); 6]; 4];
     for i in 0..4 {
         f[i] = [
             b1[i] * nxx + b2[i] * nxy,
             b2[i] * nyy + b1[i] * nxy,
-            area * (b1[i] * qx + b2[i] * qy),
+            area * (b1[i] * qxf + b2[i] * qyf),
             -b2[i] * myy - b1[i] * mxy - qya,
             b1[i] * mxx + b2[i] * mxy + qxa,
             V::default(),
@@ -441,6 +490,14 @@ pub(crate) fn quad_block(
             st[2 + k] = hg[k].0[l];
         }
     }
+    // The stiffness damping also acts on the hourglass stiffness (stiffness form).
+    if let (Some(beta), HourglassForm::Stiffness) = (beta, props.hg_form) {
+        for k in 0..5 {
+            let hd = beta * cc[k] * q[k];
+            damping += dt * hd * q[k];
+            hg[k] += hd;
+        }
+    }
     for i in 0..4 {
         for k in 0..5 {
             f[i][k] += gam[i] * hg[k];
@@ -463,21 +520,6 @@ pub(crate) fn quad_block(
         }
     }
 
-    // Characteristic length: sqrt is monotonic, so the longest length is the root of the
-    // largest square.
-    let sq = |a: V3| dot3(a, a);
-    let diag2 = sq(d31).max(sq(d42));
-    let len2 = if opts.isdo_diagonal {
-        diag2
-    } else {
-        sq(sub3(xs[1], xs[0]))
-            .max(sq(sub3(xs[2], xs[1])))
-            .max(sq(sub3(xs[3], xs[2])))
-            .max(sq(sub3(xs[0], xs[3])))
-            .max(diag2)
-    };
-    let dt_e = area / len2.sqrt() / mat.wave_speed;
-
     // Back to the global frame, into the slots.
     let mut gf = [[V::default(); 6]; 4];
     for i in 0..4 {
@@ -496,6 +538,7 @@ pub(crate) fn quad_block(
         o.dt = dt_e.0[l];
         o.internal = internal.0[l];
         o.hourglass = hourglass.0[l];
+        o.damping = damping.0[l];
         faults[blk.slot[l]] = fault[l];
     }
 }
@@ -613,6 +656,8 @@ mod tests {
             }),
             hg_form: HourglassForm::Stiffness,
             hg: [0.05, 0.05, 0.05],
+            stiffness_damping: 0.0,
+            z_moments: [0.0, 0.1 * 0.2025 * t * t * 2.0 + 0.2 * 0.0625 * t * t * 2.0],
         }
     }
 

@@ -85,7 +85,7 @@ pub mod simulation;
 pub use error::{Result, ShellError};
 pub use model::{
     BodyLoadZ, Control, CowperSymonds, Curve, Hourglass, HourglassForm, InitialVelocity, Material,
-    MaterialLaw, Node, NodeSet, NodeTarget, Output, Part, PointMass, RigidWall, Section, Shell,
+    MaterialLaw, Node, NodeSet, NodeTarget, Output, Part, PartStiffnessDamping, PointMass, RigidWall, Section, Shell,
     ShellModel, Spc, ThicknessRule, VelocityTarget, WallMethod,
 };
-pub use simulation::{Energies, Progress, Quantity, RunResult, RunSummary, Simulation};
+pub use simulation::{Energies, PartEnergies, Progress, Quantity, RunResult, RunSummary, Simulation};

@@ -219,10 +219,15 @@ pub enum WallMethod {
     /// Kinematic constraint (the default): the normal velocity of a node that would cross
     /// the plane during the next step is set so that it lands on the plane.
     Kinematic,
-    /// Penalty spring with mass-based stiffness `k = alpha m / dt^2` on penetration.
+    /// Penalty spring with mass-based stiffness `k = alpha m / dt^2` on penetration, with
+    /// a normal dashpot `c = 2 zeta sqrt(k m)` (zeta = `damping`, LS-DYNA's VDC / 100) on
+    /// the normal velocity while the node penetrates. The normal force never pulls: spring
+    /// plus dashpot is clipped at zero.
     Penalty {
         /// The stiffness factor alpha (0.1 is a safe choice), 0 < alpha <= 1.
         alpha: f64,
+        /// Fraction of critical damping of the node-on-spring oscillator, 0 <= zeta <= 1.
+        damping: f64,
     },
 }
 
@@ -300,6 +305,33 @@ pub struct BodyLoadZ {
     pub curve: u64,
     /// Scale factor SF.
     pub scale: f64,
+}
+
+/// Stiffness-proportional (Rayleigh beta) damping of the shells of one part
+/// (`*DAMPING_PART_STIFFNESS`).
+///
+/// Each element adds the viscous resultants `beta (N, M, Q)(rates)`: its elastic stiffness
+/// (membrane, bending, transverse shear and, in the stiffness form, the hourglass
+/// stiffness) applied to its deformation rates. Strain and hourglass rates vanish on
+/// rigid-body motion, so translation and rotation of the whole part are never damped.
+/// A mode of circular frequency `omega` is damped at the fraction of critical
+/// `zeta = beta omega / 2`.
+///
+/// `coef` follows the sign convention of LS-DYNA's COEF:
+/// - `coef > 0`: `zeta = coef` at each element's highest frequency `omega_e = 2 / dt_e`
+///   (`dt_e` its stable step), i.e. `beta_e = coef dt_e`; lower frequencies get
+///   proportionally less (`zeta = coef omega / omega_e`). LS-DYNA recommends 0.01 to 0.25 for
+///   its own (unpublished) positive-COEF formula, which this definition follows in spirit.
+/// - `coef < 0`: `beta = |coef|` (time unit), the classic Rayleigh coefficient.
+///
+/// The stable step of a damped element shrinks to `dt_e (sqrt(1 + zeta_e^2) - zeta_e)`.
+/// The energy removed is reported as damping energy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PartStiffnessDamping {
+    /// Part id.
+    pub part: u64,
+    /// The coefficient (see the type's docs); 0 switches the damping off.
+    pub coef: f64,
 }
 
 /// Hourglass control form.
@@ -419,6 +451,8 @@ pub struct ShellModel {
     pub body_load_z: Option<BodyLoadZ>,
     /// Mass-proportional damping constant D (1/time): nodal force `-D m v`.
     pub damping: f64,
+    /// Stiffness-proportional damping per part (at most one entry per part).
+    pub stiffness_damping: Vec<PartStiffnessDamping>,
     /// Hourglass control.
     pub hourglass: Hourglass,
     /// Run controls.

@@ -49,7 +49,8 @@ pub struct Energies {
     pub contact: f64,
     /// The friction share of `contact`.
     pub friction: f64,
-    /// Energy removed by mass-proportional damping.
+    /// Energy removed by damping: mass-proportional (`*DAMPING_GLOBAL`) and
+    /// stiffness-proportional (`*DAMPING_PART_STIFFNESS`).
     pub damping: f64,
     /// Work of the external (body) forces.
     pub external_work: f64,
@@ -110,6 +111,19 @@ pub struct RunSummary {
     pub mass: f64,
 }
 
+/// Energies of one part, summed over its shells.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PartEnergies {
+    /// Part id.
+    pub part: u64,
+    /// Internal (strain and plastic) energy.
+    pub internal: f64,
+    /// Hourglass energy.
+    pub hourglass: f64,
+    /// Energy removed by stiffness-proportional damping.
+    pub damping: f64,
+}
+
 /// The outputs of a run: sampled nodal histories (when history nodes were requested), the
 /// energy table and a summary.
 #[derive(Debug, Clone)]
@@ -125,6 +139,8 @@ pub struct RunResult {
     /// energy_ratio, wall_force, wall_fx, wall_fy, wall_fz` (the wall force is the force of
     /// the walls on the structure; `wall_force` is its normal component).
     pub energies: Histories,
+    /// Final energies of each part, in model order.
+    pub parts: Vec<PartEnergies>,
     /// Summary figures.
     pub summary: RunSummary,
 }
@@ -185,6 +201,8 @@ pub struct Simulation {
     out: Vec<ElementOutput>,
     /// Per-element faults of the last element pass.
     faults: Vec<Option<ElementFault>>,
+    /// Per-element accumulated internal, hourglass and damping energy.
+    elem_energy: Vec<[f64; 3]>,
     chunks: Vec<ChunkSum>,
     /// Per-chunk partial sums of the node loops.
     node_sums: Vec<f64>,
@@ -232,6 +250,7 @@ struct KickSum {
 struct ChunkSum {
     internal: f64,
     hourglass: f64,
+    damping: f64,
     dt_min: f64,
     /// Element (global index) of `dt_min`.
     arg: usize,
@@ -244,6 +263,7 @@ impl Default for ChunkSum {
         ChunkSum {
             internal: 0.0,
             hourglass: 0.0,
+            damping: 0.0,
             dt_min: f64::INFINITY,
             arg: 0,
             problem: None,
@@ -313,6 +333,7 @@ impl Simulation {
             state: vec![0.0; stride * ne],
             out: vec![ElementOutput::default(); ne],
             faults: vec![None; ne],
+            elem_energy: vec![[0.0; 3]; ne],
             chunks: vec![ChunkSum::default(); ne.div_ceil(ELEMENT_CHUNK)],
             node_sums: vec![0.0; nn.div_ceil(NODE_CHUNK)],
             kick_sums: vec![KickSum::default(); nn.div_ceil(NODE_CHUNK)],
@@ -403,6 +424,27 @@ impl Simulation {
         self.wall_force
     }
 
+    /// The accumulated internal, hourglass and damping energies of each part, in model
+    /// order (sums over its shells in element order).
+    pub fn part_energies(&self) -> Vec<PartEnergies> {
+        let mut parts: Vec<PartEnergies> = self
+            .c
+            .part_ids
+            .iter()
+            .map(|&part| PartEnergies {
+                part,
+                ..Default::default()
+            })
+            .collect();
+        for (e, acc) in self.c.elems.iter().zip(&self.elem_energy) {
+            let p = &mut parts[e.part as usize];
+            p.internal += acc[0];
+            p.hourglass += acc[1];
+            p.damping += acc[2];
+        }
+        parts
+    }
+
     /// Stress state `[s_xx, s_yy, s_xy, eps_p]` of thickness point `k` of element index `e`
     /// (model order), in the element frame.
     pub fn point_state(&self, e: usize, k: usize) -> Option<[f64; 4]> {
@@ -434,9 +476,10 @@ impl Simulation {
             .par_chunks_mut(stride * ELEMENT_CHUNK)
             .zip(self.out.par_chunks_mut(ELEMENT_CHUNK))
             .zip(self.faults.par_chunks_mut(ELEMENT_CHUNK))
+            .zip(self.elem_energy.par_chunks_mut(ELEMENT_CHUNK))
             .zip(self.chunks.par_iter_mut())
             .enumerate()
-            .for_each(|(ci, (((st, out), faults), sum))| {
+            .for_each(|(ci, ((((st, out), faults), acc), sum))| {
                 let first = ci * ELEMENT_CHUNK;
                 let n = out.len();
                 let mut k = 0;
@@ -479,8 +522,12 @@ impl Simulation {
                 }
                 let mut cs = ChunkSum::default();
                 for (j, (o, f)) in out.iter().zip(faults.iter()).enumerate() {
+                    acc[j][0] += o.internal;
+                    acc[j][1] += o.hourglass;
+                    acc[j][2] += o.damping;
                     cs.internal += o.internal;
                     cs.hourglass += o.hourglass;
+                    cs.damping += o.damping;
                     if cs.problem.is_none() && (f.is_some() || !(o.dt >= 0.0)) {
                         cs.problem = Some(first + j);
                     }
@@ -556,11 +603,15 @@ impl Simulation {
                         }
                         (vmin, vmin - vn)
                     }
-                    WallMethod::Penalty { alpha } => {
+                    WallMethod::Penalty { alpha, damping } => {
                         if d0 >= 0.0 {
                             continue;
                         }
-                        let dvn = -alpha * d0 / dt_v;
+                        // Spring k = alpha m / dt_v^2 and dashpot c = 2 zeta sqrt(k m) on
+                        // the predicted normal velocity; together they never pull the node
+                        // toward the wall.
+                        let spring = -alpha * d0 / dt_v;
+                        let dvn = (spring - 2.0 * damping * alpha.sqrt() * vn).max(0.0);
                         (vn + dvn, dvn)
                     }
                 };
@@ -755,13 +806,15 @@ impl Simulation {
         self.cycle += 1;
         self.element_loop(dt);
         let dt_next = self.next_dt()?;
-        let (mut die, mut dhg) = (0.0, 0.0);
+        let (mut die, mut dhg, mut ddp) = (0.0, 0.0, 0.0);
         for c in &self.chunks {
             die += c.internal;
             dhg += c.hourglass;
+            ddp += c.damping;
         }
         self.energies.internal += die;
         self.energies.hourglass += dhg;
+        self.energies.damping += ddp;
         let g1 = self.body_accel(self.time);
         self.energies.external_work += 0.5 * (g0 + g1) * mdz;
         self.gather(self.time);
@@ -919,6 +972,7 @@ impl Simulation {
         let e = self.energies;
         let mut it = nodal.into_iter();
         Ok(RunResult {
+            parts: self.part_energies(),
             displacement: it.next().flatten(),
             velocity: it.next().flatten(),
             acceleration: it.next().flatten(),
