@@ -75,6 +75,23 @@ fn apply(m: &mut ShellModel, spec: &str) {
             }
             "tssfac" => m.control.tssfac = v.parse().unwrap(),
             "damp" => m.damping = v.parse().unwrap(),
+            "bulk" => {
+                let (a, b) = v.split_once(':').unwrap_or(("1.5", "0.06"));
+                m.bulk_viscosity = Some(impactcal::shell::BulkViscosity {
+                    q1: a.parse().unwrap(),
+                    q2: b.parse().unwrap(),
+                });
+            }
+            "inn" => m.control.invariant_numbering = true,
+            "nowall" => m.walls.clear(),
+            "nograv" => m.body_load_z = None,
+            "kick" => {
+                let (p, vz) = v.split_once(':').unwrap();
+                m.initial_velocities.push(impactcal::shell::InitialVelocity::translation(
+                    impactcal::shell::VelocityTarget::Part(p.parse().unwrap()),
+                    [0.0, 0.0, vz.parse().unwrap()],
+                ));
+            }
             "fric" => m.walls[0].friction = v.parse().unwrap(),
             "norate" => {
                 for mat in &mut m.materials {
@@ -109,6 +126,7 @@ struct Run {
     /// Full nodal velocities every 1 ms.
     snaps: Vec<Vec<[f64; 3]>>,
     xs: Vec<Vec<[f64; 3]>>,
+    pe: Vec<Vec<impactcal::shell::PartEnergies>>,
     mass: Vec<f64>,
 }
 
@@ -118,10 +136,11 @@ fn run(af: &Airframe, values: &AirframeValues, spec: &str) -> Run {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let r = pool.install(|| Simulation::new(&m).unwrap().run().unwrap());
     if std::env::var("PROBE_SNAP").is_err() {
-        return Run { r, snaps: Vec::new(), xs: Vec::new(), mass: Vec::new() };
+        return Run { r, snaps: Vec::new(), xs: Vec::new(), pe: Vec::new(), mass: Vec::new() };
     }
     let mut mass = Vec::new();
     let mut xs = Vec::new();
+    let mut pe = Vec::new();
     let snaps = pool.install(|| {
         let mut sim = Simulation::new(&m).unwrap();
         mass = sim.masses().to_vec();
@@ -133,12 +152,13 @@ fn run(af: &Airframe, values: &AirframeValues, spec: &str) -> Run {
             if sim.time() >= next {
                 out.push(sim.velocities().to_vec());
                 xs.push(sim.positions().to_vec());
+                pe.push(sim.part_energies());
                 next += 1e-3;
             }
         }
         out
     });
-    Run { r, snaps, xs, mass }
+    Run { r, snaps, xs, pe, mass }
 }
 
 fn filtered(r: &RunResult, c: f64) -> Vec<Vec<f64>> {
@@ -179,7 +199,8 @@ fn main() {
     let end: f64 = args[1].parse().unwrap();
     let spec = args.get(2).cloned().unwrap_or_default();
     let perturb: Vec<String> = args[3..].to_vec();
-    let mut o = AirframeOptions::new(MeshDensity::Coarse);
+    let mesh = MeshDensity::parse(&std::env::var("PROBE_MESH").unwrap_or("coarse".into())).unwrap();
+    let mut o = AirframeOptions::new(mesh);
     o.end_time = end;
     let af = Airframe::new(o).unwrap();
     let mut nominal = AirframeValues::nominal();
@@ -203,6 +224,15 @@ fn main() {
         }
         jobs.push((p.clone(), v, s));
     }
+    let mut tri = std::collections::BTreeMap::new();
+    for (n, p) in af.shells() {
+        let e = tri.entry(p.name()).or_insert((0, 0));
+        e.0 += 1;
+        if n[3] == n[2] {
+            e.1 += 1;
+        }
+    }
+    eprintln!("shells (triangles) by part: {tri:?}");
     let t0 = std::time::Instant::now();
     let runs: Vec<Run> = jobs.par_iter().map(|(_, v, s)| run(&af, v, s)).collect();
     eprintln!("wall {:.1} s", t0.elapsed().as_secs_f64());
@@ -338,6 +368,13 @@ fn main() {
                 wf[k]
             );
         }
+        println!("internal energy by part (parts 1..14) every 4 ms:");
+        for (k, p) in base.pe.iter().enumerate() {
+            if (k + 1) % 4 == 0 {
+                let l: Vec<String> = p.iter().map(|q| format!("{:.0}", q.internal)).collect();
+                println!("  {:2} ms: {}", k + 1, l.join(" "));
+            }
+        }
         let last = wf.iter().rposition(|f| f.abs() > 0.0).unwrap_or(0);
         println!("last sample with a wall force: {:.4} s", last as f64 * 1e-4);
     }
@@ -350,6 +387,42 @@ fn main() {
         .iter()
         .map(|p| key.get(&[p[0], -p[1], p[2]].map(|c| (c * 1e4).round() as i64)).copied())
         .collect();
+    {
+        // Mesh symmetry: mirrored element node sets, mirrored masses.
+        let mut sets = std::collections::HashSet::new();
+        for (n, _) in af.shells() {
+            let mut v: Vec<u64> = n.to_vec();
+            v.sort();
+            v.dedup();
+            sets.insert(v);
+        }
+        let mut bad = 0;
+        let mut badtri = 0;
+        for (n, p) in af.shells() {
+            let mut v: Vec<u64> = n
+                .iter()
+                .map(|&id| mirror[id as usize - 1].map_or(0, |j| j as u64 + 1))
+                .collect();
+            v.sort();
+            v.dedup();
+            if !sets.contains(&v) {
+                bad += 1;
+                if n[2] == n[3] {
+                    badtri += 1;
+                }
+                if bad < 5 {
+                    eprintln!("unmirrored element {:?} of {}", n, p.name());
+                }
+            }
+        }
+        let mut mbad = 0.0f64;
+        for i in 0..nn {
+            if let Some(j) = mirror[i] {
+                mbad = mbad.max((base.mass[i] - base.mass[j]).abs() / base.mass[i]);
+            }
+        }
+        println!("elements without a mirror: {bad} ({badtri} triangles); largest mass mismatch {mbad:.2e}");
+    }
     println!(
         "mirror pairs found for {} of {} nodes",
         mirror.iter().filter(|m| m.is_some()).count(),
@@ -372,6 +445,33 @@ fn main() {
         }
     }
     println!("{line}");
+    {
+        let mut part_of = vec![None; nn];
+        for (n, p) in af.shells() {
+            for &id in &n {
+                let i = id as usize - 1;
+                if part_of[i].is_none() {
+                    part_of[i] = Some(p);
+                }
+            }
+        }
+        for ms in [1usize, 2, 5] {
+            if ms >= base.snaps.len() {
+                continue;
+            }
+            let v = &base.snaps[ms];
+            let mut per: std::collections::BTreeMap<&str, f64> = Default::default();
+            for i in 0..nn {
+                if let Some(j) = mirror[i] {
+                    let w = [v[j][0], -v[j][1], v[j][2]];
+                    let d: f64 = (0..3).map(|d| (v[i][d] - w[d]).abs()).fold(0.0, f64::max);
+                    let e = per.entry(part_of[i].map_or("none", |p| p.name())).or_default();
+                    *e = e.max(d);
+                }
+            }
+            println!("  max |v - mirror v| by part at {ms} ms: {per:?}");
+        }
+    }
     // Node -> part (first part listing the node).
     let mut part_of = vec![None; nn];
     for (n, p) in af.shells() {

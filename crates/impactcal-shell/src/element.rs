@@ -71,6 +71,9 @@ pub struct PartProps {
     /// Moments of the thickness rule `[sum w_k z_k, sum w_k z_k^2]` (physical heights), which
     /// turn strain rates into the resultants of the stiffness damping.
     pub z_moments: [f64; 2],
+    /// Shell bulk viscosity coefficients `[Q1, Q2]` (`[0, 0]`: none), see
+    /// [`crate::model::BulkViscosity`].
+    pub bulk: [f64; 2],
 }
 
 impl PartProps {
@@ -94,6 +97,7 @@ impl PartProps {
             hg: [hourglass.membrane, hourglass.transverse, hourglass.rotation],
             stiffness_damping: 0.0,
             z_moments,
+            bulk: [0.0, 0.0],
         }
     }
 
@@ -106,14 +110,31 @@ impl PartProps {
     }
 
     /// The Rayleigh coefficient `beta` of an element whose undamped stable step is `dt_e`,
-    /// and its damped stable step `dt_e (sqrt(1 + zeta^2) - zeta)`, `zeta = beta / dt_e`
+    /// and the factor `sqrt(1 + zeta^2) - zeta` on its stable step, `zeta = beta / dt_e`
     /// (the fraction of critical damping at the element's highest frequency `2 / dt_e`).
     #[inline]
     pub fn damping_beta(&self, dt_e: f64) -> (f64, f64) {
         let c = self.stiffness_damping;
         let beta = if c > 0.0 { c * dt_e } else { -c };
         let zeta = beta / dt_e;
-        (beta, dt_e * ((1.0 + zeta * zeta).sqrt() - zeta))
+        (beta, (1.0 + zeta * zeta).sqrt() - zeta)
+    }
+
+    /// Shell bulk viscosity for the areal strain rate `rate` (`d_xx + d_yy`) of an element
+    /// of characteristic length `len`: the in-plane pressure
+    /// `q = rho len (Q1^2 len rate^2 - Q2 c rate)` while the area shrinks (`rate < 0`, else
+    /// 0) and the stable step `len / (Q + sqrt(Q^2 + c^2))`, `Q = Q1^2 len |rate| + Q2 c`.
+    #[inline]
+    pub fn bulk_pressure(&self, rate: f64, len: f64) -> (f64, f64) {
+        let c = self.mat.wave_speed;
+        if !(rate < 0.0) || self.bulk == [0.0, 0.0] {
+            return (0.0, len / c);
+        }
+        let [q1, q2] = self.bulk;
+        let a = q1 * q1 * len * rate.abs();
+        let q = self.mat.rho * len * (a * rate.abs() + q2 * c * rate.abs());
+        let big_q = a + q2 * c;
+        (q, len / (big_q + (big_q * big_q + c * c).sqrt()))
     }
 }
 
@@ -158,6 +179,9 @@ pub struct KernelOptions {
     pub projection: bool,
     /// ISDO 1: characteristic length = area / longest diagonal.
     pub isdo_diagonal: bool,
+    /// Invariant node numbering (LS-DYNA INN 2): the quad frame's first axis bisects the
+    /// diagonals instead of following the edges 1-2 and 4-3.
+    pub invariant: bool,
 }
 
 /// Frame and centre derivatives of an element on its current geometry.
@@ -231,7 +255,46 @@ fn tri_local(x: &[[f64; 3]; 3]) -> Result<Local<3>, ElementFault> {
     let e3 = normalise(cross(d21, sub(x[2], x[0]))).ok_or(ElementFault::Degenerate)?;
     let e1 = normalise(d21).ok_or(ElementFault::Degenerate)?;
     let e2 = cross(e3, e1);
-    let rot = [e1, e2, e3];
+    tri_local_in(x, [e1, e2, e3])
+}
+
+/// The triangle's frame turned in its plane by the rotation of the polar decomposition of
+/// its in-plane deformation gradient since the reference configuration, so that the frame
+/// follows the mean rotation of the material rather than the edge 1-2. The reference
+/// configuration (node 1 at the origin, edge 1-2 along x: `[x2, x3, y3]`) is kept in
+/// `reference`; all zero means "not yet recorded": the current configuration is recorded
+/// and the frame is the edge frame.
+fn tri_local_invariant(
+    x: &[[f64; 3]; 3],
+    reference: &mut [f64],
+) -> Result<Local<3>, ElementFault> {
+    let edge = tri_local(x)?;
+    let [e1, e2, e3] = edge.rot;
+    let d2 = sub(x[1], x[0]);
+    let d3 = sub(x[2], x[0]);
+    let (a, b, c) = (dot(d2, e1), dot(d3, e1), dot(d3, e2));
+    if reference[0] == 0.0 {
+        reference[0] = a;
+        reference[1] = b;
+        reference[2] = c;
+        return Ok(edge);
+    }
+    let (x2, x3, y3) = (reference[0], reference[1], reference[2]);
+    // F = [[a, b], [0, c]] [[x2, x3], [0, y3]]^-1; polar angle atan2(F21 - F12, F11 + F22).
+    let f11 = a / x2;
+    let f12 = b / y3 - a * x3 / (x2 * y3);
+    let f22 = c / y3;
+    let psi = (-f12).atan2(f11 + f22);
+    let (s, co) = psi.sin_cos();
+    let r1 = [
+        co * e1[0] + s * e2[0],
+        co * e1[1] + s * e2[1],
+        co * e1[2] + s * e2[2],
+    ];
+    tri_local_in(x, [r1, cross(e3, r1), e3])
+}
+
+fn tri_local_in(x: &[[f64; 3]; 3], rot: [[f64; 3]; 3]) -> Result<Local<3>, ElementFault> {
     let r = local_coords(x, &rot);
     let (x1, x2, x3) = (r[0][0], r[1][0], r[2][0]);
     let (y1, y2, y3) = (r[0][1], r[1][1], r[2][1]);
@@ -316,7 +379,9 @@ pub fn quad_batch(
 }
 
 /// Evaluates one C0 triangle for one cycle (as [`quad`], without hourglass control or
-/// projection; row 3 of the forces is zero).
+/// projection; row 3 of the forces is zero). With `opts.invariant` the frame follows the
+/// polar rotation of the element since its first evaluation (recorded in the state's
+/// unused hourglass slots), so the result does not depend on the node numbering.
 ///
 /// # Errors
 /// [`ElementFault::Degenerate`] when the current geometry has no area or is inverted.
@@ -327,8 +392,13 @@ pub fn triangle(
     props: &PartProps,
     state: &mut [f64],
     dt: f64,
+    opts: KernelOptions,
 ) -> Result<ElementOutput, ElementFault> {
-    let loc = tri_local(x)?;
+    let loc = if opts.invariant {
+        tri_local_invariant(x, &mut state[2..5])?
+    } else {
+        tri_local(x)?
+    };
     let mut u = [[0.0; 6]; 3];
     for i in 0..3 {
         for k in 0..3 {
@@ -338,13 +408,16 @@ pub fn triangle(
     }
     let d = |i: usize, j: usize| norm(sub(x[i], x[j]));
     let side = d(0, 1).max(d(1, 2)).max(d(2, 0));
-    let dt_e = 2.0 * loc.area / side / props.mat.wave_speed;
-    let (beta, dt_out) = if props.stiffness_damping == 0.0 {
-        (0.0, dt_e)
+    let len = 2.0 * loc.area / side;
+    let dt_e = len / props.mat.wave_speed;
+    let (beta, factor) = if props.stiffness_damping == 0.0 {
+        (0.0, 1.0)
     } else {
         props.damping_beta(dt_e)
     };
-    let (f, internal, damping) = resultant_forces(&loc, &u, props, state, dt, beta);
+    let (f, internal, damping, dt_bulk) =
+        resultant_forces(&loc, &u, props, state, dt, beta, len);
+    let dt_out = dt_bulk * factor;
     let g = to_global(&loc.rot, &f);
     Ok(ElementOutput {
         f: [g[0], g[1], g[2], [0.0; 6]],
@@ -367,8 +440,10 @@ fn to_global<const N: usize>(rot: &[[f64; 3]; 3], f: &[[f64; 6]; N]) -> [[f64; 6
 }
 
 /// Strain rates, material update through the thickness, resultants and local nodal forces,
-/// with stiffness-proportional damping `beta` (0: none). Returns the local forces, the
-/// internal energy increment and the damping energy increment.
+/// with stiffness-proportional damping `beta` (0: none) and the bulk viscosity of an element
+/// of characteristic length `len`. Returns the local forces, the internal energy increment,
+/// the damping energy increment (stiffness damping and bulk viscosity) and the stable step
+/// with the bulk viscosity (`len / c` without it).
 fn resultant_forces<const N: usize>(
     loc: &Local<N>,
     u: &[[f64; 6]; N],
@@ -376,7 +451,8 @@ fn resultant_forces<const N: usize>(
     state: &mut [f64],
     dt: f64,
     beta: f64,
-) -> ([[f64; 6]; N], f64, f64) {
+    len: f64,
+) -> ([[f64; 6]; N], f64, f64, f64) {
     let (b1, b2) = (&loc.b1, &loc.b2);
     let (mut dxx, mut dyy, mut gxy) = (0.0, 0.0, 0.0);
     let (mut kxx, mut kyy, mut kxy) = (0.0, 0.0, 0.0);
@@ -486,6 +562,12 @@ fn resultant_forces<const N: usize>(
         qx += qdx;
         qy += qdy;
     }
+    let (qb, dt_bulk) = props.bulk_pressure(dxx + dyy, len);
+    if qb > 0.0 {
+        damping -= dt * a * t * qb * (dxx + dyy);
+        nxx -= qb;
+        nyy -= qb;
+    }
 
     let (nxx, nyy, nxy) = (t * a * nxx, t * a * nyy, t * a * nxy);
     let (mxx, myy, mxy) = (t * a * mxx, t * a * myy, t * a * mxy);
@@ -501,7 +583,7 @@ fn resultant_forces<const N: usize>(
             0.0,
         ];
     }
-    (f, internal, damping)
+    (f, internal, damping, dt_bulk)
 }
 
 /// Area of the current geometry of a quad or triangle and whether it is usable, for

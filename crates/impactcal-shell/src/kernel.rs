@@ -173,8 +173,17 @@ pub(crate) fn quad_block(
     let n3 = cross3(d31, d42);
     let len3 = dot3(n3, n3).sqrt();
     let mut a = [V::default(); 3];
-    for k in 0..3 {
-        a[k] = xs[1][k] - xs[0][k] + xs[2][k] - xs[3][k];
+    if opts.invariant {
+        // Bisector of the two diagonals: the same frame, up to quarter turns, whichever
+        // node is numbered first and whichever way the nodes run.
+        let (i31, i42) = (1.0 / dot3(d31, d31).sqrt(), 1.0 / dot3(d42, d42).sqrt());
+        for k in 0..3 {
+            a[k] = d31[k] * i31 - d42[k] * i42;
+        }
+    } else {
+        for k in 0..3 {
+            a[k] = xs[1][k] - xs[0][k] + xs[2][k] - xs[3][k];
+        }
     }
     let inv3 = 1.0 / len3;
     let e3 = [n3[0] * inv3, n3[1] * inv3, n3[2] * inv3];
@@ -308,12 +317,14 @@ pub(crate) fn quad_block(
             .max(sq(sub3(xs[0], xs[3])))
             .max(diag2)
     };
-    let mut dt_e = area / len2.sqrt() / mat.wave_speed;
+    let len = area / len2.sqrt();
+    let mut dt_e = len / mat.wave_speed;
     // Stiffness-proportional damping: Rayleigh beta per lane and the damped stable step.
+    let mut step_factor = V::splat(1.0);
     let beta = (props.stiffness_damping != 0.0).then(|| {
         let mut beta = V::default();
         for l in 0..LANES {
-            (beta.0[l], dt_e.0[l]) = props.damping_beta(dt_e.0[l]);
+            (beta.0[l], step_factor.0[l]) = props.damping_beta(dt_e.0[l]);
         }
         beta
     });
@@ -415,6 +426,18 @@ pub(crate) fn quad_block(
         qxf += qdx;
         qyf += qdy;
     }
+    // Bulk viscosity: an in-plane pressure while the area shrinks, and its smaller step.
+    if props.bulk != [0.0, 0.0] {
+        let rate = dxx + dyy;
+        for l in 0..LANES {
+            let (q, dt_b) = props.bulk_pressure(rate.0[l], len.0[l]);
+            dt_e.0[l] = dt_b;
+            damping.0[l] -= dt * area.0[l] * t * q * rate.0[l];
+            nxx.0[l] -= q;
+            nyy.0[l] -= q;
+        }
+    }
+    dt_e = dt_e * step_factor;
 
     let ta = t * area;
     let (nxx, nyy, nxy) = (ta * nxx, ta * nyy, ta * nxy);
@@ -461,11 +484,17 @@ pub(crate) fn quad_block(
             cc[4] = cc[3];
         }
         HourglassForm::Viscous => {
-            let base = 0.25 * mat.rho * mat.wave_speed * t * area.sqrt();
+            // Each mode's coefficient is r times its impedance sqrt(S m) (S its
+            // stiffness-form coefficient at r = 1, m its nodal mass or rotary inertia),
+            // scaled so that the membrane modes keep r rho c t sqrt(A) / 4.
+            let root = area.sqrt();
+            let base = 0.25 * mat.rho * mat.wave_speed * t * root;
             cc[0] = rm * base;
             cc[1] = cc[0];
-            cc[2] = rw * base;
-            cc[3] = (rb * t * t / 12.0) * base;
+            let w = (props.shear_factor / (3.0 * (1.0 + mat.nu))).sqrt();
+            cc[2] = rw * w * t * base / root;
+            let inertia = (area * 0.125).max(V::splat(t * t / 12.0));
+            cc[3] = (rb * t) * base * (inertia * (1.0 / 24.0)).sqrt();
             cc[4] = cc[3];
         }
     }
@@ -658,6 +687,7 @@ mod tests {
             hg: [0.05, 0.05, 0.05],
             stiffness_damping: 0.0,
             z_moments: [0.0, 0.1 * 0.2025 * t * t * 2.0 + 0.2 * 0.0625 * t * t * 2.0],
+            bulk: [0.0, 0.0],
         }
     }
 
@@ -702,6 +732,7 @@ mod tests {
         let opts = KernelOptions {
             projection: true,
             isdo_diagonal: false,
+            invariant: false,
         };
         let dt = 2e-6;
         // Full and partial blocks in turn, elements in reverse lane order.
@@ -853,6 +884,7 @@ mod tests {
             let on = KernelOptions {
                 projection: true,
                 isdo_diagonal: false,
+                invariant: false,
             };
             let off = KernelOptions {
                 projection: false,

@@ -84,7 +84,7 @@ pub mod simulation;
 
 pub use error::{Result, ShellError};
 pub use model::{
-    BodyLoadZ, Control, CowperSymonds, Curve, Hourglass, HourglassForm, InitialVelocity, Material,
+    BodyLoadZ, BulkViscosity, Control, CowperSymonds, Curve, Hourglass, HourglassForm, InitialVelocity, Material,
     MaterialLaw, Node, NodeSet, NodeTarget, Output, Part, PartStiffnessDamping, PointMass, RigidWall, Section, Shell,
     ShellModel, Spc, ThicknessRule, VelocityTarget, WallMethod,
 };

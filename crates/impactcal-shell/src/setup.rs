@@ -178,6 +178,14 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         let mat = &model.materials[lookup(&mat_map, p.material, "material", &by)?];
         parts.push(PartProps::new(sec, mat, hg));
     }
+    if let Some(b) = model.bulk_viscosity {
+        for (name, v) in [("Q1", b.q1), ("Q2", b.q2)] {
+            non_negative(format!("bulk viscosity {name}"), v)?;
+        }
+        for p in &mut parts {
+            p.bulk = [b.q1, b.q2];
+        }
+    }
     let mut damped = vec![false; parts.len()];
     for d in &model.stiffness_damping {
         let by = "*DAMPING_PART_STIFFNESS";

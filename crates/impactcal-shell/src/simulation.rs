@@ -227,6 +227,9 @@ pub struct Simulation {
     cycle: u64,
     dt_half: f64,
     dt_first: f64,
+    /// The smallest element step of the undeformed model (before TSSFAC): the reference
+    /// step of penalty walls.
+    dt_ref: f64,
     dt_min: f64,
     dt_max: f64,
     energies: Energies,
@@ -327,6 +330,7 @@ impl Simulation {
             kernel: KernelOptions {
                 projection: model.control.warping_projection,
                 isdo_diagonal: model.control.isdo_diagonal,
+                invariant: model.control.invariant_numbering,
             },
             interval,
             stride,
@@ -361,6 +365,7 @@ impl Simulation {
             cycle: 0,
             dt_half: 0.0,
             dt_first: 0.0,
+            dt_ref: 0.0,
             dt_min: f64::INFINITY,
             dt_max: 0.0,
             energies: Energies::default(),
@@ -496,7 +501,7 @@ impl Simulation {
                         };
                         let es = &mut st[k * stride..(k + 1) * stride];
                         (out[k], faults[k]) =
-                            match element::triangle(&g(x), &g(v), &g(w), props, es, dt) {
+                            match element::triangle(&g(x), &g(v), &g(w), props, es, dt, kernel) {
                                 Ok(o) => (o, None),
                                 Err(f) => (ElementOutput::default(), Some(f)),
                             };
@@ -543,6 +548,7 @@ impl Simulation {
     /// Gathers slot forces into accelerations (before walls and constraints).
     fn gather(&mut self, t: f64) {
         let g = self.body_accel(t);
+
         let (out, csr, start) = (&self.out, &self.csr, &self.csr_start);
         let (inv_mass, inv_inertia) = (&self.inv_mass, &self.inv_inertia);
         let damping = self.damping;
@@ -607,11 +613,12 @@ impl Simulation {
                         if d0 >= 0.0 {
                             continue;
                         }
-                        // Spring k = alpha m / dt_v^2 and dashpot c = 2 zeta sqrt(k m) on
+                        // Spring k = alpha m / dt_ref^2 and dashpot c = 2 zeta sqrt(k m) on
                         // the predicted normal velocity; together they never pull the node
                         // toward the wall.
-                        let spring = -alpha * d0 / dt_v;
-                        let dvn = (spring - 2.0 * damping * alpha.sqrt() * vn).max(0.0);
+                        let w2 = alpha / (self.dt_ref * self.dt_ref);
+                        let spring = -w2 * d0 * dt_v;
+                        let dvn = (spring - 2.0 * damping * w2.sqrt() * vn * dt_v).max(0.0);
                         (vn + dvn, dvn)
                     }
                 };
@@ -716,6 +723,11 @@ impl Simulation {
     fn start(&mut self) -> Result<()> {
         self.element_loop(0.0);
         let dt = self.next_dt()?;
+        self.dt_ref = self
+            .chunks
+            .iter()
+            .map(|c| c.dt_min)
+            .fold(f64::INFINITY, f64::min);
         self.gather(0.0);
         self.kick(0.0, dt);
         self.energies.initial = self.energies.kinetic;
@@ -1131,7 +1143,7 @@ fn eval_element(
     let n = e.nodes.map(|i| i as usize);
     let res = if e.tri {
         let g = |a: &[[f64; 3]]| [a[n[0]], a[n[1]], a[n[2]]];
-        element::triangle(&g(x), &g(v), &g(w), props, st, dt)
+        element::triangle(&g(x), &g(v), &g(w), props, st, dt, kernel)
     } else {
         let g = |a: &[[f64; 3]]| [a[n[0]], a[n[1]], a[n[2]], a[n[3]]];
         element::quad(&g(x), &g(v), &g(w), props, st, dt, kernel)
