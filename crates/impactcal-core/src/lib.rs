@@ -5,6 +5,9 @@
 //! - [`ParameterSpace`] and [`Parameter`]: named bounded parameters, the unit-cube map, and
 //!   bounds files `name,lower,upper,nominal[,unit]`.
 //! - [`Model`]: a parameter vector in, histories out, with parallel batch evaluation.
+//! - [`noise`]: the noise a model produces on its own, measured with a jitter ensemble
+//!   ([`SimulationNoise`]: spread per channel and time, predictability horizons).
+//! - [`filter`]: a CFC low-pass filter (SAE J211 style) for single channels.
 //! - [`sampling`]: Halton (plain and scrambled), Sobol' (Joe-Kuo, optionally Owen-scrambled),
 //!   Latin hypercube and symmetric Latin hypercube samples, seeded, mapped onto a space.
 //! - [`Table`]: the numeric CSV reader every file of the project goes through, reporting the
@@ -27,8 +30,10 @@
 //! ```
 
 pub mod error;
+pub mod filter;
 pub mod histories;
 pub mod model;
+pub mod noise;
 pub mod sampling;
 pub mod space;
 pub mod table;
@@ -36,6 +41,7 @@ pub mod table;
 pub use error::{CoreError, Result, check_finite};
 pub use histories::Histories;
 pub use model::{BatchResults, Model, RunFailure};
+pub use noise::{GroupHorizon, JitterOptions, SimulationNoise};
 pub use sampling::{Method as SamplingMethod, Points};
 pub use space::{Parameter, ParameterSpace};
 pub use table::{Table, TableOptions, read_text};
