@@ -72,6 +72,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod airframe;
+pub mod deck_model;
 pub mod element;
 pub mod error;
 mod geometry;
@@ -82,6 +83,7 @@ pub mod model;
 mod setup;
 pub mod simulation;
 
+pub use deck_model::DeckModel;
 pub use error::{Result, ShellError};
 pub use model::{
     BodyLoadZ, BulkViscosity, Control, CowperSymonds, Curve, Hourglass, HourglassForm, InitialVelocity, Material,

@@ -618,7 +618,9 @@ impl Simulation {
                         // toward the wall.
                         let w2 = alpha / (self.dt_ref * self.dt_ref);
                         let spring = -w2 * d0 * dt_v;
-                        let dvn = (spring - 2.0 * damping * w2.sqrt() * vn * dt_v).max(0.0);
+                        // Dashpot on the mean of the normal velocities before and after.
+                        let c = 2.0 * damping * w2.sqrt() * dt_v;
+                        let dvn = ((spring - c * vn) / (1.0 + 0.5 * c)).max(0.0);
                         (vn + dvn, dvn)
                     }
                 };

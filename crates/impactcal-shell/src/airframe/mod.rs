@@ -39,7 +39,9 @@ mod svg;
 
 use impactcal_core::{CoreError, Histories, Model, ParameterSpace};
 
-pub use catalogue::{Adjustable, AirframeValues, GRAVITY, Preset, catalogue, space_of};
+pub use catalogue::{
+    Adjustable, AirframeValues, GRAVITY, Preset, catalogue, space_of, structural_space,
+};
 
 use crate::error::{Result, ShellError};
 use crate::model::{
