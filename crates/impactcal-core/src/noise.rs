@@ -90,7 +90,12 @@ impl JitterOptions {
         self
     }
 
-    fn check(&self) -> Result<()> {
+    /// Checks the options.
+    ///
+    /// # Errors
+    /// [`CoreError::Invalid`] for fewer than 2 runs, `eps` outside `(0, 0.1]` or a CFC class
+    /// that is not finite and positive.
+    pub fn validate(&self) -> Result<()> {
         if self.runs < 2 {
             return Err(CoreError::Invalid(format!(
                 "a jitter ensemble needs at least 2 runs, got {}",
@@ -132,7 +137,7 @@ pub fn jitter_points(
     point: &[f64],
     options: &JitterOptions,
 ) -> Result<Vec<Vec<f64>>> {
-    options.check()?;
+    options.validate()?;
     space.to_unit(point)?;
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let scales: Vec<f64> = space

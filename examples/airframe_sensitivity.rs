@@ -1,0 +1,535 @@
+//! How predictable is the airframe crash? The measurements behind docs/airframe.md
+//! ("Predictability") and the before/after table of docs/validation.md.
+//!
+//! ```text
+//! cargo run --release --example airframe_sensitivity -- targets [--variant SPEC] [--end T]
+//! cargo run --release --example airframe_sensitivity -- compare [--variant SPEC] [--end T] CHANGE...
+//! cargo run --release --example airframe_sensitivity -- physics [--variant SPEC] [--end T]
+//! cargo run --release --example airframe_sensitivity -- symmetry [--variant SPEC] [--end T] CHANGE
+//! ```
+//!
+//! Every run is the coarse airframe at nominal values (`--set name=value` changes them), one
+//! thread per run, two runs at a time. Histories are the 1,215 sensor velocities, compared
+//! after a CFC 60 filter; "relative L2" is `||a - b|| / ||a||` over all channels and the
+//! samples of the window.
+//!
+//! - `targets`: the targets of the predictability work for windows ending at 0.01, 0.02, 0.04
+//!   and `T`: +0.1 % of each Table 2 thickness, TSSFAC halved, each thickness from its lower
+//!   to its upper bound (relative L2 and max |Q_upper - Q_lower| / max Q), and the energy
+//!   balance of the nominal run.
+//! - `compare`: relative L2 (raw and CFC 60) of each CHANGE against the nominal run, and the
+//!   pointwise relative difference at a few times.
+//! - `physics`: centre-of-mass velocity, rigid-body and deformation kinetic energy, energy
+//!   split and wall force every 4 ms, internal energy by part.
+//! - `symmetry`: the left-right asymmetry of the nominal run, and for CHANGE the growth of
+//!   the difference, its antisymmetric share and the parts where it is largest.
+//!
+//! CHANGE is `name=value`, `name*=factor` (catalogue names, `impactcal airframe --list`) or
+//! `spec:SPEC` (the same model with a variant). SPEC is a comma-separated list applied to
+//! the generated model: `before` (the solver settings before the predictability work: edge
+//! frames, no bulk viscosity), `inn=0|1`, `bulk=Q1:Q2|off`, `hg=stiff|visc:QH`, `hgm=`,
+//! `hgw=`, `hgb=` (one mode's coefficient), `sd=COEF` (*DAMPING_PART_STIFFNESS on every
+//! part), `damp=D` (*DAMPING_GLOBAL), `wall=penalty:ALPHA:ZETA`, `tssfac=`, `fric=`,
+//! `elastic`, `norate`.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::needless_range_loop)]
+
+use std::collections::BTreeMap;
+
+use impactcal::core::filter::cfc_filter;
+use impactcal::shell::airframe::{Airframe, AirframeOptions, AirframeValues, MeshDensity, Preset};
+use impactcal::shell::{
+    BulkViscosity, Hourglass, HourglassForm, MaterialLaw, PartEnergies, PartStiffnessDamping,
+    RunResult, ShellModel, Simulation, WallMethod,
+};
+use rayon::prelude::*;
+
+/// Applies a variant SPEC to a generated model.
+fn apply(m: &mut ShellModel, spec: &str) {
+    for item in spec.split(',').filter(|s| !s.is_empty()) {
+        let (k, v) = item.split_once('=').unwrap_or((item, ""));
+        let num = || v.parse::<f64>().unwrap_or_else(|_| panic!("bad number in `{item}`"));
+        match k {
+            "before" => {
+                m.control.invariant_numbering = false;
+                m.bulk_viscosity = None;
+            }
+            "inn" => m.control.invariant_numbering = v == "1",
+            "bulk" => {
+                m.bulk_viscosity = v.split_once(':').map(|(a, b)| BulkViscosity {
+                    q1: a.parse().unwrap(),
+                    q2: b.parse().unwrap(),
+                });
+            }
+            "hg" => {
+                let (form, q) = v.split_once(':').expect("hg=stiff:QH or hg=visc:QH");
+                let q: f64 = q.parse().unwrap();
+                m.hourglass = Hourglass {
+                    form: if form == "visc" {
+                        HourglassForm::Viscous
+                    } else {
+                        HourglassForm::Stiffness
+                    },
+                    membrane: q,
+                    transverse: q,
+                    rotation: q,
+                };
+            }
+            "hgm" => m.hourglass.membrane = num(),
+            "hgw" => m.hourglass.transverse = num(),
+            "hgb" => m.hourglass.rotation = num(),
+            "sd" => {
+                let coef = num();
+                m.stiffness_damping = m
+                    .parts
+                    .iter()
+                    .map(|p| PartStiffnessDamping { part: p.id, coef })
+                    .collect();
+            }
+            "damp" => m.damping = num(),
+            "wall" => {
+                let p: Vec<&str> = v.split(':').collect();
+                assert_eq!(p[0], "penalty", "wall=penalty:ALPHA:ZETA");
+                m.walls[0].method = WallMethod::Penalty {
+                    alpha: p[1].parse().unwrap(),
+                    damping: p.get(2).map_or(0.0, |z| z.parse().unwrap()),
+                };
+            }
+            "tssfac" => m.control.tssfac = num(),
+            "fric" => m.walls[0].friction = num(),
+            "elastic" => m.materials.iter_mut().for_each(|x| x.law = MaterialLaw::Elastic),
+            "norate" => {
+                for x in &mut m.materials {
+                    if let MaterialLaw::Plastic { rate, .. } = &mut x.law {
+                        *rate = None;
+                    }
+                }
+            }
+            _ => panic!("unknown variant item `{item}`"),
+        }
+    }
+}
+
+/// One run: its result, and (when asked) the nodal velocities, positions and part energies
+/// every millisecond.
+struct Run {
+    result: RunResult,
+    masses: Vec<f64>,
+    velocities: Vec<Vec<[f64; 3]>>,
+    positions: Vec<Vec<[f64; 3]>>,
+    parts: Vec<Vec<PartEnergies>>,
+}
+
+fn run(model: &ShellModel, snapshots: bool) -> Run {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    pool.install(|| {
+        let result = Simulation::new(model).unwrap().run().unwrap();
+        let mut sim = Simulation::new(model).unwrap();
+        let masses = sim.masses().to_vec();
+        let (mut velocities, mut positions, mut parts) = (Vec::new(), Vec::new(), Vec::new());
+        if snapshots {
+            velocities.push(sim.velocities().to_vec());
+            positions.push(sim.positions().to_vec());
+            parts.push(sim.part_energies());
+            let mut next = 1e-3;
+            while sim.time() < model.control.end_time {
+                sim.step().unwrap();
+                if sim.time() >= next {
+                    velocities.push(sim.velocities().to_vec());
+                    positions.push(sim.positions().to_vec());
+                    parts.push(sim.part_energies());
+                    next += 1e-3;
+                }
+            }
+        }
+        Run {
+            result,
+            masses,
+            velocities,
+            positions,
+            parts,
+        }
+    })
+}
+
+/// The sensor velocities, CFC 60 filtered (or raw), channel by channel.
+fn channels(r: &RunResult, filtered: bool) -> Vec<Vec<f64>> {
+    let h = r.velocity.as_ref().unwrap();
+    (0..h.channels())
+        .map(|c| {
+            if filtered {
+                cfc_filter(h.channel(c), h.dt(), 60.0).unwrap()
+            } else {
+                h.channel(c).to_vec()
+            }
+        })
+        .collect()
+}
+
+/// `||a - b|| / ||a||` over all channels and the first `n` samples.
+fn rel_l2(a: &[Vec<f64>], b: &[Vec<f64>], n: usize) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        for k in 0..n.min(x.len()) {
+            num += (x[k] - y[k]).powi(2);
+            den += x[k] * x[k];
+        }
+    }
+    (num / den).sqrt()
+}
+
+/// `||a(t_k) - b(t_k)|| / ||a(t_k)||` across channels at sample `k`.
+fn rel_at(a: &[Vec<f64>], b: &[Vec<f64>], k: usize) -> f64 {
+    rel_l2(
+        &a.iter().map(|x| vec![x[k]]).collect::<Vec<_>>(),
+        &b.iter().map(|x| vec![x[k]]).collect::<Vec<_>>(),
+        1,
+    )
+}
+
+/// The 2-norm over channels at every sample (the paper's Q(t)).
+fn q_norm(a: &[Vec<f64>]) -> Vec<f64> {
+    let n = a[0].len();
+    (0..n)
+        .map(|k| a.iter().map(|x| x[k] * x[k]).sum::<f64>().sqrt())
+        .collect()
+}
+
+struct Setup {
+    airframe: Airframe,
+    values: AirframeValues,
+    variant: String,
+    end: f64,
+}
+
+impl Setup {
+    fn model(&self, values: &AirframeValues, extra: &str) -> ShellModel {
+        let mut m = self.airframe.model(values).unwrap();
+        apply(&mut m, &self.variant);
+        apply(&mut m, extra);
+        m
+    }
+
+    /// The model of a CHANGE argument.
+    fn changed(&self, change: &str) -> ShellModel {
+        if let Some(spec) = change.strip_prefix("spec:") {
+            return self.model(&self.values, spec);
+        }
+        let mut v = self.values.clone();
+        if let Some((name, f)) = change.split_once("*=") {
+            let x = v.get(name).unwrap();
+            v.set(name, x * f.parse::<f64>().unwrap()).unwrap();
+        } else {
+            v.assign(change).unwrap();
+        }
+        self.model(&v, "")
+    }
+}
+
+fn energy_line(r: &RunResult) -> String {
+    let e = r.summary.energies;
+    format!(
+        "KE0 {:.0}, KE {:.0}, internal {:.0}, hourglass {:.0} ({:.1} % of internal), contact {:.0} \
+         (friction {:.0}), damping {:.0} ({:.1} % of KE0), external work {:.0}; \
+         |total - KE0 - W| = {:.2} % of KE0; {} cycles",
+        e.initial,
+        e.kinetic,
+        e.internal,
+        e.hourglass,
+        100.0 * e.hourglass / e.internal,
+        e.contact,
+        e.friction,
+        e.damping,
+        100.0 * e.damping / e.initial,
+        e.external_work,
+        100.0 * (e.total() - e.initial - e.external_work).abs() / e.initial,
+        r.summary.cycles
+    )
+}
+
+fn targets(s: &Setup) {
+    let space = Preset::Table2.space().unwrap();
+    let mut jobs: Vec<(String, ShellModel)> = vec![("nominal".into(), s.model(&s.values, ""))];
+    for p in space.parameters() {
+        let nominal = s.values.get(&p.name).unwrap();
+        for (tag, value) in [
+            ("+0.1%", nominal * 1.001),
+            ("lower", p.lower),
+            ("upper", p.upper),
+        ] {
+            let mut v = s.values.clone();
+            v.set(&p.name, value).unwrap();
+            jobs.push((format!("{} {tag}", p.name), s.model(&v, "")));
+        }
+    }
+    let tssfac = jobs[0].1.control.tssfac;
+    jobs.push((
+        "TSSFAC halved".into(),
+        s.model(&s.values, &format!("tssfac={}", 0.5 * tssfac)),
+    ));
+    let runs: Vec<Run> = jobs.par_iter().map(|(_, m)| run(m, false)).collect();
+    let f: Vec<Vec<Vec<f64>>> = runs.iter().map(|r| channels(&r.result, true)).collect();
+    println!("variant [{}], end {} s", s.variant, s.end);
+    println!("nominal: {}", energy_line(&runs[0].result));
+    let q0 = q_norm(&f[0]);
+    let mut windows: Vec<f64> = vec![0.01, 0.02, 0.04];
+    windows.retain(|&w| w < s.end - 1e-9);
+    windows.push(s.end);
+    for w in windows {
+        let n = (w / 1e-4).round() as usize + 1;
+        let qmax = q0[..n].iter().cloned().fold(0.0, f64::max);
+        println!("\nwindow 0 to {w} s (CFC 60, relative L2 over 1,215 channels)");
+        println!("| thickness | +0.1 % | lower to upper | ratio | max dQ / max Q |");
+        println!("|---|---|---|---|---|");
+        for (i, p) in space.parameters().iter().enumerate() {
+            let (small, lo, hi) = (1 + 3 * i, 2 + 3 * i, 3 + 3 * i);
+            let d_small = rel_l2(&f[0], &f[small], n);
+            let d_range = rel_l2(&f[lo], &f[hi], n);
+            let (ql, qh) = (q_norm(&f[lo]), q_norm(&f[hi]));
+            let dq = (0..n).map(|k| (qh[k] - ql[k]).abs()).fold(0.0, f64::max) / qmax;
+            println!(
+                "| `{}` | {:.2} % | {:.2} % | {:.1} | {:.2} % |",
+                p.name,
+                100.0 * d_small,
+                100.0 * d_range,
+                d_range / d_small,
+                100.0 * dq
+            );
+        }
+        let last = runs.len() - 1;
+        println!("TSSFAC halved: {:.2} %", 100.0 * rel_l2(&f[0], &f[last], n));
+    }
+}
+
+fn compare(s: &Setup, changes: &[String]) {
+    let mut jobs = vec![s.model(&s.values, "")];
+    jobs.extend(changes.iter().map(|c| s.changed(c)));
+    let runs: Vec<Run> = jobs.par_iter().map(|m| run(m, false)).collect();
+    println!("variant [{}], end {} s", s.variant, s.end);
+    println!("nominal: {}", energy_line(&runs[0].result));
+    let hg: Vec<String> = runs[0]
+        .result
+        .parts
+        .iter()
+        .map(|p| format!("{}:{:.0}%", p.part, 100.0 * p.hourglass / p.internal.max(1e-12)))
+        .collect();
+    println!("hourglass / internal by part id: {}", hg.join(" "));
+    let (f0, r0) = (channels(&runs[0].result, true), channels(&runs[0].result, false));
+    let n = f0[0].len();
+    for (c, r) in changes.iter().zip(&runs[1..]) {
+        let (f, raw) = (channels(&r.result, true), channels(&r.result, false));
+        let marks: Vec<String> = [0.01, 0.02, 0.03, 0.04, 0.06, 0.08]
+            .iter()
+            .filter(|&&t| t <= s.end + 1e-9)
+            .map(|&t| format!("{t}: {:.4}", rel_at(&f0, &f, ((t / 1e-4) as usize).min(n - 1))))
+            .collect();
+        println!(
+            "{c:<32} raw {:.4}  CFC 60 {:.4}  | at {}",
+            rel_l2(&r0, &raw, n),
+            rel_l2(&f0, &f, n),
+            marks.join(", ")
+        );
+        if c.starts_with("spec:") {
+            println!("{:<32} {}", "", energy_line(&r.result));
+        }
+    }
+}
+
+/// Kinetic energy of the rigid-body motion (translation of the centre of mass and rotation
+/// about it), the centre-of-mass velocity and the angular velocity.
+fn rigid_body(v: &[[f64; 3]], x: &[[f64; 3]], m: &[f64]) -> (f64, [f64; 3], [f64; 3]) {
+    let mt: f64 = m.iter().sum();
+    let (mut p, mut c) = ([0.0; 3], [0.0; 3]);
+    for ((vi, xi), mi) in v.iter().zip(x).zip(m) {
+        for d in 0..3 {
+            p[d] += mi * vi[d];
+            c[d] += mi * xi[d];
+        }
+    }
+    let (vc, c) = (p.map(|q| q / mt), c.map(|q| q / mt));
+    let (mut h, mut inertia) = ([0.0; 3], [[0.0; 3]; 3]);
+    for ((vi, xi), mi) in v.iter().zip(x).zip(m) {
+        let r = [xi[0] - c[0], xi[1] - c[1], xi[2] - c[2]];
+        let u = [vi[0] - vc[0], vi[1] - vc[1], vi[2] - vc[2]];
+        h[0] += mi * (r[1] * u[2] - r[2] * u[1]);
+        h[1] += mi * (r[2] * u[0] - r[0] * u[2]);
+        h[2] += mi * (r[0] * u[1] - r[1] * u[0]);
+        let rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        for a in 0..3 {
+            for b in 0..3 {
+                inertia[a][b] += mi * (if a == b { rr } else { 0.0 } - r[a] * r[b]);
+            }
+        }
+    }
+    let det = |a: [[f64; 3]; 3]| {
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    };
+    let d = det(inertia);
+    let w: [f64; 3] = std::array::from_fn(|k| {
+        let mut a = inertia;
+        for row in 0..3 {
+            a[row][k] = h[row];
+        }
+        det(a) / d
+    });
+    let ke = 0.5 * mt * (vc[0] * vc[0] + vc[1] * vc[1] + vc[2] * vc[2])
+        + 0.5 * (w[0] * h[0] + w[1] * h[1] + w[2] * h[2]);
+    (ke, vc, w)
+}
+
+fn physics(s: &Setup) {
+    let r = run(&s.model(&s.values, ""), true);
+    println!("variant [{}]: {}", s.variant, energy_line(&r.result));
+    let e = &r.result.energies;
+    let col = |l: &str| e.channel_by_label(l).unwrap().to_vec();
+    let (ie, hg, ct, fr, dp, wf) = (
+        col("internal"),
+        col("hourglass"),
+        col("contact"),
+        col("friction"),
+        col("damping"),
+        col("wall_force"),
+    );
+    println!(
+        "| t (ms) | v_x com | v_z com | pitch rate (rad/s) | KE | KE rigid | KE deformation | internal | hourglass | wall, normal | wall, friction | damping | wall force (lbf) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for ms in (0..r.velocities.len()).step_by(4) {
+        let v = &r.velocities[ms];
+        let (ke_rigid, vc, w) = rigid_body(v, &r.positions[ms], &r.masses);
+        let ke: f64 = v
+            .iter()
+            .zip(&r.masses)
+            .map(|(vi, m)| 0.5 * m * (vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]))
+            .sum();
+        let k = (ms * 10).min(ie.len() - 1);
+        println!(
+            "| {ms} | {:.1} | {:.1} | {:.2} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} |",
+            vc[0],
+            vc[2],
+            w[1],
+            ke,
+            ke_rigid,
+            ke - ke_rigid,
+            ie[k],
+            hg[k],
+            ct[k] - fr[k],
+            fr[k],
+            dp[k],
+            wf[k]
+        );
+    }
+    let last = wf.iter().rposition(|f| f.abs() > 0.0).unwrap_or(0);
+    println!("last sample with a wall force: {:.4} s", last as f64 * 1e-4);
+    println!("internal energy by part id, every 8 ms:");
+    for (k, p) in r.parts.iter().enumerate().skip(8).step_by(8) {
+        let l: Vec<String> = p.iter().map(|q| format!("{}:{:.0}", q.part, q.internal)).collect();
+        println!("  {k} ms: {}", l.join(" "));
+    }
+}
+
+fn symmetry(s: &Setup, change: &str) {
+    let models = [s.model(&s.values, ""), s.changed(change)];
+    let runs: Vec<Run> = models.par_iter().map(|m| run(m, true)).collect();
+    let pos = s.airframe.node_positions();
+    let nn = pos.len();
+    let key = |p: [f64; 3]| p.map(|c| (c * 1e4).round() as i64);
+    let index: BTreeMap<[i64; 3], usize> = pos.iter().enumerate().map(|(i, p)| (key(*p), i)).collect();
+    let mirror: Vec<Option<usize>> = pos
+        .iter()
+        .map(|p| index.get(&key([p[0], -p[1], p[2]])).copied())
+        .collect();
+    println!(
+        "variant [{}]: {} of {} nodes have a mirror node",
+        s.variant,
+        mirror.iter().flatten().count(),
+        nn
+    );
+    let mut part_of = vec![None; nn];
+    for (n, p) in s.airframe.shells() {
+        for id in n {
+            part_of[id as usize - 1].get_or_insert(p);
+        }
+    }
+    println!("| t (ms) | asymmetry of the nominal run | difference | antisymmetric share of it |");
+    println!("|---|---|---|---|");
+    for ms in (0..runs[0].velocities.len()).step_by(4) {
+        let (a, b) = (&runs[0].velocities[ms], &runs[1].velocities[ms]);
+        let (mut asym, mut norm, mut diff, mut anti) = (0.0, 0.0, 0.0, 0.0);
+        for i in 0..nn {
+            for d in 0..3 {
+                norm += a[i][d] * a[i][d];
+                diff += (a[i][d] - b[i][d]).powi(2);
+            }
+            if let Some(j) = mirror[i] {
+                let sign = [1.0, -1.0, 1.0];
+                for d in 0..3 {
+                    asym += (0.5 * (a[i][d] - sign[d] * a[j][d])).powi(2);
+                    let (di, dj) = (a[i][d] - b[i][d], sign[d] * (a[j][d] - b[j][d]));
+                    anti += (0.5 * (di - dj)).powi(2);
+                }
+            }
+        }
+        println!(
+            "| {ms} | {:.1e} | {:.1e} | {:.0} % |",
+            (asym / norm.max(1e-300)).sqrt(),
+            (diff / norm.max(1e-300)).sqrt(),
+            100.0 * anti / diff.max(1e-300)
+        );
+    }
+    println!("rms velocity difference (in/s) by part, largest five:");
+    for ms in [10usize, 15, 20, 25, 30, 40] {
+        if ms >= runs[0].velocities.len() {
+            continue;
+        }
+        let (a, b) = (&runs[0].velocities[ms], &runs[1].velocities[ms]);
+        let mut per: BTreeMap<&str, (f64, f64)> = BTreeMap::new();
+        for i in 0..nn {
+            let e = per.entry(part_of[i].map_or("none", |p| p.name())).or_default();
+            for d in 0..3 {
+                e.0 += (a[i][d] - b[i][d]).powi(2);
+                e.1 += 1.0;
+            }
+        }
+        let mut v: Vec<(&str, f64)> = per.into_iter().map(|(k, (s2, c))| (k, (s2 / c).sqrt())).collect();
+        v.sort_by(|x, y| y.1.total_cmp(&x.1));
+        let top: Vec<String> = v.iter().take(5).map(|(k, x)| format!("{k} {x:.1}")).collect();
+        println!("  {ms} ms: {}", top.join(", "));
+    }
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let command = args.next().unwrap_or_else(|| "targets".into());
+    let (mut variant, mut end, mut sets, mut rest) = (String::new(), 0.08, Vec::new(), Vec::new());
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--variant" => variant = args.next().expect("--variant SPEC"),
+            "--end" => end = args.next().expect("--end T").parse().unwrap(),
+            "--set" => sets.push(args.next().expect("--set name=value")),
+            _ => rest.push(a),
+        }
+    }
+    let mut options = AirframeOptions::new(MeshDensity::Coarse);
+    options.end_time = end;
+    let mut values = AirframeValues::nominal();
+    for a in &sets {
+        values.assign(a).unwrap();
+    }
+    let setup = Setup {
+        airframe: Airframe::new(options).unwrap(),
+        values,
+        variant,
+        end,
+    };
+    let started = std::time::Instant::now();
+    match command.as_str() {
+        "targets" => targets(&setup),
+        "compare" => compare(&setup, &rest),
+        "physics" => physics(&setup),
+        "symmetry" => symmetry(&setup, rest.first().map_or("belly_panel.t*=1.001", String::as_str)),
+        c => panic!("unknown command `{c}` (targets, compare, physics, symmetry)"),
+    }
+    eprintln!("{:.0} s wall time", started.elapsed().as_secs_f64());
+}
