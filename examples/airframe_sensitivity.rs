@@ -30,7 +30,8 @@
 //! frames, no bulk viscosity), `inn=0|1`, `bulk=Q1:Q2|off`, `hg=stiff|visc:QH`, `hgm=`,
 //! `hgw=`, `hgb=` (one mode's coefficient), `sd=COEF` (*DAMPING_PART_STIFFNESS on every
 //! part), `damp=D` (*DAMPING_GLOBAL), `wall=penalty:ALPHA:ZETA`, `tssfac=`, `fric=`,
-//! `elastic`, `norate`.
+//! `elastic`, `norate`, `nowall`, `nograv`, `kick=PART:VZ` (an extra initial vertical
+//! velocity of one part's nodes). `--mesh medium|fine` changes the mesh.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::needless_range_loop)]
 
 use std::collections::BTreeMap;
@@ -38,8 +39,8 @@ use std::collections::BTreeMap;
 use impactcal::core::filter::cfc_filter;
 use impactcal::shell::airframe::{Airframe, AirframeOptions, AirframeValues, MeshDensity, Preset};
 use impactcal::shell::{
-    BulkViscosity, Hourglass, HourglassForm, MaterialLaw, PartEnergies, PartStiffnessDamping,
-    RunResult, ShellModel, Simulation, WallMethod,
+    BulkViscosity, Hourglass, HourglassForm, InitialVelocity, MaterialLaw, PartEnergies,
+    PartStiffnessDamping, RunResult, ShellModel, Simulation, VelocityTarget, WallMethod,
 };
 use rayon::prelude::*;
 
@@ -96,6 +97,15 @@ fn apply(m: &mut ShellModel, spec: &str) {
             }
             "tssfac" => m.control.tssfac = num(),
             "fric" => m.walls[0].friction = num(),
+            "nowall" => m.walls.clear(),
+            "nograv" => m.body_load_z = None,
+            "kick" => {
+                let (p, vz) = v.split_once(':').expect("kick=PART:VZ");
+                m.initial_velocities.push(InitialVelocity::translation(
+                    VelocityTarget::Part(p.parse().unwrap()),
+                    [0.0, 0.0, vz.parse().unwrap()],
+                ));
+            }
             "elastic" => m.materials.iter_mut().for_each(|x| x.law = MaterialLaw::Elastic),
             "norate" => {
                 for x in &mut m.materials {
@@ -117,6 +127,7 @@ struct Run {
     velocities: Vec<Vec<[f64; 3]>>,
     positions: Vec<Vec<[f64; 3]>>,
     parts: Vec<Vec<PartEnergies>>,
+    elastic: Vec<f64>,
 }
 
 fn run(model: &ShellModel, snapshots: bool) -> Run {
@@ -126,10 +137,12 @@ fn run(model: &ShellModel, snapshots: bool) -> Run {
         let mut sim = Simulation::new(model).unwrap();
         let masses = sim.masses().to_vec();
         let (mut velocities, mut positions, mut parts) = (Vec::new(), Vec::new(), Vec::new());
+        let mut elastic = Vec::new();
         if snapshots {
             velocities.push(sim.velocities().to_vec());
             positions.push(sim.positions().to_vec());
             parts.push(sim.part_energies());
+            elastic.push(sim.elastic_energy());
             let mut next = 1e-3;
             while sim.time() < model.control.end_time {
                 sim.step().unwrap();
@@ -137,6 +150,7 @@ fn run(model: &ShellModel, snapshots: bool) -> Run {
                     velocities.push(sim.velocities().to_vec());
                     positions.push(sim.positions().to_vec());
                     parts.push(sim.part_energies());
+                    elastic.push(sim.elastic_energy());
                     next += 1e-3;
                 }
             }
@@ -147,6 +161,7 @@ fn run(model: &ShellModel, snapshots: bool) -> Run {
             velocities,
             positions,
             parts,
+            elastic,
         }
     })
 }
@@ -392,9 +407,9 @@ fn physics(s: &Setup) {
         col("wall_force"),
     );
     println!(
-        "| t (ms) | v_x com | v_z com | pitch rate (rad/s) | KE | KE rigid | KE deformation | internal | hourglass | wall, normal | wall, friction | damping | wall force (lbf) |"
+        "| t (ms) | v_x com | v_z com | pitch rate (rad/s) | KE | KE rigid | KE deformation | internal | elastic | plastic | hourglass | wall, normal | wall, friction | damping | wall force (lbf) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for ms in (0..r.velocities.len()).step_by(4) {
         let v = &r.velocities[ms];
         let (ke_rigid, vc, w) = rigid_body(v, &r.positions[ms], &r.masses);
@@ -405,7 +420,7 @@ fn physics(s: &Setup) {
             .sum();
         let k = (ms * 10).min(ie.len() - 1);
         println!(
-            "| {ms} | {:.1} | {:.1} | {:.2} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} |",
+            "| {ms} | {:.1} | {:.1} | {:.2} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} |",
             vc[0],
             vc[2],
             w[1],
@@ -413,6 +428,8 @@ fn physics(s: &Setup) {
             ke_rigid,
             ke - ke_rigid,
             ie[k],
+            r.elastic[ms],
+            ie[k] - r.elastic[ms],
             hg[k],
             ct[k] - fr[k],
             fr[k],
@@ -451,6 +468,21 @@ fn symmetry(s: &Setup, change: &str) {
         for id in n {
             part_of[id as usize - 1].get_or_insert(p);
         }
+    }
+    for ms in [1usize, 2] {
+        let v = &runs[0].velocities[ms.min(runs[0].velocities.len() - 1)];
+        let mut per: BTreeMap<&str, f64> = BTreeMap::new();
+        for i in 0..nn {
+            if let Some(j) = mirror[i] {
+                let d = (v[i][0] - v[j][0]).abs().max((v[i][1] + v[j][1]).abs()).max((v[i][2] - v[j][2]).abs());
+                let e = per.entry(part_of[i].map_or("none", |p| p.name())).or_default();
+                *e = e.max(d);
+            }
+        }
+        let mut l: Vec<(&str, f64)> = per.into_iter().collect();
+        l.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let top: Vec<String> = l.iter().take(4).map(|(k, x)| format!("{k} {x:.1e}")).collect();
+        println!("largest |v - mirrored v| (in/s) at {ms} ms: {}", top.join(", "));
     }
     println!("| t (ms) | asymmetry of the nominal run | difference | antisymmetric share of it |");
     println!("|---|---|---|---|");
@@ -503,15 +535,17 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let command = args.next().unwrap_or_else(|| "targets".into());
     let (mut variant, mut end, mut sets, mut rest) = (String::new(), 0.08, Vec::new(), Vec::new());
+    let mut mesh = MeshDensity::Coarse;
     while let Some(a) = args.next() {
         match a.as_str() {
+            "--mesh" => mesh = MeshDensity::parse(&args.next().expect("--mesh NAME")).unwrap(),
             "--variant" => variant = args.next().expect("--variant SPEC"),
             "--end" => end = args.next().expect("--end T").parse().unwrap(),
             "--set" => sets.push(args.next().expect("--set name=value")),
             _ => rest.push(a),
         }
     }
-    let mut options = AirframeOptions::new(MeshDensity::Coarse);
+    let mut options = AirframeOptions::new(mesh);
     options.end_time = end;
     let mut values = AirframeValues::nominal();
     for a in &sets {

@@ -450,6 +450,33 @@ impl Simulation {
         parts
     }
 
+    /// The elastic (recoverable) strain energy stored in the shells now: at every thickness
+    /// point `(s_xx^2 + s_yy^2 - 2 nu s_xx s_yy) / (2 E) + s_xy^2 / (2 G)` integrated over
+    /// the thickness and the current area, plus the transverse shear `Q^2 / (2 k_s G t)` per
+    /// unit area. The internal energy less this is the plastic work (hourglass energy is
+    /// booked apart).
+    pub fn elastic_energy(&self) -> f64 {
+        let mut total = 0.0;
+        for (k, e) in self.c.elems.iter().enumerate() {
+            let p = &self.c.parts[e.part as usize];
+            let n = if e.tri { 3 } else { 4 };
+            let xs: Vec<[f64; 3]> = e.nodes[..n].iter().map(|&i| self.x[i as usize]).collect();
+            let area = crate::geometry::polygon_area(&xs);
+            let st = &self.state[k * self.stride..(k + 1) * self.stride];
+            let (ym, nu, g) = (p.mat.e, p.mat.nu, p.mat.g);
+            let mut density = 0.0;
+            for (j, w) in p.w.iter().enumerate() {
+                let s = &st[STATE_HEAD + STATE_PER_POINT * j..];
+                density += w
+                    * ((s[0] * s[0] + s[1] * s[1] - 2.0 * nu * s[0] * s[1]) / (2.0 * ym)
+                        + s[2] * s[2] / (2.0 * g));
+            }
+            let shear = (st[0] * st[0] + st[1] * st[1]) / (2.0 * p.shear_factor * g * p.t);
+            total += area * (p.t * density + shear);
+        }
+        total
+    }
+
     /// Stress state `[s_xx, s_yy, s_xy, eps_p]` of thickness point `k` of element index `e`
     /// (model order), in the element frame.
     pub fn point_state(&self, e: usize, k: usize) -> Option<[f64; 4]> {

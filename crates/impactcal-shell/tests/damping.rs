@@ -334,3 +334,24 @@ fn new_options_are_bit_identical_for_any_thread_count() {
         assert_eq!(a.parts, b.parts);
     }
 }
+
+/// In an elastic vibration all the internal energy is recoverable: the stored elastic
+/// energy computed from the stresses equals the internal energy accumulated from the work
+/// increments.
+#[test]
+fn elastic_energy_is_the_internal_energy_of_an_elastic_plate() {
+    let (m, _) = plate_in_its_first_mode();
+    let mut sim = Simulation::new(&m).unwrap();
+    let mut worst: f64 = 0.0;
+    let mut peak: f64 = 0.0;
+    for k in 0..600 {
+        sim.step().unwrap();
+        if k % 50 == 0 {
+            let (ie, el) = (sim.energies().internal, sim.elastic_energy());
+            peak = peak.max(ie);
+            worst = worst.max((ie - el).abs());
+        }
+    }
+    assert!(peak > 0.0);
+    assert!(worst < 2e-3 * peak, "{worst} of {peak}");
+}
