@@ -398,7 +398,8 @@ fn physics(s: &Setup) {
     println!("variant [{}]: {}", s.variant, energy_line(&r.result));
     let e = &r.result.energies;
     let col = |l: &str| e.channel_by_label(l).unwrap().to_vec();
-    let (ie, hg, ct, fr, dp, wf) = (
+    let (ke_all, ie, hg, ct, fr, dp, wf) = (
+        col("kinetic"),
         col("internal"),
         col("hourglass"),
         col("contact"),
@@ -407,7 +408,7 @@ fn physics(s: &Setup) {
         col("wall_force"),
     );
     println!(
-        "| t (ms) | v_x com | v_z com | pitch rate (rad/s) | KE | KE rigid | KE deformation | internal | elastic | plastic | hourglass | wall, normal | wall, friction | damping | wall force (lbf) |"
+        "| t (ms) | v_x com | v_z com | pitch rate (rad/s) | KE rigid | KE deformation | KE nodal rotations | internal | elastic | plastic | hourglass | wall, normal | wall, friction | damping | wall force (lbf) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for ms in (0..r.velocities.len()).step_by(4) {
@@ -424,9 +425,9 @@ fn physics(s: &Setup) {
             vc[0],
             vc[2],
             w[1],
-            ke,
             ke_rigid,
             ke - ke_rigid,
+            ke_all[k] - ke,
             ie[k],
             r.elastic[ms],
             ie[k] - r.elastic[ms],
