@@ -48,7 +48,10 @@ use rayon::prelude::*;
 fn apply(m: &mut ShellModel, spec: &str) {
     for item in spec.split(',').filter(|s| !s.is_empty()) {
         let (k, v) = item.split_once('=').unwrap_or((item, ""));
-        let num = || v.parse::<f64>().unwrap_or_else(|_| panic!("bad number in `{item}`"));
+        let num = || {
+            v.parse::<f64>()
+                .unwrap_or_else(|_| panic!("bad number in `{item}`"))
+        };
         match k {
             "before" => {
                 m.control.invariant_numbering = false;
@@ -106,7 +109,10 @@ fn apply(m: &mut ShellModel, spec: &str) {
                     [0.0, 0.0, vz.parse().unwrap()],
                 ));
             }
-            "elastic" => m.materials.iter_mut().for_each(|x| x.law = MaterialLaw::Elastic),
+            "elastic" => m
+                .materials
+                .iter_mut()
+                .for_each(|x| x.law = MaterialLaw::Elastic),
             "norate" => {
                 for x in &mut m.materials {
                     if let MaterialLaw::Plastic { rate, .. } = &mut x.law {
@@ -131,7 +137,10 @@ struct Run {
 }
 
 fn run(model: &ShellModel, snapshots: bool) -> Run {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
     pool.install(|| {
         let result = Simulation::new(model).unwrap().run().unwrap();
         let mut sim = Simulation::new(model).unwrap();
@@ -325,17 +334,31 @@ fn compare(s: &Setup, changes: &[String]) {
         .result
         .parts
         .iter()
-        .map(|p| format!("{}:{:.0}%", p.part, 100.0 * p.hourglass / p.internal.max(1e-12)))
+        .map(|p| {
+            format!(
+                "{}:{:.0}%",
+                p.part,
+                100.0 * p.hourglass / p.internal.max(1e-12)
+            )
+        })
         .collect();
     println!("hourglass / internal by part id: {}", hg.join(" "));
-    let (f0, r0) = (channels(&runs[0].result, true), channels(&runs[0].result, false));
+    let (f0, r0) = (
+        channels(&runs[0].result, true),
+        channels(&runs[0].result, false),
+    );
     let n = f0[0].len();
     for (c, r) in changes.iter().zip(&runs[1..]) {
         let (f, raw) = (channels(&r.result, true), channels(&r.result, false));
         let marks: Vec<String> = [0.01, 0.02, 0.03, 0.04, 0.06, 0.08]
             .iter()
             .filter(|&&t| t <= s.end + 1e-9)
-            .map(|&t| format!("{t}: {:.4}", rel_at(&f0, &f, ((t / 1e-4) as usize).min(n - 1))))
+            .map(|&t| {
+                format!(
+                    "{t}: {:.4}",
+                    rel_at(&f0, &f, ((t / 1e-4) as usize).min(n - 1))
+                )
+            })
             .collect();
         println!(
             "{c:<32} raw {:.4}  CFC 60 {:.4}  | at {}",
@@ -442,7 +465,10 @@ fn physics(s: &Setup) {
     println!("last sample with a wall force: {:.4} s", last as f64 * 1e-4);
     println!("internal energy by part id, every 8 ms:");
     for (k, p) in r.parts.iter().enumerate().skip(8).step_by(8) {
-        let l: Vec<String> = p.iter().map(|q| format!("{}:{:.0}", q.part, q.internal)).collect();
+        let l: Vec<String> = p
+            .iter()
+            .map(|q| format!("{}:{:.0}", q.part, q.internal))
+            .collect();
         println!("  {k} ms: {}", l.join(" "));
     }
 }
@@ -453,7 +479,8 @@ fn symmetry(s: &Setup, change: &str) {
     let pos = s.airframe.node_positions();
     let nn = pos.len();
     let key = |p: [f64; 3]| p.map(|c| (c * 1e4).round() as i64);
-    let index: BTreeMap<[i64; 3], usize> = pos.iter().enumerate().map(|(i, p)| (key(*p), i)).collect();
+    let index: BTreeMap<[i64; 3], usize> =
+        pos.iter().enumerate().map(|(i, p)| (key(*p), i)).collect();
     let mirror: Vec<Option<usize>> = pos
         .iter()
         .map(|p| index.get(&key([p[0], -p[1], p[2]])).copied())
@@ -475,15 +502,27 @@ fn symmetry(s: &Setup, change: &str) {
         let mut per: BTreeMap<&str, f64> = BTreeMap::new();
         for i in 0..nn {
             if let Some(j) = mirror[i] {
-                let d = (v[i][0] - v[j][0]).abs().max((v[i][1] + v[j][1]).abs()).max((v[i][2] - v[j][2]).abs());
-                let e = per.entry(part_of[i].map_or("none", |p| p.name())).or_default();
+                let d = (v[i][0] - v[j][0])
+                    .abs()
+                    .max((v[i][1] + v[j][1]).abs())
+                    .max((v[i][2] - v[j][2]).abs());
+                let e = per
+                    .entry(part_of[i].map_or("none", |p| p.name()))
+                    .or_default();
                 *e = e.max(d);
             }
         }
         let mut l: Vec<(&str, f64)> = per.into_iter().collect();
         l.sort_by(|a, b| b.1.total_cmp(&a.1));
-        let top: Vec<String> = l.iter().take(4).map(|(k, x)| format!("{k} {x:.1e}")).collect();
-        println!("largest |v - mirrored v| (in/s) at {ms} ms: {}", top.join(", "));
+        let top: Vec<String> = l
+            .iter()
+            .take(4)
+            .map(|(k, x)| format!("{k} {x:.1e}"))
+            .collect();
+        println!(
+            "largest |v - mirrored v| (in/s) at {ms} ms: {}",
+            top.join(", ")
+        );
     }
     println!("| t (ms) | asymmetry of the nominal run | difference | antisymmetric share of it |");
     println!("|---|---|---|---|");
@@ -519,15 +558,24 @@ fn symmetry(s: &Setup, change: &str) {
         let (a, b) = (&runs[0].velocities[ms], &runs[1].velocities[ms]);
         let mut per: BTreeMap<&str, (f64, f64)> = BTreeMap::new();
         for i in 0..nn {
-            let e = per.entry(part_of[i].map_or("none", |p| p.name())).or_default();
+            let e = per
+                .entry(part_of[i].map_or("none", |p| p.name()))
+                .or_default();
             for d in 0..3 {
                 e.0 += (a[i][d] - b[i][d]).powi(2);
                 e.1 += 1.0;
             }
         }
-        let mut v: Vec<(&str, f64)> = per.into_iter().map(|(k, (s2, c))| (k, (s2 / c).sqrt())).collect();
+        let mut v: Vec<(&str, f64)> = per
+            .into_iter()
+            .map(|(k, (s2, c))| (k, (s2 / c).sqrt()))
+            .collect();
         v.sort_by(|x, y| y.1.total_cmp(&x.1));
-        let top: Vec<String> = v.iter().take(5).map(|(k, x)| format!("{k} {x:.1}")).collect();
+        let top: Vec<String> = v
+            .iter()
+            .take(5)
+            .map(|(k, x)| format!("{k} {x:.1}"))
+            .collect();
         println!("  {ms} ms: {}", top.join(", "));
     }
 }
@@ -563,7 +611,10 @@ fn main() {
         "targets" => targets(&setup),
         "compare" => compare(&setup, &rest),
         "physics" => physics(&setup),
-        "symmetry" => symmetry(&setup, rest.first().map_or("belly_panel.t*=1.001", String::as_str)),
+        "symmetry" => symmetry(
+            &setup,
+            rest.first().map_or("belly_panel.t*=1.001", String::as_str),
+        ),
         c => panic!("unknown command `{c}` (targets, compare, physics, symmetry)"),
     }
     eprintln!("{:.0} s wall time", started.elapsed().as_secs_f64());

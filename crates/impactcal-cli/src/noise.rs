@@ -7,12 +7,17 @@ use clap::Args as ClapArgs;
 use impactcal::core::noise::{JitterOptions, SimulationNoise};
 use impactcal::core::{GroupHorizon, Model};
 use impactcal::shell::DeckModel;
-use impactcal::shell::airframe::{Airframe, AirframeModel, AirframeOptions, AirframeValues, Preset, structural_space};
+use impactcal::shell::airframe::{
+    Airframe, AirframeModel, AirframeOptions, AirframeValues, Preset, structural_space,
+};
 use impactcal::shell::keyword::read_deck;
 
 use crate::error::CliError;
 use crate::output::write_json_compact;
 use crate::simulate::{BuiltIn, MeshArg};
+
+/// The group of a channel label, for the summary.
+type Grouping = Box<dyn Fn(&str) -> String>;
 
 /// Arguments of `impactcal noise`.
 #[derive(ClapArgs, Debug)]
@@ -86,7 +91,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .build()
         .map_err(|e| CliError::Failure(format!("cannot start the thread pool: {e}")))?;
     let started = std::time::Instant::now();
-    let (noise, group): (SimulationNoise, Box<dyn Fn(&str) -> String>) = match &args.deck {
+    let (noise, group): (SimulationNoise, Grouping) = match &args.deck {
         Some(path) => {
             let deck = read_deck(path).map_err(CliError::input)?;
             for w in &deck.warnings {

@@ -44,7 +44,10 @@ fn noise_of_a_deck_equals_the_library_ensemble() {
         String::from_utf8_lossy(&o.stderr).to_string()
     };
     let log = run("1");
-    assert!(log.contains("relative spread") && log.contains("z, 2"), "{log}");
+    assert!(
+        log.contains("relative spread") && log.contains("z, 2"),
+        "{log}"
+    );
     let one = read(&out);
     run("2");
     assert_eq!(read(&out), one);
@@ -55,7 +58,12 @@ fn noise_of_a_deck_equals_the_library_ensemble() {
     assert_eq!(one.labels, ["21.x", "21.y", "21.z", "42.x", "42.y", "42.z"]);
     assert_eq!(
         one.parameters,
-        ["section.1.t", "material.1.E", "material.1.sigy", "material.1.Et"]
+        [
+            "section.1.t",
+            "material.1.E",
+            "material.1.sigy",
+            "material.1.Et"
+        ]
     );
     assert!(one.spread.iter().flatten().any(|&s| s > 0.0));
 }
@@ -84,7 +92,10 @@ fn noise_of_the_airframe_groups_channels_by_part() {
     assert_eq!(noise.channels(), 1215);
     assert_eq!(noise.parameters.len(), 6);
     assert_eq!(noise.options.runs, 2);
-    assert!(log.contains("belly_panel.z,") && log.contains("tail_boom.x,"), "{log}");
+    assert!(
+        log.contains("belly_panel.z,") && log.contains("tail_boom.x,"),
+        "{log}"
+    );
 }
 
 #[test]
@@ -105,7 +116,10 @@ fn bad_input_exits_with_code_two_and_one_line() {
         (vec!["--deck", deck, "--fraction", "0"], "--fraction"),
         (vec!["--deck", deck, "--cfc", "20000"], "Nyquist"),
         (vec!["--deck", "missing.k"], "missing.k"),
-        (vec!["--deck", no_history.to_str().unwrap()], "history nodes"),
+        (
+            vec!["--deck", no_history.to_str().unwrap()],
+            "history nodes",
+        ),
         (vec!["--model", "airframe", "--preset", "table9"], "table9"),
         (vec!["--model", "airframe", "--set", "belly.t=1"], "belly.t"),
     ] {

@@ -245,8 +245,8 @@ impl SimulationNoise {
         for (j, r) in runs.iter().enumerate() {
             let same = r.labels() == nominal.labels()
                 && r.samples() == nominal.samples()
-                && r.dt() == nominal.dt()
-                && r.start() == nominal.start();
+                && (r.dt() - nominal.dt()).abs() <= 1e-9 * nominal.dt()
+                && (r.start() - nominal.start()).abs() <= 1e-9 * nominal.dt();
             if !same {
                 return Err(CoreError::Invalid(format!(
                     "run {j} does not match the nominal run (labels, samples, step or start)"
@@ -409,7 +409,7 @@ impl SimulationNoise {
 
     fn samples_until(&self, until: f64) -> usize {
         let n = self.samples();
-        if !(until >= self.start) {
+        if until.is_nan() || until < self.start {
             return 0;
         }
         (((until - self.start) / self.dt * (1.0 + 1e-12)).floor() as usize + 1).min(n)
@@ -437,6 +437,7 @@ pub struct GroupHorizon {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::float_cmp)]
 mod tests {
     use super::*;
     use crate::space::Parameter;
@@ -456,7 +457,13 @@ mod tests {
                 .iter()
                 .map(|t| 1.0 + (p[0] - 1.0) * (p[1] * t).exp())
                 .collect();
-            Histories::from_channels(vec!["s".into(), "g".into()], vec![smooth, grow], 0.01, 0.0, "m/s")
+            Histories::from_channels(
+                vec!["s".into(), "g".into()],
+                vec![smooth, grow],
+                0.01,
+                0.0,
+                "m/s",
+            )
         }
     }
 
@@ -476,7 +483,10 @@ mod tests {
         let o = JitterOptions::new(50, 1e-3, 7);
         let a = jitter_points(&space, &[1.0, 0.0], &o).unwrap();
         assert_eq!(a, jitter_points(&space, &[1.0, 0.0], &o).unwrap());
-        assert_ne!(a, jitter_points(&space, &[1.0, 0.0], &JitterOptions { seed: 8, ..o }).unwrap());
+        assert_ne!(
+            a,
+            jitter_points(&space, &[1.0, 0.0], &JitterOptions { seed: 8, ..o }).unwrap()
+        );
         for p in &a {
             assert!((p[0] - 1.0).abs() <= 1e-3);
             // A zero coordinate moves by eps times the range width (20).
@@ -529,9 +539,16 @@ mod tests {
 
     #[test]
     fn group_summaries_and_json_round_trip() {
-        let noise = SimulationNoise::measure(&model(), &[1.0, 10.0], &JitterOptions::new(6, 1e-3, 1))
-            .unwrap();
-        let groups = noise.horizons_by(0.1, |l| if l == "s" { "smooth".into() } else { "other".into() });
+        let noise =
+            SimulationNoise::measure(&model(), &[1.0, 10.0], &JitterOptions::new(6, 1e-3, 1))
+                .unwrap();
+        let groups = noise.horizons_by(0.1, |l| {
+            if l == "s" {
+                "smooth".into()
+            } else {
+                "other".into()
+            }
+        });
         assert_eq!(groups.len(), 2);
         assert_eq!(groups[0].group, "smooth");
         assert_eq!(groups[0].predictable_to_end, 1);
@@ -547,7 +564,7 @@ mod tests {
         let m = model();
         let a = m.simulate(&[1.0, 10.0]).unwrap();
         let b = a.select(&["s"]).unwrap();
-        assert!(SimulationNoise::from_runs(&a, &[a.clone()]).is_err());
+        assert!(SimulationNoise::from_runs(&a, std::slice::from_ref(&a)).is_err());
         assert!(SimulationNoise::from_runs(&a, &[a.clone(), b]).is_err());
         let ok = SimulationNoise::from_runs(&a, &[a.clone(), a.clone()]).unwrap();
         assert!(ok.spread.iter().flatten().all(|&s| s == 0.0));
@@ -561,6 +578,13 @@ mod tests {
         let raw = m.simulate(&[1.0, 10.0]).unwrap();
         let f = crate::filter::cfc_filter(raw.channel(1), 0.01, 5.0).unwrap();
         assert_eq!(noise.nominal[1], f);
-        assert!(SimulationNoise::measure(&m, &[1.0, 10.0], &JitterOptions::new(4, 1e-3, 2).with_cfc(-1.0)).is_err());
+        assert!(
+            SimulationNoise::measure(
+                &m,
+                &[1.0, 10.0],
+                &JitterOptions::new(4, 1e-3, 2).with_cfc(-1.0)
+            )
+            .is_err()
+        );
     }
 }

@@ -264,10 +264,7 @@ fn tri_local(x: &[[f64; 3]; 3]) -> Result<Local<3>, ElementFault> {
 /// configuration (node 1 at the origin, edge 1-2 along x: `[x2, x3, y3]`) is kept in
 /// `reference`; all zero means "not yet recorded": the current configuration is recorded
 /// and the frame is the edge frame.
-fn tri_local_invariant(
-    x: &[[f64; 3]; 3],
-    reference: &mut [f64],
-) -> Result<Local<3>, ElementFault> {
+fn tri_local_invariant(x: &[[f64; 3]; 3], reference: &mut [f64]) -> Result<Local<3>, ElementFault> {
     let edge = tri_local(x)?;
     let [e1, e2, e3] = edge.rot;
     let d2 = sub(x[1], x[0]);
@@ -415,8 +412,7 @@ pub fn triangle(
     } else {
         props.damping_beta(dt_e)
     };
-    let (f, internal, damping, dt_bulk) =
-        resultant_forces(&loc, &u, props, state, dt, beta, len);
+    let (f, internal, damping, dt_bulk) = resultant_forces(&loc, &u, props, state, dt, beta, len);
     let dt_out = dt_bulk * factor;
     let g = to_global(&loc.rot, &f);
     Ok(ElementOutput {

@@ -86,8 +86,11 @@ pub mod simulation;
 pub use deck_model::DeckModel;
 pub use error::{Result, ShellError};
 pub use model::{
-    BodyLoadZ, BulkViscosity, Control, CowperSymonds, Curve, Hourglass, HourglassForm, InitialVelocity, Material,
-    MaterialLaw, Node, NodeSet, NodeTarget, Output, Part, PartStiffnessDamping, PointMass, RigidWall, Section, Shell,
-    ShellModel, Spc, ThicknessRule, VelocityTarget, WallMethod,
+    BodyLoadZ, BulkViscosity, Control, CowperSymonds, Curve, Hourglass, HourglassForm,
+    InitialVelocity, Material, MaterialLaw, Node, NodeSet, NodeTarget, Output, Part,
+    PartStiffnessDamping, PointMass, RigidWall, Section, Shell, ShellModel, Spc, ThicknessRule,
+    VelocityTarget, WallMethod,
 };
-pub use simulation::{Energies, PartEnergies, Progress, Quantity, RunResult, RunSummary, Simulation};
+pub use simulation::{
+    Energies, PartEnergies, Progress, Quantity, RunResult, RunSummary, Simulation,
+};

@@ -4,13 +4,13 @@
 
 use impactcal_core::Model;
 use impactcal_core::filter::cfc_filter;
-use rayon::prelude::*;
 use impactcal_shell::Simulation;
 use impactcal_shell::airframe::{
     Airframe, AirframeModel, AirframeOptions, AirframeValues, GRAVITY, MeshDensity, Preset,
     catalogue,
 };
 use impactcal_shell::keyword::{parse_deck, write_deck};
+use rayon::prelude::*;
 
 fn coarse(end_time: f64) -> Airframe {
     let mut o = AirframeOptions::new(MeshDensity::Coarse);
@@ -377,7 +377,11 @@ fn the_impact_is_predictable_over_its_first_20_ms() {
         (num / den).sqrt()
     };
     let (d_t, d_dt) = (rel(&runs[0], &runs[1]), rel(&runs[0], &runs[2]));
-    eprintln!("+0.1 % belly panel: {:.3} %, TSSFAC halved: {:.3} %", 100.0 * d_t, 100.0 * d_dt);
+    eprintln!(
+        "+0.1 % belly panel: {:.3} %, TSSFAC halved: {:.3} %",
+        100.0 * d_t,
+        100.0 * d_dt
+    );
     assert!(d_t > 1e-5 && d_t < 0.0025, "{d_t}");
     assert!(d_dt < 0.016, "{d_dt}");
 }

@@ -53,7 +53,12 @@ fn stiffness_damping_decays_a_mode_at_beta_omega_over_two() {
     // First the undamped frequency of this mesh.
     m.control.end_time = 0.05;
     let r = Simulation::new(&m).unwrap().run().unwrap();
-    let uz = r.displacement.unwrap().channel_by_label(&format!("{centre}.z")).unwrap().to_vec();
+    let uz = r
+        .displacement
+        .unwrap()
+        .channel_by_label(&format!("{centre}.z"))
+        .unwrap()
+        .to_vec();
     let z = zero_crossings(&uz[5..], 1e-5);
     let omega = 2.0 * std::f64::consts::PI / (2.0 * (z[3] - z[0]) / 3.0);
     // 3 % of critical at that frequency.
@@ -65,7 +70,12 @@ fn stiffness_damping_decays_a_mode_at_beta_omega_over_two() {
     }];
     m.control.end_time = 0.07;
     let r = Simulation::new(&m).unwrap().run().unwrap();
-    let uz = r.displacement.unwrap().channel_by_label(&format!("{centre}.z")).unwrap().to_vec();
+    let uz = r
+        .displacement
+        .unwrap()
+        .channel_by_label(&format!("{centre}.z"))
+        .unwrap()
+        .to_vec();
     // Successive maxima of |uz| (half periods).
     let mut peaks = Vec::new();
     for k in 1..uz.len() - 1 {
@@ -76,18 +86,27 @@ fn stiffness_damping_decays_a_mode_at_beta_omega_over_two() {
     assert!(peaks.len() >= 6, "{} peaks", peaks.len());
     let halves = (peaks.len() - 1) as f64;
     let delta = 2.0 * (peaks[0] / peaks[peaks.len() - 1]).ln() / halves;
-    let measured = delta / (4.0 * std::f64::consts::PI * std::f64::consts::PI + delta * delta).sqrt();
+    let measured =
+        delta / (4.0 * std::f64::consts::PI * std::f64::consts::PI + delta * delta).sqrt();
     eprintln!("zeta measured {measured:.4} vs {zeta} (beta {beta:.3e}, omega {omega:.1})");
     assert!(rel(measured, zeta) < 0.08, "zeta {measured} vs {zeta}");
     // The energy balance closes with the damping energy booked.
     let e = r.summary.energies;
     assert!(e.damping > 0.5 * e.initial, "{e:?}");
-    assert!((r.summary.energy_ratio - 1.0).abs() < 2e-3, "{}", r.summary.energy_ratio);
+    assert!(
+        (r.summary.energy_ratio - 1.0).abs() < 2e-3,
+        "{}",
+        r.summary.energy_ratio
+    );
     // The step shrinks by sqrt(1 + z^2) - z with z = beta / dt_e: for z >> 1, by 2 z.
     let dt_e = (1.0 / 6.0) / 2f64.sqrt() / (E / (RHO * (1.0 - NU * NU))).sqrt();
     let z = beta / dt_e;
     let expect = 0.9 * dt_e * ((1.0 + z * z).sqrt() - z);
-    assert!(rel(r.summary.dt_first, expect) < 1e-9, "{} vs {expect}", r.summary.dt_first);
+    assert!(
+        rel(r.summary.dt_first, expect) < 1e-9,
+        "{} vs {expect}",
+        r.summary.dt_first
+    );
 }
 
 /// A free plate in rigid translation and spin keeps its kinetic energy: stiffness damping
@@ -106,7 +125,10 @@ fn rigid_body_motion_is_not_damped() {
     iv.centre = [0.03, 0.03, 0.0];
     iv.axis = [0.3, 0.2, 1.0];
     m.initial_velocities.push(iv);
-    m.stiffness_damping = vec![PartStiffnessDamping { part: 1, coef: 0.25 }];
+    m.stiffness_damping = vec![PartStiffnessDamping {
+        part: 1,
+        coef: 0.25,
+    }];
     m.bulk_viscosity = Some(BulkViscosity::default());
     let mut sim = Simulation::new(&m).unwrap();
     let e0 = sim.energies().kinetic;
@@ -181,7 +203,12 @@ fn damped_penalty_wall_rebounds_like_a_spring_dashpot() {
         m.control.tssfac = tssfac;
         m.control.end_time = 1e-3 / v0 + 20.0 / w;
         let r = Simulation::new(&m).unwrap().run().unwrap();
-        let vz = r.velocity.unwrap().channel_by_label("13.z").unwrap().to_vec();
+        let vz = r
+            .velocity
+            .unwrap()
+            .channel_by_label("13.z")
+            .unwrap()
+            .to_vec();
         let rebound = *vz.last().unwrap() / v0;
         eprintln!("TSSFAC {tssfac}: rebound {rebound:.4} vs {e_expected:.4}");
         errors.push(rel(rebound, e_expected));
@@ -264,14 +291,24 @@ fn invariant_numbering_makes_results_independent_of_node_order() {
         let h = r.velocity.unwrap();
         (0..h.channels())
             .flat_map(|c| {
-                let sign = if mirror && h.labels()[c].ends_with(".y") { -1.0 } else { 1.0 };
-                h.channel(c).iter().map(move |v| sign * v).collect::<Vec<_>>()
+                let sign = if mirror && h.labels()[c].ends_with(".y") {
+                    -1.0
+                } else {
+                    1.0
+                };
+                h.channel(c)
+                    .iter()
+                    .map(move |v| sign * v)
+                    .collect::<Vec<_>>()
             })
             .collect()
     };
     let diff = |a: &[f64], b: &[f64]| {
         let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-        a.iter().zip(b).fold(0.0f64, |s, (x, y)| s.max((x - y).abs())) / scale
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |s, (x, y)| s.max((x - y).abs()))
+            / scale
     };
     for invariant in [true, false] {
         let a = velocities(&m, invariant, false);

@@ -12,8 +12,8 @@ mod common;
 use common::*;
 use impactcal_shell::keyword::{parse_deck, write_deck};
 use impactcal_shell::{
-    BulkViscosity, CowperSymonds, HourglassForm, InitialVelocity, Material, MaterialLaw,
-    NodeSet, NodeTarget, PartStiffnessDamping, RigidWall, Section, ShellError, Simulation, Spc,
+    BulkViscosity, CowperSymonds, HourglassForm, InitialVelocity, Material, MaterialLaw, NodeSet,
+    NodeTarget, PartStiffnessDamping, RigidWall, Section, ShellError, Simulation, Spc,
     VelocityTarget, WallMethod,
 };
 
@@ -225,9 +225,15 @@ $   slsfac    rwpnal
         }
     );
     // SLSFAC is not used: a warning says so.
-    assert!(deck.warnings.iter().any(|w| w.contains("RWPNAL")), "{:?}", deck.warnings);
+    assert!(
+        deck.warnings.iter().any(|w| w.contains("RWPNAL")),
+        "{:?}",
+        deck.warnings
+    );
     // Written and read again: the same model; and it runs.
-    let back = parse_deck(&write_deck(m).unwrap(), "again.k").unwrap().model;
+    let back = parse_deck(&write_deck(m).unwrap(), "again.k")
+        .unwrap()
+        .model;
     assert_eq!(&back, m);
     let r = Simulation::new(m).unwrap().run().unwrap();
     assert!((r.summary.energy_ratio - 1.0).abs() < 0.05);
@@ -238,10 +244,26 @@ $   slsfac    rwpnal
     assert!(d.warnings.iter().any(|w| w.contains("solids only")));
     // Bad values are typed errors naming the keyword and line.
     for (from, to, keyword) in [
-        ("                        -2", "                         7", "*CONTROL_BULK_VISCOSITY"),
-        ("         0         2", "         0         9", "*CONTROL_ACCURACY"),
-        ("       0.1      0.25", "       0.1       1.5", "*CONTROL_CONTACT"),
-        ("         1      0.08", "         1       abc", "*DAMPING_PART_STIFFNESS"),
+        (
+            "                        -2",
+            "                         7",
+            "*CONTROL_BULK_VISCOSITY",
+        ),
+        (
+            "         0         2",
+            "         0         9",
+            "*CONTROL_ACCURACY",
+        ),
+        (
+            "       0.1      0.25",
+            "       0.1       1.5",
+            "*CONTROL_CONTACT",
+        ),
+        (
+            "         1      0.08",
+            "         1       abc",
+            "*DAMPING_PART_STIFFNESS",
+        ),
     ] {
         match parse_deck(&text.replace(from, to), "bad.k") {
             Err(ShellError::Keyword { keyword: k, .. }) => assert_eq!(k, keyword),
@@ -252,9 +274,16 @@ $   slsfac    rwpnal
     let undefined = text.replace("         1      0.08", "         9      0.08");
     assert!(matches!(
         err(&undefined),
-        ShellError::Reference { what: "part", id: 9, .. }
+        ShellError::Reference {
+            what: "part",
+            id: 9,
+            ..
+        }
     ));
-    let twice = text.replace("         1      0.08", "         1      0.08\n         1      0.02");
+    let twice = text.replace(
+        "         1      0.08",
+        "         1      0.08\n         1      0.02",
+    );
     assert!(matches!(err(&twice), ShellError::Reference { id: 1, .. }));
     // Features the cards cannot express are refused by the writer.
     let mut damped = m.clone();

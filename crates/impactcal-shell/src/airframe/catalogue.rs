@@ -348,7 +348,9 @@ pub fn structural_space() -> Result<ParameterSpace> {
     let names: Vec<String> = catalogue()
         .into_iter()
         .map(|a| a.name)
-        .filter(|n| n.starts_with("mass.") || [".t", ".E", ".Et", ".sigy"].iter().any(|f| n.ends_with(f)))
+        .filter(|n| {
+            n.starts_with("mass.") || [".t", ".E", ".Et", ".sigy"].iter().any(|f| n.ends_with(f))
+        })
         .collect();
     space_of(&names)
 }

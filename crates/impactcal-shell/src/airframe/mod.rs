@@ -45,8 +45,8 @@ pub use catalogue::{
 
 use crate::error::{Result, ShellError};
 use crate::model::{
-    BulkViscosity, CowperSymonds, InitialVelocity, Material, MaterialLaw, Part, RigidWall,
-    Section, ShellModel, VelocityTarget, WallMethod,
+    BulkViscosity, CowperSymonds, InitialVelocity, Material, MaterialLaw, Part, RigidWall, Section,
+    ShellModel, VelocityTarget, WallMethod,
 };
 use crate::simulation::{RunResult, Simulation};
 use mesh::{Counts, MassSite, Mesh};

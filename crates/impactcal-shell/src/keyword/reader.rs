@@ -5,8 +5,8 @@ use std::path::Path;
 use crate::error::{Result, ShellError};
 use crate::model::{
     BodyLoadZ, BulkViscosity, CowperSymonds, Curve, HourglassForm, InitialVelocity, Material,
-    MaterialLaw, NodeSet, NodeTarget, Part, PartStiffnessDamping, PointMass, RigidWall,
-    Section, ShellModel, Spc, ThicknessRule, VelocityTarget, WallMethod,
+    MaterialLaw, NodeSet, NodeTarget, Part, PartStiffnessDamping, PointMass, RigidWall, Section,
+    ShellModel, Spc, ThicknessRule, VelocityTarget, WallMethod,
 };
 
 /// Output-only keywords that are skipped with a warning (their cards are ignored).

@@ -133,7 +133,12 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             ));
         }
         w("*CONTROL_BULK_VISCOSITY".into());
-        w(format!("{}{}{}", real(b.q1, 10), real(b.q2, 10), int_signed(-2, 10)));
+        w(format!(
+            "{}{}{}",
+            real(b.q1, 10),
+            real(b.q2, 10),
+            int_signed(-2, 10)
+        ));
     }
     if c.invariant_numbering {
         w("*CONTROL_ACCURACY".into());
