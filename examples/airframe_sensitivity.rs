@@ -491,12 +491,9 @@ fn symmetry(s: &Setup, change: &str) {
         mirror.iter().flatten().count(),
         nn
     );
-    let mut part_of = vec![None; nn];
-    for (n, p) in s.airframe.shells() {
-        for id in n {
-            part_of[id as usize - 1].get_or_insert(p);
-        }
-    }
+    let part_of: Vec<_> = (1..=nn as u64)
+        .map(|id| s.airframe.part_of_node(id))
+        .collect();
     for ms in [1usize, 2] {
         let v = &runs[0].velocities[ms.min(runs[0].velocities.len() - 1)];
         let mut per: BTreeMap<&str, f64> = BTreeMap::new();
@@ -512,16 +509,9 @@ fn symmetry(s: &Setup, change: &str) {
                 *e = e.max(d);
             }
         }
-        let mut l: Vec<(&str, f64)> = per.into_iter().collect();
-        l.sort_by(|a, b| b.1.total_cmp(&a.1));
-        let top: Vec<String> = l
-            .iter()
-            .take(4)
-            .map(|(k, x)| format!("{k} {x:.1e}"))
-            .collect();
         println!(
             "largest |v - mirrored v| (in/s) at {ms} ms: {}",
-            top.join(", ")
+            largest(per.into_iter().collect(), 4, |x| format!("{x:.1e}"))
         );
     }
     println!("| t (ms) | asymmetry of the nominal run | difference | antisymmetric share of it |");
@@ -566,18 +556,22 @@ fn symmetry(s: &Setup, change: &str) {
                 e.1 += 1.0;
             }
         }
-        let mut v: Vec<(&str, f64)> = per
+        let rms = per
             .into_iter()
             .map(|(k, (s2, c))| (k, (s2 / c).sqrt()))
             .collect();
-        v.sort_by(|x, y| y.1.total_cmp(&x.1));
-        let top: Vec<String> = v
-            .iter()
-            .take(5)
-            .map(|(k, x)| format!("{k} {x:.1}"))
-            .collect();
-        println!("  {ms} ms: {}", top.join(", "));
+        println!("  {ms} ms: {}", largest(rms, 5, |x| format!("{x:.1}")));
     }
+}
+
+/// The `count` largest values with their names, largest first, as `name value, ...`.
+fn largest(mut v: Vec<(&str, f64)>, count: usize, fmt: impl Fn(f64) -> String) -> String {
+    v.sort_by(|a, b| b.1.total_cmp(&a.1));
+    v.iter()
+        .take(count)
+        .map(|(k, x)| format!("{k} {}", fmt(*x)))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn main() {

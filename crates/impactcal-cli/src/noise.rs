@@ -7,43 +7,27 @@ use clap::Args as ClapArgs;
 use impactcal::core::noise::{JitterOptions, SimulationNoise};
 use impactcal::core::{GroupHorizon, Model};
 use impactcal::shell::DeckModel;
-use impactcal::shell::airframe::{
-    Airframe, AirframeModel, AirframeOptions, AirframeValues, Preset, structural_space,
-};
-use impactcal::shell::keyword::read_deck;
+use impactcal::shell::airframe::{AirframeModel, Preset, structural_space};
 
 use crate::error::CliError;
 use crate::output::write_json_compact;
-use crate::simulate::{BuiltIn, MeshArg};
+use crate::simulate::Source;
 
 /// The group of a channel label, for the summary.
 type Grouping = Box<dyn Fn(&str) -> String>;
 
 /// Arguments of `impactcal noise`.
 #[derive(ClapArgs, Debug)]
-#[command(group(clap::ArgGroup::new("source").required(true).args(["deck", "model"])))]
 pub struct Args {
-    /// A keyword deck: every section thickness, material E, yield stress and tangent
+    /// The model: a deck (every section thickness, material E, yield stress and tangent
     /// modulus and concentrated mass is jittered; the output is the velocity of the
-    /// *DATABASE_HISTORY_NODE nodes.
-    #[arg(long)]
-    pub deck: Option<PathBuf>,
-    /// A built-in model instead of a deck (the airframe: every part's t, E, Et, sigy and
-    /// the five masses are jittered; the output is the 1,215 sensor velocities).
-    #[arg(long, value_enum)]
-    pub model: Option<BuiltIn>,
-    /// Mesh density of the built-in airframe.
-    #[arg(long, value_enum, default_value_t, requires = "model")]
-    pub mesh: MeshArg,
-    /// Set a quantity of the built-in airframe (repeatable): the point of the ensemble.
-    #[arg(long = "set", value_name = "NAME=VALUE", requires = "model")]
-    pub set: Vec<String>,
+    /// *DATABASE_HISTORY_NODE nodes) or the airframe (every part's t, E, Et, sigy and the
+    /// five masses are jittered; the output is the 1,215 sensor velocities).
+    #[command(flatten)]
+    pub source: Source,
     /// Jitter only the quantities of a preset of the airframe (`table1` or `table2`).
     #[arg(long, requires = "model")]
     pub preset: Option<String>,
-    /// Simulated time of the built-in airframe in seconds (0.08 by default).
-    #[arg(long, requires = "model")]
-    pub end_time: Option<f64>,
     /// Number of jittered runs.
     #[arg(long, default_value_t = 8)]
     pub runs: usize,
@@ -91,28 +75,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .build()
         .map_err(|e| CliError::Failure(format!("cannot start the thread pool: {e}")))?;
     let started = std::time::Instant::now();
-    let (noise, group): (SimulationNoise, Grouping) = match &args.deck {
+    let (noise, group): (SimulationNoise, Grouping) = match &args.source.deck {
         Some(path) => {
-            let deck = read_deck(path).map_err(CliError::input)?;
-            for w in &deck.warnings {
-                eprintln!("impactcal: warning: {w}");
-            }
-            let model = DeckModel::new(deck.model).map_err(CliError::input)?;
+            let model = DeckModel::new(args.source.deck_model(path)?).map_err(CliError::input)?;
             let point = model.space().nominal();
             let noise = measure(&pool, &model, &point, &options)?;
             (noise, Box::new(|l: &str| axis(l).to_string()))
         }
         None => {
-            let mut o = AirframeOptions::new(args.mesh.into());
-            if let Some(t) = args.end_time {
-                o.end_time = t;
-                o.output_interval = o.output_interval.min(t);
-            }
-            let airframe = Airframe::new(o).map_err(CliError::input)?;
-            let mut values = AirframeValues::nominal();
-            for a in &args.set {
-                values.assign(a).map_err(CliError::input)?;
-            }
+            let (airframe, values) = args.source.airframe()?;
             let space = match &args.preset {
                 Some(p) => Preset::parse(p).and_then(|p| p.space()),
                 None => structural_space(),

@@ -115,7 +115,6 @@ fn bad_input_exits_with_code_two_and_one_line() {
         (vec!["--deck", deck, "--eps", "0"], "eps"),
         (vec!["--deck", deck, "--fraction", "0"], "--fraction"),
         (vec!["--deck", deck, "--cfc", "20000"], "Nyquist"),
-        (vec!["--deck", "missing.k"], "missing.k"),
         (
             vec!["--deck", no_history.to_str().unwrap()],
             "history nodes",
@@ -132,4 +131,8 @@ fn bad_input_exits_with_code_two_and_one_line() {
         assert_eq!(errors.len(), 1, "{err}");
         assert!(err.contains(needle), "{all:?}: {err}");
     }
+    // An unreadable deck is an I/O failure (exit 1), as for `simulate`.
+    let o = impactcal(&["noise", "--out", out, "--deck", "missing.k"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing.k"));
 }

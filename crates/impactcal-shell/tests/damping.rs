@@ -6,41 +6,34 @@ mod common;
 
 use common::*;
 use impactcal_shell::{
-    BulkViscosity, InitialVelocity, NodeSet, NodeTarget, PartStiffnessDamping, RigidWall,
-    ShellModel, Simulation, Spc, VelocityTarget, WallMethod,
+    BulkViscosity, InitialVelocity, PartStiffnessDamping, RigidWall, ShellModel, Simulation,
+    VelocityTarget, WallMethod,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// The simply supported plate of V5 (1 m, 10 mm), 6 x 6 quads, started in its first mode.
+/// The simply supported plate of V5 (1 m, 10 mm), 6 x 6 quads, started in its first mode,
+/// and its centre node.
 fn plate_in_its_first_mode() -> (ShellModel, u64) {
-    let (a, t, n) = (1.0, 0.01, 6);
-    let mut m = plate(n, n, a, a, [0.0; 3]);
-    with_section(&mut m, t, aluminium(1));
-    let edge: Vec<u64> = m
-        .nodes
-        .iter()
-        .filter(|p| p.x[0] < 1e-9 || p.x[1] < 1e-9 || p.x[0] > a - 1e-9 || p.x[1] > a - 1e-9)
-        .map(|p| p.id)
-        .collect();
-    m.node_sets.push(NodeSet { id: 1, nodes: edge });
-    m.spcs.push(Spc {
-        target: NodeTarget::NodeSet(1),
-        dofs: [false, false, true, false, false, false],
-    });
-    let pi = std::f64::consts::PI;
-    for p in m.nodes.clone() {
-        let (sx, cx) = (pi * p.x[0] / a).sin_cos();
-        let (sy, cy) = (pi * p.x[1] / a).sin_cos();
-        let mut iv =
-            InitialVelocity::translation(VelocityTarget::Node(p.id), [0.0, 0.0, 0.1 * sx * sy]);
-        iv.rotation = [0.1 * pi / a * sx * cy, -0.1 * pi / a * cx * sy, 0.0];
-        m.initial_velocities.push(iv);
-    }
+    let n = 6;
+    let mut m = simply_supported_plate_in_first_mode(1.0, 0.01, n);
     let centre = node_id(n, n / 2, n / 2);
     m.output.history_nodes = vec![centre];
     m.output.interval = 1e-5;
     (m, centre)
+}
+
+/// The centre deflection history of a run.
+fn centre_deflection(m: &ShellModel, centre: u64) -> (Vec<f64>, impactcal_shell::RunResult) {
+    let r = Simulation::new(m).unwrap().run().unwrap();
+    let uz = r
+        .displacement
+        .as_ref()
+        .unwrap()
+        .channel_by_label(&format!("{centre}.z"))
+        .unwrap()
+        .to_vec();
+    (uz, r)
 }
 
 /// Rayleigh damping `beta K` damps a mode of circular frequency `omega` at the fraction of
@@ -52,13 +45,7 @@ fn stiffness_damping_decays_a_mode_at_beta_omega_over_two() {
     let (mut m, centre) = plate_in_its_first_mode();
     // First the undamped frequency of this mesh.
     m.control.end_time = 0.05;
-    let r = Simulation::new(&m).unwrap().run().unwrap();
-    let uz = r
-        .displacement
-        .unwrap()
-        .channel_by_label(&format!("{centre}.z"))
-        .unwrap()
-        .to_vec();
+    let (uz, _) = centre_deflection(&m, centre);
     let z = zero_crossings(&uz[5..], 1e-5);
     let omega = 2.0 * std::f64::consts::PI / (2.0 * (z[3] - z[0]) / 3.0);
     // 3 % of critical at that frequency.
@@ -69,13 +56,7 @@ fn stiffness_damping_decays_a_mode_at_beta_omega_over_two() {
         coef: -beta,
     }];
     m.control.end_time = 0.07;
-    let r = Simulation::new(&m).unwrap().run().unwrap();
-    let uz = r
-        .displacement
-        .unwrap()
-        .channel_by_label(&format!("{centre}.z"))
-        .unwrap()
-        .to_vec();
+    let (uz, r) = centre_deflection(&m, centre);
     // Successive maxima of |uz| (half periods).
     let mut peaks = Vec::new();
     for k in 1..uz.len() - 1 {
