@@ -11,7 +11,7 @@ use impactcal::shell::airframe::{AirframeModel, Preset, structural_space};
 
 use crate::error::CliError;
 use crate::output::write_json_compact;
-use crate::simulate::Source;
+use crate::simulate::{Source, thread_pool};
 
 /// The group of a channel label, for the summary.
 type Grouping = Box<dyn Fn(&str) -> String>;
@@ -64,16 +64,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut options = JitterOptions::new(args.runs, args.eps, args.seed);
     options.cfc = args.cfc;
     options.validate()?;
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = args.threads {
-        if n == 0 {
-            return Err(CliError::Input("--threads must be at least 1".into()));
-        }
-        builder = builder.num_threads(n);
-    }
-    let pool = builder
-        .build()
-        .map_err(|e| CliError::Failure(format!("cannot start the thread pool: {e}")))?;
+    let pool = thread_pool(args.threads)?;
     let started = std::time::Instant::now();
     let (noise, group): (SimulationNoise, Grouping) = match &args.source.deck {
         Some(path) => {

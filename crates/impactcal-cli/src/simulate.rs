@@ -140,19 +140,24 @@ fn load(args: &Args) -> Result<(ShellModel, String), CliError> {
     Ok((model, "the airframe".into()))
 }
 
-/// Runs the subcommand.
-pub fn run(args: Args) -> Result<(), CliError> {
-    let (model, name) = load(&args)?;
+/// A thread pool of `--threads` threads (rayon's default when absent).
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, CliError> {
     let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = args.threads {
+    if let Some(n) = threads {
         if n == 0 {
             return Err(CliError::Input("--threads must be at least 1".into()));
         }
         builder = builder.num_threads(n);
     }
-    let pool = builder
+    builder
         .build()
-        .map_err(|e| CliError::Failure(format!("cannot start the thread pool: {e}")))?;
+        .map_err(|e| CliError::Failure(format!("cannot start the thread pool: {e}")))
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let (model, name) = load(&args)?;
+    let pool = thread_pool(args.threads)?;
     let started = std::time::Instant::now();
     let result = pool.install(|| -> Result<_, ShellError> {
         let mut sim = Simulation::new(&model)?;
