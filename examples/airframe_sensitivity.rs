@@ -4,7 +4,7 @@
 //! ```text
 //! cargo run --release --example airframe_sensitivity -- targets [--variant SPEC] [--end T]
 //! cargo run --release --example airframe_sensitivity -- compare [--variant SPEC] [--end T] CHANGE...
-//! cargo run --release --example airframe_sensitivity -- physics [--variant SPEC] [--end T]
+//! cargo run --release --example airframe_sensitivity -- physics [--variant SPEC] [--end T] [--svg FILE]
 //! cargo run --release --example airframe_sensitivity -- symmetry [--variant SPEC] [--end T] CHANGE
 //! ```
 //!
@@ -20,7 +20,8 @@
 //! - `compare`: relative L2 (raw and CFC 60) of each CHANGE against the nominal run, and the
 //!   pointwise relative difference at a few times.
 //! - `physics`: centre-of-mass velocity, rigid-body and deformation kinetic energy, energy
-//!   split and wall force every 4 ms, internal energy by part.
+//!   split and wall force every 4 ms, internal energy by part; with `--svg` a picture of the
+//!   centre-of-mass vertical velocity and the energy split.
 //! - `symmetry`: the left-right asymmetry of the nominal run, and for CHANGE the growth of
 //!   the difference, its antisymmetric share and the parts where it is largest.
 //!
@@ -223,6 +224,8 @@ struct Setup {
     values: AirframeValues,
     variant: String,
     end: f64,
+    /// `physics --svg FILE`: where to draw the centre-of-mass velocity and energy split.
+    svg: Option<String>,
 }
 
 impl Setup {
@@ -434,7 +437,10 @@ fn physics(s: &Setup) {
         "| t (ms) | v_x com | v_z com | pitch rate (rad/s) | KE rigid | KE deformation | KE nodal rotations | internal | elastic | plastic | hourglass | wall, normal | wall, friction | damping | wall force (lbf) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for ms in (0..r.velocities.len()).step_by(4) {
+    // Per millisecond: v_z of the centre of mass, and the energy split for the plot.
+    let mut vz = Vec::new();
+    let mut split: Vec<[f64; 7]> = Vec::new();
+    for ms in 0..r.velocities.len() {
         let v = &r.velocities[ms];
         let (ke_rigid, vc, w) = rigid_body(v, &r.positions[ms], &r.masses);
         let ke: f64 = v
@@ -443,6 +449,19 @@ fn physics(s: &Setup) {
             .map(|(vi, m)| 0.5 * m * (vi[0] * vi[0] + vi[1] * vi[1] + vi[2] * vi[2]))
             .sum();
         let k = (ms * 10).min(ie.len() - 1);
+        vz.push(vc[2]);
+        split.push([
+            ke_rigid,
+            ke_all[k] - ke_rigid,
+            r.elastic[ms],
+            ie[k] - r.elastic[ms],
+            fr[k],
+            ct[k] - fr[k],
+            hg[k] + dp[k],
+        ]);
+        if ms % 4 != 0 {
+            continue;
+        }
         println!(
             "| {ms} | {:.1} | {:.1} | {:.2} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} |",
             vc[0],
@@ -463,6 +482,10 @@ fn physics(s: &Setup) {
     }
     let last = wf.iter().rposition(|f| f.abs() > 0.0).unwrap_or(0);
     println!("last sample with a wall force: {:.4} s", last as f64 * 1e-4);
+    if let Some(path) = &s.svg {
+        std::fs::write(path, physics_svg(&vz, &split, last as f64 * 1e-4)).unwrap();
+        println!("wrote {path}");
+    }
     println!("internal energy by part id, every 8 ms:");
     for (k, p) in r.parts.iter().enumerate().skip(8).step_by(8) {
         let l: Vec<String> = p
@@ -564,6 +587,141 @@ fn symmetry(s: &Setup, change: &str) {
     }
 }
 
+/// Two panels, one sample per millisecond: the vertical velocity of the centre of mass,
+/// and the split of the initial kinetic energy (stacked areas).
+fn physics_svg(vz: &[f64], split: &[[f64; 7]], contact_end: f64) -> String {
+    use std::fmt::Write;
+    let names = [
+        "kinetic, rigid body",
+        "kinetic, deformation and nodal rotations",
+        "elastic",
+        "plastic",
+        "friction",
+        "wall, normal",
+        "hourglass and damping",
+    ];
+    let colours = [
+        "#4e79a7", "#a0cbe8", "#59a14f", "#e15759", "#f28e2b", "#b07aa1", "#9c755f",
+    ];
+    let (w, h, left, top) = (640.0, 260.0, 70.0, 30.0);
+    let n = vz.len() - 1;
+    let x = |k: usize| left + w * k as f64 / n as f64;
+    let mut svg = String::new();
+    let height = 2.0 * (h + 2.0 * top) + 20.0;
+    let _ = write!(
+        svg,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{height}\" \
+         font-family=\"sans-serif\" font-size=\"12\">\n",
+        w + left + 330.0
+    );
+    // Panel 1: v_z of the centre of mass, -320 to 80 in/s.
+    let y1 = |v: f64| top + h * (80.0 - v) / 400.0;
+    let _ = writeln!(
+        svg,
+        "<text x=\"{left}\" y=\"18\">vertical velocity of the centre of mass (in/s)</text>"
+    );
+    for v in [-300.0, -200.0, -100.0, 0.0, 60.0] {
+        let _ = writeln!(
+            svg,
+            "<line x1=\"{left}\" x2=\"{}\" y1=\"{y}\" y2=\"{y}\" stroke=\"#ddd\"/>\
+             <text x=\"{}\" y=\"{}\" text-anchor=\"end\">{v}</text>",
+            left + w,
+            left - 6.0,
+            y1(v) + 4.0,
+            y = y1(v)
+        );
+    }
+    let xc = left + w * contact_end * 1e3 / n as f64;
+    let _ = writeln!(
+        svg,
+        "<line x1=\"{xc}\" x2=\"{xc}\" y1=\"{top}\" y2=\"{}\" stroke=\"#999\" stroke-dasharray=\"4\"/>\
+         <text x=\"{}\" y=\"{}\">last ground contact</text>",
+        top + h,
+        xc + 4.0,
+        top + 14.0
+    );
+    let pts: Vec<String> = vz
+        .iter()
+        .enumerate()
+        .map(|(k, v)| format!("{:.1},{:.1}", x(k), y1(*v)))
+        .collect();
+    let _ = writeln!(
+        svg,
+        "<polyline fill=\"none\" stroke=\"#4e79a7\" stroke-width=\"2\" points=\"{}\"/>",
+        pts.join(" ")
+    );
+    // Panel 2: stacked energy split, 0 to the initial kinetic energy.
+    let top2 = 2.0 * top + h + 20.0;
+    let total = split[0].iter().sum::<f64>();
+    let y2 = |e: f64| top2 + h * (1.0 - e / total);
+    let _ = writeln!(
+        svg,
+        "<text x=\"{left}\" y=\"{}\">where the initial kinetic energy goes (in·lbf, stacked)</text>",
+        top2 - 12.0
+    );
+    let mut below = vec![0.0; split.len()];
+    for (c, (name, colour)) in names.iter().zip(colours).enumerate() {
+        let upper: Vec<f64> = split
+            .iter()
+            .zip(&below)
+            .map(|(s, b)| b + s[c].max(0.0))
+            .collect();
+        let mut pts: Vec<String> = upper
+            .iter()
+            .enumerate()
+            .map(|(k, e)| format!("{:.1},{:.1}", x(k), y2(*e)))
+            .collect();
+        pts.extend(
+            below
+                .iter()
+                .enumerate()
+                .rev()
+                .map(|(k, e)| format!("{:.1},{:.1}", x(k), y2(*e))),
+        );
+        let _ = writeln!(
+            svg,
+            "<polygon fill=\"{colour}\" stroke=\"none\" points=\"{}\"/>",
+            pts.join(" ")
+        );
+        let ly = top2 + 16.0 * c as f64 + 10.0;
+        let _ = writeln!(
+            svg,
+            "<rect x=\"{}\" y=\"{}\" width=\"12\" height=\"12\" fill=\"{colour}\"/><text x=\"{}\" y=\"{}\">{name}</text>",
+            left + w + 14.0,
+            ly - 10.0,
+            left + w + 30.0,
+            ly
+        );
+        below = upper;
+    }
+    for e in [0.0, 100_000.0, 200_000.0, 300_000.0] {
+        let _ = writeln!(
+            svg,
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{e}</text>",
+            left - 6.0,
+            y2(e) + 4.0
+        );
+    }
+    for (panel_top, label_y) in [(top, top + h + 16.0), (top2, top2 + h + 16.0)] {
+        for ms in (0..=n).step_by(10) {
+            let _ = writeln!(
+                svg,
+                "<text x=\"{}\" y=\"{label_y}\" text-anchor=\"middle\">{ms}</text>",
+                x(ms)
+            );
+        }
+        let _ = writeln!(
+            svg,
+            "<rect x=\"{left}\" y=\"{panel_top}\" width=\"{w}\" height=\"{h}\" fill=\"none\" stroke=\"#333\"/>\
+             <text x=\"{}\" y=\"{}\">t (ms)</text>",
+            left + w + 10.0,
+            label_y
+        );
+    }
+    svg.push_str("</svg>\n");
+    svg
+}
+
 /// The `count` largest values with their names, largest first, as `name value, ...`.
 fn largest(mut v: Vec<(&str, f64)>, count: usize, fmt: impl Fn(f64) -> String) -> String {
     v.sort_by(|a, b| b.1.total_cmp(&a.1));
@@ -579,8 +737,10 @@ fn main() {
     let command = args.next().unwrap_or_else(|| "targets".into());
     let (mut variant, mut end, mut sets, mut rest) = (String::new(), 0.08, Vec::new(), Vec::new());
     let mut mesh = MeshDensity::Coarse;
+    let mut svg = None;
     while let Some(a) = args.next() {
         match a.as_str() {
+            "--svg" => svg = Some(args.next().expect("--svg FILE")),
             "--mesh" => mesh = MeshDensity::parse(&args.next().expect("--mesh NAME")).unwrap(),
             "--variant" => variant = args.next().expect("--variant SPEC"),
             "--end" => end = args.next().expect("--end T").parse().unwrap(),
@@ -599,6 +759,7 @@ fn main() {
         values,
         variant,
         end,
+        svg,
     };
     let started = std::time::Instant::now();
     match command.as_str() {
