@@ -608,10 +608,10 @@ fn physics_svg(vz: &[f64], split: &[[f64; 7]], contact_end: f64) -> String {
     let x = |k: usize| left + w * k as f64 / n as f64;
     let mut svg = String::new();
     let height = 2.0 * (h + 2.0 * top) + 20.0;
-    let _ = write!(
+    let _ = writeln!(
         svg,
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{height}\" \
-         font-family=\"sans-serif\" font-size=\"12\">\n",
+         font-family=\"sans-serif\" font-size=\"12\">",
         w + left + 330.0
     );
     // Panel 1: v_z of the centre of mass, -320 to 80 in/s.
