@@ -7,10 +7,13 @@
 //! - plane-stress J2 plasticity with linear isotropic hardening by the exact return, and
 //!   optional Cowper-Symonds rate scaling ([`material`]);
 //! - lumped masses with scaled rotary inertia, point masses, gravity, mass-proportional
-//!   damping, single-point constraints;
+//!   damping, stiffness-proportional damping per part, shell bulk viscosity, single-point
+//!   constraints, optional invariant node numbering;
 //! - central-difference integration with the critical step recomputed every cycle
 //!   ([`Simulation`]);
-//! - stationary rigid planes with Coulomb friction (kinematic constraint or penalty);
+//! - stationary rigid planes with Coulomb friction (kinematic constraint, or penalty with a
+//!   normal dashpot);
+//! - any model as an [`impactcal_core::Model`] ([`DeckModel`]);
 //! - energies, wall force and nodal histories as [`impactcal_core::Histories`] with labels
 //!   `<node>.<x|y|z>`;
 //! - the LS-DYNA keyword subset in and out ([`keyword`]).
