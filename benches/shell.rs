@@ -35,6 +35,7 @@ fn kernel(c: &mut Criterion) {
     let opts = KernelOptions {
         projection: true,
         isdo_diagonal: false,
+        invariant: false,
     };
     let dt = Simulation::new(&m).unwrap().dt();
     for _ in 0..20 {

@@ -10,6 +10,7 @@ mod error;
 mod expand;
 mod filter;
 mod metrics;
+mod noise;
 mod optimize;
 mod output;
 mod place;
@@ -53,6 +54,9 @@ enum Command {
     /// Run an LS-DYNA keyword deck with the built-in explicit shell solver; write nodal
     /// histories and energies as CSV.
     Simulate(simulate::Args),
+    /// The noise a model produces on its own: a jitter ensemble at one point gives the
+    /// spread per channel and time and each channel's predictability horizon (JSON).
+    Noise(noise::Args),
     /// Space-filling samples (Halton, Sobol', Latin hypercubes) and Saltelli designs.
     Sample(sample::Args),
     /// Sobol' sensitivity indices of every output column.
@@ -78,6 +82,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Optimize(a) => optimize::run(a),
         Command::Place(a) => place::run(a),
         Command::Simulate(a) => simulate::run(a),
+        Command::Noise(a) => noise::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Sobol(a) => sobol::run(a),
         Command::Airframe(a) => airframe::run(a),

@@ -12,6 +12,14 @@ pub fn write_json(value: &impl serde::Serialize, out: Option<&Path>) -> Result<(
     write_text(&(text + "\n"), out)
 }
 
+/// Writes `value` as compact JSON to `out` (for large results that programs read).
+pub fn write_json_compact(value: &impl serde::Serialize, out: &Path) -> Result<(), CliError> {
+    let (mut w, name) = writer(Some(out))?;
+    serde_json::to_writer(&mut w, value)
+        .map_err(|e| CliError::io(format!("{name}: cannot write the JSON: {e}")))?;
+    w.flush().map_err(|e| CliError::io(format!("{name}: {e}")))
+}
+
 /// Writes `text` to `out`, or to stdout when `out` is `None`.
 pub fn write_text(text: &str, out: Option<&Path>) -> Result<(), CliError> {
     match out {

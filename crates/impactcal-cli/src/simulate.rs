@@ -52,10 +52,10 @@ impl From<MeshArg> for MeshDensity {
     }
 }
 
-/// Arguments of `impactcal simulate`.
+/// The model a command runs: a keyword deck, or the built-in airframe with its settings.
 #[derive(ClapArgs, Debug)]
 #[command(group(clap::ArgGroup::new("source").required(true).args(["deck", "model"])))]
-pub struct Args {
+pub struct Source {
     /// The keyword deck (`.k`).
     #[arg(long)]
     pub deck: Option<PathBuf>,
@@ -72,6 +72,41 @@ pub struct Args {
     /// Simulated time of the built-in airframe in seconds (0.08 by default).
     #[arg(long, requires = "model")]
     pub end_time: Option<f64>,
+}
+
+impl Source {
+    /// The built-in airframe with the `--mesh` and `--end-time` options, and the values
+    /// with the `--set` assignments.
+    pub fn airframe(&self) -> Result<(Airframe, AirframeValues), CliError> {
+        let mut options = AirframeOptions::new(self.mesh.into());
+        if let Some(t) = self.end_time {
+            options.end_time = t;
+            options.output_interval = options.output_interval.min(t);
+        }
+        let airframe = Airframe::new(options)?;
+        let mut values = AirframeValues::nominal();
+        for a in &self.set {
+            values.assign(a)?;
+        }
+        Ok((airframe, values))
+    }
+
+    /// The deck's model, with its warnings printed on stderr.
+    pub fn deck_model(&self, path: &std::path::Path) -> Result<ShellModel, CliError> {
+        let deck = read_deck(path)?;
+        for w in &deck.warnings {
+            eprintln!("impactcal: warning: {w}");
+        }
+        Ok(deck.model)
+    }
+}
+
+/// Arguments of `impactcal simulate`.
+#[derive(ClapArgs, Debug)]
+pub struct Args {
+    /// The model to run.
+    #[command(flatten)]
+    pub source: Source,
     /// Write the nodal histories of *DATABASE_HISTORY_NODE (for the airframe: its sensor
     /// nodes) here (wide CSV, labels `<node>.<x|y|z>`).
     #[arg(long)]
@@ -90,40 +125,32 @@ pub struct Args {
 /// The model to run and a name for messages: the deck, or the built-in airframe with the
 /// `--set` values.
 fn load(args: &Args) -> Result<(ShellModel, String), CliError> {
-    if let Some(path) = &args.deck {
-        let deck = read_deck(path)?;
-        for w in &deck.warnings {
-            eprintln!("impactcal: warning: {w}");
-        }
-        return Ok((deck.model, path.display().to_string()));
+    if let Some(path) = &args.source.deck {
+        return Ok((args.source.deck_model(path)?, path.display().to_string()));
     }
-    let mut options = AirframeOptions::new(args.mesh.into());
-    if let Some(t) = args.end_time {
-        options.end_time = t;
-        options.output_interval = options.output_interval.min(t);
-    }
-    let airframe = Airframe::new(options)?;
-    let mut values = AirframeValues::nominal();
-    for a in &args.set {
-        values.assign(a)?;
-    }
+    let (airframe, values) = args.source.airframe()?;
     let model = airframe.model(&values)?;
     Ok((model, "the airframe".into()))
 }
 
-/// Runs the subcommand.
-pub fn run(args: Args) -> Result<(), CliError> {
-    let (model, name) = load(&args)?;
+/// A thread pool of `--threads` threads (rayon's default when absent).
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, CliError> {
     let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = args.threads {
+    if let Some(n) = threads {
         if n == 0 {
             return Err(CliError::input("--threads must be at least 1"));
         }
         builder = builder.num_threads(n);
     }
-    let pool = builder
+    builder
         .build()
-        .map_err(|e| CliError::failure(format!("cannot start the thread pool: {e}")))?;
+        .map_err(|e| CliError::failure(format!("cannot start the thread pool: {e}")))
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let (model, name) = load(&args)?;
+    let pool = thread_pool(args.threads)?;
     let started = std::time::Instant::now();
     let result = pool.install(|| -> Result<_, ShellError> {
         let mut sim = Simulation::new(&model)?;

@@ -6,7 +6,13 @@
 //!   and its conversions from and to rows.
 //! - [`ParameterSpace`] and [`Parameter`]: named bounded parameters, the unit-cube map of
 //!   single points and of whole matrices, and bounds files `name,lower,upper,nominal[,unit]`.
+//! - [`testdata`]: measured data in: CSV records on their own time base, ISO-MME data sets,
+//!   channel maps from test to model labels.
+//! - [`signal`]: SAE J211 / ISO 6487 CFC filters, interpolation of model histories onto test
+//!   time points, resampling and cropping.
 //! - [`Model`]: a parameter vector in, histories out, with parallel batch evaluation.
+//! - [`noise`]: the noise a model produces on its own, measured with a jitter ensemble
+//!   ([`SimulationNoise`]: spread per channel and time, predictability horizons).
 //! - [`sampling`]: Halton (plain and scrambled), Sobol' (Joe-Kuo, optionally Owen-scrambled),
 //!   Latin hypercube and symmetric Latin hypercube samples, seeded, mapped onto a space.
 //! - [`Table`]: the numeric CSV reader every file of the project goes through, reporting the
@@ -33,6 +39,7 @@
 pub mod error;
 pub mod histories;
 pub mod model;
+pub mod noise;
 pub mod points;
 pub mod samples;
 pub mod sampling;
@@ -45,6 +52,7 @@ pub mod testdata;
 pub use error::{CoreError, ErrorKind, ParamGuard, Result, check_finite, check_finite_mat};
 pub use histories::Histories;
 pub use model::{BatchResults, Model, RunFailure};
+pub use noise::{GroupHorizon, JitterOptions, SimulationNoise};
 pub use points::PointRows;
 pub use samples::{Samples, read_samples};
 pub use sampling::Method as SamplingMethod;

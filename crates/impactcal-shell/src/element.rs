@@ -65,6 +65,15 @@ pub struct PartProps {
     pub hg_form: HourglassForm,
     /// Hourglass coefficients (membrane, out-of-plane, rotation).
     pub hg: [f64; 3],
+    /// Stiffness-proportional damping coefficient in the sign convention of
+    /// [`crate::model::PartStiffnessDamping::coef`] (0: none).
+    pub stiffness_damping: f64,
+    /// Moments of the thickness rule `[sum w_k z_k, sum w_k z_k^2]` (physical heights), which
+    /// turn strain rates into the resultants of the stiffness damping.
+    pub z_moments: [f64; 2],
+    /// Shell bulk viscosity coefficients `[Q1, Q2]` (`[0, 0]`: none), see
+    /// [`crate::model::BulkViscosity`].
+    pub bulk: [f64; 2],
 }
 
 impl PartProps {
@@ -73,15 +82,59 @@ impl PartProps {
     /// positive thickness, 1 to 10 points, Lobatto with at least 2).
     pub fn new(section: &Section, material: &Material, hourglass: &Hourglass) -> Self {
         let (zeta, w) = thickness_rule(section.nip, section.rule == ThicknessRule::Lobatto);
+        let z: Vec<f64> = zeta.iter().map(|z| 0.5 * z * section.thickness).collect();
+        let z_moments = [
+            z.iter().zip(&w).map(|(z, w)| w * z).sum(),
+            z.iter().zip(&w).map(|(z, w)| w * z * z).sum(),
+        ];
         PartProps {
             t: section.thickness,
-            z: zeta.iter().map(|z| 0.5 * z * section.thickness).collect(),
+            z,
             w,
             shear_factor: section.shear_factor,
             mat: MaterialProps::new(material),
             hg_form: hourglass.form,
             hg: [hourglass.membrane, hourglass.transverse, hourglass.rotation],
+            stiffness_damping: 0.0,
+            z_moments,
+            bulk: [0.0, 0.0],
         }
+    }
+
+    /// The same part with stiffness-proportional damping `coef` (see
+    /// [`crate::model::PartStiffnessDamping`]).
+    #[must_use]
+    pub fn with_stiffness_damping(mut self, coef: f64) -> Self {
+        self.stiffness_damping = coef;
+        self
+    }
+
+    /// The Rayleigh coefficient `beta` of an element whose undamped stable step is `dt_e`,
+    /// and the factor `sqrt(1 + zeta^2) - zeta` on its stable step, `zeta = beta / dt_e`
+    /// (the fraction of critical damping at the element's highest frequency `2 / dt_e`).
+    #[inline]
+    pub fn damping_beta(&self, dt_e: f64) -> (f64, f64) {
+        let c = self.stiffness_damping;
+        let beta = if c > 0.0 { c * dt_e } else { -c };
+        let zeta = beta / dt_e;
+        (beta, (1.0 + zeta * zeta).sqrt() - zeta)
+    }
+
+    /// Shell bulk viscosity for the areal strain rate `rate` (`d_xx + d_yy`) of an element
+    /// of characteristic length `len`: the in-plane pressure
+    /// `q = rho len (Q1^2 len rate^2 - Q2 c rate)` while the area shrinks (`rate < 0`, else
+    /// 0) and the stable step `len / (Q + sqrt(Q^2 + c^2))`, `Q = Q1^2 len |rate| + Q2 c`.
+    #[inline]
+    pub fn bulk_pressure(&self, rate: f64, len: f64) -> (f64, f64) {
+        let c = self.mat.wave_speed;
+        if !(rate < 0.0) || self.bulk == [0.0, 0.0] {
+            return (0.0, len / c);
+        }
+        let [q1, q2] = self.bulk;
+        let a = q1 * q1 * len * rate.abs();
+        let q = self.mat.rho * len * (a * rate.abs() + q2 * c * rate.abs());
+        let big_q = a + q2 * c;
+        (q, len / (big_q + (big_q * big_q + c * c).sqrt()))
     }
 }
 
@@ -97,6 +150,8 @@ pub struct ElementOutput {
     pub internal: f64,
     /// Hourglass energy increment of the cycle.
     pub hourglass: f64,
+    /// Energy removed by stiffness-proportional damping in the cycle.
+    pub damping: f64,
 }
 
 /// Why an element could not be evaluated.
@@ -124,6 +179,9 @@ pub struct KernelOptions {
     pub projection: bool,
     /// ISDO 1: characteristic length = area / longest diagonal.
     pub isdo_diagonal: bool,
+    /// Invariant node numbering (LS-DYNA INN 2): the quad frame's first axis bisects the
+    /// diagonals instead of following the edges 1-2 and 4-3.
+    pub invariant: bool,
 }
 
 /// Frame and centre derivatives of an element on its current geometry.
@@ -197,7 +255,43 @@ fn tri_local(x: &[[f64; 3]; 3]) -> Result<Local<3>, ElementFault> {
     let e3 = normalise(cross(d21, sub(x[2], x[0]))).ok_or(ElementFault::Degenerate)?;
     let e1 = normalise(d21).ok_or(ElementFault::Degenerate)?;
     let e2 = cross(e3, e1);
-    let rot = [e1, e2, e3];
+    tri_local_in(x, [e1, e2, e3])
+}
+
+/// The triangle's frame turned in its plane by the rotation of the polar decomposition of
+/// its in-plane deformation gradient since the reference configuration, so that the frame
+/// follows the mean rotation of the material rather than the edge 1-2. The reference
+/// configuration (node 1 at the origin, edge 1-2 along x: `[x2, x3, y3]`) is kept in
+/// `reference`; all zero means "not yet recorded": the current configuration is recorded
+/// and the frame is the edge frame.
+fn tri_local_invariant(x: &[[f64; 3]; 3], reference: &mut [f64]) -> Result<Local<3>, ElementFault> {
+    let edge = tri_local(x)?;
+    let [e1, e2, e3] = edge.rot;
+    let d2 = sub(x[1], x[0]);
+    let d3 = sub(x[2], x[0]);
+    let (a, b, c) = (dot(d2, e1), dot(d3, e1), dot(d3, e2));
+    if reference[0] == 0.0 {
+        reference[0] = a;
+        reference[1] = b;
+        reference[2] = c;
+        return Ok(edge);
+    }
+    let (x2, x3, y3) = (reference[0], reference[1], reference[2]);
+    // F = [[a, b], [0, c]] [[x2, x3], [0, y3]]^-1; polar angle atan2(F21 - F12, F11 + F22).
+    let f11 = a / x2;
+    let f12 = b / y3 - a * x3 / (x2 * y3);
+    let f22 = c / y3;
+    let psi = (-f12).atan2(f11 + f22);
+    let (s, co) = psi.sin_cos();
+    let r1 = [
+        co * e1[0] + s * e2[0],
+        co * e1[1] + s * e2[1],
+        co * e1[2] + s * e2[2],
+    ];
+    tri_local_in(x, [r1, cross(e3, r1), e3])
+}
+
+fn tri_local_in(x: &[[f64; 3]; 3], rot: [[f64; 3]; 3]) -> Result<Local<3>, ElementFault> {
     let r = local_coords(x, &rot);
     let (x1, x2, x3) = (r[0][0], r[1][0], r[2][0]);
     let (y1, y2, y3) = (r[0][1], r[1][1], r[2][1]);
@@ -282,7 +376,9 @@ pub fn quad_batch(
 }
 
 /// Evaluates one C0 triangle for one cycle (as [`quad`], without hourglass control or
-/// projection; row 3 of the forces is zero).
+/// projection; row 3 of the forces is zero). With `opts.invariant` the frame follows the
+/// polar rotation of the element since its first evaluation (recorded in the state's
+/// unused hourglass slots), so the result does not depend on the node numbering.
 ///
 /// # Errors
 /// [`ElementFault::Degenerate`] when the current geometry has no area or is inverted.
@@ -293,8 +389,13 @@ pub fn triangle(
     props: &PartProps,
     state: &mut [f64],
     dt: f64,
+    opts: KernelOptions,
 ) -> Result<ElementOutput, ElementFault> {
-    let loc = tri_local(x)?;
+    let loc = if opts.invariant {
+        tri_local_invariant(x, &mut state[2..5])?
+    } else {
+        tri_local(x)?
+    };
     let mut u = [[0.0; 6]; 3];
     for i in 0..3 {
         for k in 0..3 {
@@ -302,15 +403,24 @@ pub fn triangle(
             u[i][3 + k] = dot(loc.rot[k], omega[i]);
         }
     }
-    let (f, internal, _) = resultant_forces(&loc, &u, props, state, dt);
     let d = |i: usize, j: usize| norm(sub(x[i], x[j]));
     let side = d(0, 1).max(d(1, 2)).max(d(2, 0));
+    let len = 2.0 * loc.area / side;
+    let dt_e = len / props.mat.wave_speed;
+    let (beta, factor) = if props.stiffness_damping == 0.0 {
+        (0.0, 1.0)
+    } else {
+        props.damping_beta(dt_e)
+    };
+    let (f, internal, damping, dt_bulk) = resultant_forces(&loc, &u, props, state, dt, beta, len);
+    let dt_out = dt_bulk * factor;
     let g = to_global(&loc.rot, &f);
     Ok(ElementOutput {
         f: [g[0], g[1], g[2], [0.0; 6]],
-        dt: 2.0 * loc.area / side / props.mat.wave_speed,
+        dt: dt_out,
         internal,
         hourglass: 0.0,
+        damping,
     })
 }
 
@@ -325,15 +435,20 @@ fn to_global<const N: usize>(rot: &[[f64; 3]; 3], f: &[[f64; 6]; N]) -> [[f64; 6
     g
 }
 
-/// Strain rates, material update through the thickness, resultants and local nodal forces.
-/// Returns the local forces, the internal energy increment and 0.
+/// Strain rates, material update through the thickness, resultants and local nodal forces,
+/// with stiffness-proportional damping `beta` (0: none) and the bulk viscosity of an element
+/// of characteristic length `len`. Returns the local forces, the internal energy increment,
+/// the damping energy increment (stiffness damping and bulk viscosity) and the stable step
+/// with the bulk viscosity (`len / c` without it).
 fn resultant_forces<const N: usize>(
     loc: &Local<N>,
     u: &[[f64; 6]; N],
     props: &PartProps,
     state: &mut [f64],
     dt: f64,
-) -> ([[f64; 6]; N], f64, f64) {
+    beta: f64,
+    len: f64,
+) -> ([[f64; 6]; N], f64, f64, f64) {
     let (b1, b2) = (&loc.b1, &loc.b2);
     let (mut dxx, mut dyy, mut gxy) = (0.0, 0.0, 0.0);
     let (mut kxx, mut kyy, mut kxy) = (0.0, 0.0, 0.0);
@@ -409,6 +524,47 @@ fn resultant_forces<const N: usize>(
     head[1] = qy;
     internal += 0.5 * a * dt * ((qx0 + qx) * gxz + (qy0 + qy) * gyz);
 
+    // Stiffness-proportional damping: beta times the elastic resultants of the rates.
+    let mut damping = 0.0;
+    let (mut qx, mut qy) = (qx, qy);
+    if beta > 0.0 {
+        let c12 = mat.nu * mat.c11;
+        let [z1, z2] = props.z_moments;
+        let sm = [
+            mat.c11 * dxx + c12 * dyy,
+            c12 * dxx + mat.c11 * dyy,
+            mat.g * gxy,
+        ];
+        let sb = [
+            mat.c11 * kxx + c12 * kyy,
+            c12 * kxx + mat.c11 * kyy,
+            mat.g * kxy,
+        ];
+        let n_d = [0, 1, 2].map(|k| beta * (sm[k] + z1 * sb[k]));
+        let m_d = [0, 1, 2].map(|k| beta * (z1 * sm[k] + z2 * sb[k]));
+        let qs = beta * props.shear_factor * mat.g * t;
+        let (qdx, qdy) = (qs * gxz, qs * gyz);
+        let power = t * (n_d[0] * dxx + n_d[1] * dyy + n_d[2] * gxy)
+            + t * (m_d[0] * kxx + m_d[1] * kyy + m_d[2] * kxy)
+            + qdx * gxz
+            + qdy * gyz;
+        damping = dt * a * power;
+        nxx += n_d[0];
+        nyy += n_d[1];
+        nxy += n_d[2];
+        mxx += m_d[0];
+        myy += m_d[1];
+        mxy += m_d[2];
+        qx += qdx;
+        qy += qdy;
+    }
+    let (qb, dt_bulk) = props.bulk_pressure(dxx + dyy, len);
+    if qb > 0.0 {
+        damping -= dt * a * t * qb * (dxx + dyy);
+        nxx -= qb;
+        nyy -= qb;
+    }
+
     let (nxx, nyy, nxy) = (t * a * nxx, t * a * nyy, t * a * nxy);
     let (mxx, myy, mxy) = (t * a * mxx, t * a * myy, t * a * mxy);
     let (qxa, qya) = (a * qx * inv_n, a * qy * inv_n);
@@ -423,7 +579,7 @@ fn resultant_forces<const N: usize>(
             0.0,
         ];
     }
-    (f, internal, 0.0)
+    (f, internal, damping, dt_bulk)
 }
 
 /// Area of the current geometry of a quad or triangle and whether it is usable, for

@@ -173,8 +173,17 @@ pub(crate) fn quad_block(
     let n3 = cross3(d31, d42);
     let len3 = dot3(n3, n3).sqrt();
     let mut a = [V::default(); 3];
-    for k in 0..3 {
-        a[k] = xs[1][k] - xs[0][k] + xs[2][k] - xs[3][k];
+    if opts.invariant {
+        // Bisector of the two diagonals: the same frame, up to quarter turns, whichever
+        // node is numbered first and whichever way the nodes run.
+        let (i31, i42) = (1.0 / dot3(d31, d31).sqrt(), 1.0 / dot3(d42, d42).sqrt());
+        for k in 0..3 {
+            a[k] = d31[k] * i31 - d42[k] * i42;
+        }
+    } else {
+        for k in 0..3 {
+            a[k] = xs[1][k] - xs[0][k] + xs[2][k] - xs[3][k];
+        }
     }
     let inv3 = 1.0 / len3;
     let e3 = [n3[0] * inv3, n3[1] * inv3, n3[2] * inv3];
@@ -295,6 +304,31 @@ pub(crate) fn quad_block(
         V::splat(1.0)
     };
 
+    // Characteristic length: sqrt is monotonic, so the longest length is the root of the
+    // largest square.
+    let sq = |a: V3| dot3(a, a);
+    let diag2 = sq(d31).max(sq(d42));
+    let len2 = if opts.isdo_diagonal {
+        diag2
+    } else {
+        sq(sub3(xs[1], xs[0]))
+            .max(sq(sub3(xs[2], xs[1])))
+            .max(sq(sub3(xs[3], xs[2])))
+            .max(sq(sub3(xs[0], xs[3])))
+            .max(diag2)
+    };
+    let len = area / len2.sqrt();
+    let mut dt_e = len / mat.wave_speed;
+    // Stiffness-proportional damping: Rayleigh beta per lane and the damped stable step.
+    let mut step_factor = V::splat(1.0);
+    let beta = (props.stiffness_damping != 0.0).then(|| {
+        let mut beta = V::default();
+        for l in 0..LANES {
+            (beta.0[l], step_factor.0[l]) = props.damping_beta(dt_e.0[l]);
+        }
+        beta
+    });
+
     // Through the thickness.
     let base = blk.slot.map(|e| e * stride);
     let (c11, c12, g) = (mat.c11, mat.nu * mat.c11, mat.g);
@@ -367,16 +401,54 @@ pub(crate) fn quad_block(
     let qy = qy0 + ks * gyz;
     internal += 0.5 * area * dt * ((qx0 + qx) * gxz + (qy0 + qy) * gyz);
 
+    // Damping resultants beta C (rates), added to the forces, not to the state.
+    let mut damping = V::default();
+    let (mut qxf, mut qyf) = (qx, qy);
+    if let Some(beta) = beta {
+        let [z1, z2] = props.z_moments;
+        let sm = [c11 * dxx + c12 * dyy, c12 * dxx + c11 * dyy, g * gxy];
+        let sb = [c11 * kxx + c12 * kyy, c12 * kxx + c11 * kyy, g * kxy];
+        let n_d = [0, 1, 2].map(|k| beta * (sm[k] + z1 * sb[k]));
+        let m_d = [0, 1, 2].map(|k| beta * (z1 * sm[k] + z2 * sb[k]));
+        let qs = beta * (props.shear_factor * g * t);
+        let (qdx, qdy) = (qs * gxz, qs * gyz);
+        let power = t * (n_d[0] * dxx + n_d[1] * dyy + n_d[2] * gxy)
+            + t * (m_d[0] * kxx + m_d[1] * kyy + m_d[2] * kxy)
+            + qdx * gxz
+            + qdy * gyz;
+        damping = dt * area * power;
+        nxx += n_d[0];
+        nyy += n_d[1];
+        nxy += n_d[2];
+        mxx += m_d[0];
+        myy += m_d[1];
+        mxy += m_d[2];
+        qxf += qdx;
+        qyf += qdy;
+    }
+    // Bulk viscosity: an in-plane pressure while the area shrinks, and its smaller step.
+    if props.bulk != [0.0, 0.0] {
+        let rate = dxx + dyy;
+        for l in 0..LANES {
+            let (q, dt_b) = props.bulk_pressure(rate.0[l], len.0[l]);
+            dt_e.0[l] = dt_b;
+            damping.0[l] -= dt * area.0[l] * t * q * rate.0[l];
+            nxx.0[l] -= q;
+            nyy.0[l] -= q;
+        }
+    }
+    dt_e = dt_e * step_factor;
+
     let ta = t * area;
     let (nxx, nyy, nxy) = (ta * nxx, ta * nyy, ta * nxy);
     let (mxx, myy, mxy) = (ta * mxx, ta * myy, ta * mxy);
-    let (qxa, qya) = (area * qx * 0.25, area * qy * 0.25);
+    let (qxa, qya) = (area * qxf * 0.25, area * qyf * 0.25);
     let mut f = [[V::default(); 6]; 4];
     for i in 0..4 {
         f[i] = [
             b1[i] * nxx + b2[i] * nxy,
             b2[i] * nyy + b1[i] * nxy,
-            area * (b1[i] * qx + b2[i] * qy),
+            area * (b1[i] * qxf + b2[i] * qyf),
             -b2[i] * myy - b1[i] * mxy - qya,
             b1[i] * mxx + b2[i] * mxy + qxa,
             V::default(),
@@ -412,11 +484,17 @@ pub(crate) fn quad_block(
             cc[4] = cc[3];
         }
         HourglassForm::Viscous => {
-            let base = 0.25 * mat.rho * mat.wave_speed * t * area.sqrt();
+            // Each mode's coefficient is r times its impedance sqrt(S m) (S its
+            // stiffness-form coefficient at r = 1, m its nodal mass or rotary inertia),
+            // scaled so that the membrane modes keep r rho c t sqrt(A) / 4.
+            let root = area.sqrt();
+            let base = 0.25 * mat.rho * mat.wave_speed * t * root;
             cc[0] = rm * base;
             cc[1] = cc[0];
-            cc[2] = rw * base;
-            cc[3] = (rb * t * t / 12.0) * base;
+            let w = (props.shear_factor / (3.0 * (1.0 + mat.nu))).sqrt();
+            cc[2] = rw * w * t * base / root;
+            let inertia = (area * 0.125).max(V::splat(t * t / 12.0));
+            cc[3] = (rb * t) * base * (inertia * (1.0 / 24.0)).sqrt();
             cc[4] = cc[3];
         }
     }
@@ -441,6 +519,14 @@ pub(crate) fn quad_block(
             st[2 + k] = hg[k].0[l];
         }
     }
+    // The stiffness damping also acts on the hourglass stiffness (stiffness form).
+    if let (Some(beta), HourglassForm::Stiffness) = (beta, props.hg_form) {
+        for k in 0..5 {
+            let hd = beta * cc[k] * q[k];
+            damping += dt * hd * q[k];
+            hg[k] += hd;
+        }
+    }
     for i in 0..4 {
         for k in 0..5 {
             f[i][k] += gam[i] * hg[k];
@@ -463,21 +549,6 @@ pub(crate) fn quad_block(
         }
     }
 
-    // Characteristic length: sqrt is monotonic, so the longest length is the root of the
-    // largest square.
-    let sq = |a: V3| dot3(a, a);
-    let diag2 = sq(d31).max(sq(d42));
-    let len2 = if opts.isdo_diagonal {
-        diag2
-    } else {
-        sq(sub3(xs[1], xs[0]))
-            .max(sq(sub3(xs[2], xs[1])))
-            .max(sq(sub3(xs[3], xs[2])))
-            .max(sq(sub3(xs[0], xs[3])))
-            .max(diag2)
-    };
-    let dt_e = area / len2.sqrt() / mat.wave_speed;
-
     // Back to the global frame, into the slots.
     let mut gf = [[V::default(); 6]; 4];
     for i in 0..4 {
@@ -496,6 +567,7 @@ pub(crate) fn quad_block(
         o.dt = dt_e.0[l];
         o.internal = internal.0[l];
         o.hourglass = hourglass.0[l];
+        o.damping = damping.0[l];
         faults[blk.slot[l]] = fault[l];
     }
 }
@@ -613,6 +685,9 @@ mod tests {
             }),
             hg_form: HourglassForm::Stiffness,
             hg: [0.05, 0.05, 0.05],
+            stiffness_damping: 0.0,
+            z_moments: [0.0, 0.1 * 0.2025 * t * t * 2.0 + 0.2 * 0.0625 * t * t * 2.0],
+            bulk: [0.0, 0.0],
         }
     }
 
@@ -657,6 +732,7 @@ mod tests {
         let opts = KernelOptions {
             projection: true,
             isdo_diagonal: false,
+            invariant: false,
         };
         let dt = 2e-6;
         // Full and partial blocks in turn, elements in reverse lane order.
@@ -808,6 +884,7 @@ mod tests {
             let on = KernelOptions {
                 projection: true,
                 isdo_diagonal: false,
+                invariant: false,
             };
             let off = KernelOptions {
                 projection: false,

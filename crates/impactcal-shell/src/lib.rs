@@ -7,10 +7,13 @@
 //! - plane-stress J2 plasticity with linear isotropic hardening by the exact return, and
 //!   optional Cowper-Symonds rate scaling ([`material`]);
 //! - lumped masses with scaled rotary inertia, point masses, gravity, mass-proportional
-//!   damping, single-point constraints;
+//!   damping, stiffness-proportional damping per part, shell bulk viscosity, single-point
+//!   constraints, optional invariant node numbering;
 //! - central-difference integration with the critical step recomputed every cycle
 //!   ([`Simulation`]);
-//! - stationary rigid planes with Coulomb friction (kinematic constraint or penalty);
+//! - stationary rigid planes with Coulomb friction (kinematic constraint, or penalty with a
+//!   normal dashpot);
+//! - any model as an [`impactcal_core::Model`] ([`DeckModel`]);
 //! - energies, wall force and nodal histories as [`impactcal_core::Histories`] with labels
 //!   `<node>.<x|y|z>`;
 //! - the LS-DYNA keyword subset in and out ([`keyword`]).
@@ -72,6 +75,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod airframe;
+pub mod deck_model;
 pub mod element;
 pub mod error;
 mod geometry;
@@ -82,10 +86,14 @@ pub mod model;
 mod setup;
 pub mod simulation;
 
+pub use deck_model::DeckModel;
 pub use error::{Result, ShellError};
 pub use model::{
-    BodyLoadZ, Control, CowperSymonds, Curve, Hourglass, HourglassForm, InitialVelocity, Material,
-    MaterialLaw, Node, NodeSet, NodeTarget, Output, Part, PointMass, RigidWall, Section, Shell,
-    ShellModel, Spc, ThicknessRule, VelocityTarget, WallMethod,
+    BodyLoadZ, BulkViscosity, Control, CowperSymonds, Curve, Hourglass, HourglassForm,
+    InitialVelocity, Material, MaterialLaw, Node, NodeSet, NodeTarget, Output, Part,
+    PartStiffnessDamping, PointMass, RigidWall, Section, Shell, ShellModel, Spc, ThicknessRule,
+    VelocityTarget, WallMethod,
 };
-pub use simulation::{Energies, Progress, Quantity, RunResult, RunSummary, Simulation};
+pub use simulation::{
+    Energies, PartEnergies, Progress, Quantity, RunResult, RunSummary, Simulation,
+};

@@ -219,10 +219,18 @@ pub enum WallMethod {
     /// Kinematic constraint (the default): the normal velocity of a node that would cross
     /// the plane during the next step is set so that it lands on the plane.
     Kinematic,
-    /// Penalty spring with mass-based stiffness `k = alpha m / dt^2` on penetration.
+    /// Penalty spring with mass-based stiffness `k = alpha m / dt_ref^2` on penetration,
+    /// `dt_ref` the smallest element step of the undeformed model before the safety factor
+    /// (fixed for the run, so the contact stiffness does not change with TSSFAC), with a
+    /// normal dashpot `c = 2 zeta sqrt(k m)` (zeta = `damping`, LS-DYNA's VDC / 100) on the
+    /// normal velocity while the node penetrates. The normal force never pulls: spring plus
+    /// dashpot is clipped at zero. Each node is an oscillator of circular frequency
+    /// `sqrt(alpha) / dt_ref`, stable for any TSSFAC <= 1 when alpha <= 1.
     Penalty {
         /// The stiffness factor alpha (0.1 is a safe choice), 0 < alpha <= 1.
         alpha: f64,
+        /// Fraction of critical damping of the node-on-spring oscillator, 0 <= zeta <= 1.
+        damping: f64,
     },
 }
 
@@ -302,6 +310,53 @@ pub struct BodyLoadZ {
     pub scale: f64,
 }
 
+/// Stiffness-proportional (Rayleigh beta) damping of the shells of one part
+/// (`*DAMPING_PART_STIFFNESS`).
+///
+/// Each element adds the viscous resultants `beta (N, M, Q)(rates)`: its elastic stiffness
+/// (membrane, bending, transverse shear and, in the stiffness form, the hourglass
+/// stiffness) applied to its deformation rates. Strain and hourglass rates vanish on
+/// rigid-body motion, so translation and rotation of the whole part are never damped.
+/// A mode of circular frequency `omega` is damped at the fraction of critical
+/// `zeta = beta omega / 2`.
+///
+/// `coef` follows the sign convention of LS-DYNA's COEF:
+/// - `coef > 0`: `zeta = coef` at each element's highest frequency `omega_e = 2 / dt_e`
+///   (`dt_e` its stable step), i.e. `beta_e = coef dt_e`; lower frequencies get
+///   proportionally less (`zeta = coef omega / omega_e`). LS-DYNA recommends 0.01 to 0.25 for
+///   its own (unpublished) positive-COEF formula, which this definition follows in spirit.
+/// - `coef < 0`: `beta = |coef|` (time unit), the classic Rayleigh coefficient.
+///
+/// The stable step of a damped element shrinks to `dt_e (sqrt(1 + zeta_e^2) - zeta_e)`.
+/// The energy removed is reported as damping energy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PartStiffnessDamping {
+    /// Part id.
+    pub part: u64,
+    /// The coefficient (see the type's docs); 0 switches the damping off.
+    pub coef: f64,
+}
+
+/// Bulk viscosity of the shells (`*CONTROL_BULK_VISCOSITY` with TYPE -1 or -2): while an
+/// element's area shrinks (areal strain rate `r = d_xx + d_yy < 0`), an in-plane pressure
+/// `q = rho L (Q1^2 L r^2 - Q2 c r)` acts on its membrane, `L` its characteristic length and
+/// `c` the plate wave speed; it spreads compressive membrane shocks over a few elements.
+/// The element's stable step becomes `L / (Q + sqrt(Q^2 + c^2))`, `Q = Q1^2 L |r| + Q2 c`.
+/// The energy it removes is reported as damping energy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BulkViscosity {
+    /// Quadratic coefficient Q1 (1.5 in LS-DYNA), >= 0.
+    pub q1: f64,
+    /// Linear coefficient Q2 (0.06 in LS-DYNA), >= 0.
+    pub q2: f64,
+}
+
+impl Default for BulkViscosity {
+    fn default() -> Self {
+        BulkViscosity { q1: 1.5, q2: 0.06 }
+    }
+}
+
 /// Hourglass control form.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum HourglassForm {
@@ -359,6 +414,11 @@ pub struct Control {
     /// Warping projection of the quads (on by default): rigid motions of warped elements
     /// give no strain and element forces are self-equilibrated.
     pub warping_projection: bool,
+    /// Invariant node numbering of the quads (`*CONTROL_ACCURACY` INN 2; off by default):
+    /// the corotational frame's first axis bisects the element's diagonals, so that the
+    /// result of an element does not depend on which node is numbered first or on the
+    /// direction of numbering (a mirrored mesh gives a mirrored result).
+    pub invariant_numbering: bool,
     /// The run stops with an error when the energy ratio (total over initial plus external
     /// work) exceeds this bound (1.5 by default).
     pub energy_ratio_bound: f64,
@@ -374,6 +434,7 @@ impl Default for Control {
             dtmin_factor: 0.0,
             isdo_diagonal: false,
             warping_projection: true,
+            invariant_numbering: false,
             energy_ratio_bound: 1.5,
         }
     }
@@ -419,6 +480,11 @@ pub struct ShellModel {
     pub body_load_z: Option<BodyLoadZ>,
     /// Mass-proportional damping constant D (1/time): nodal force `-D m v`.
     pub damping: f64,
+    /// Bulk viscosity of the shells (`None`: off, as in LS-DYNA, whose default bulk
+    /// viscosity acts on solids only).
+    pub bulk_viscosity: Option<BulkViscosity>,
+    /// Stiffness-proportional damping per part (at most one entry per part).
+    pub stiffness_damping: Vec<PartStiffnessDamping>,
     /// Hourglass control.
     pub hourglass: Hourglass,
     /// Run controls.

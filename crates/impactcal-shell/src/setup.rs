@@ -34,6 +34,7 @@ pub(crate) struct Compiled {
     pub elem_ids: Vec<u64>,
     pub elems: Vec<Elem>,
     pub parts: Vec<PartProps>,
+    pub part_ids: Vec<u64>,
     pub mass: Vec<f64>,
     pub inertia: Vec<f64>,
     pub fixed: Vec<(u32, [bool; 6])>,
@@ -176,6 +177,33 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         let sec = &model.sections[lookup(&sec_map, p.section, "section", &by)?];
         let mat = &model.materials[lookup(&mat_map, p.material, "material", &by)?];
         parts.push(PartProps::new(sec, mat, hg));
+    }
+    if let Some(b) = model.bulk_viscosity {
+        for (name, v) in [("Q1", b.q1), ("Q2", b.q2)] {
+            non_negative(format!("bulk viscosity {name}"), v)?;
+        }
+        for p in &mut parts {
+            p.bulk = [b.q1, b.q2];
+        }
+    }
+    let mut damped = vec![false; parts.len()];
+    for d in &model.stiffness_damping {
+        let by = "*DAMPING_PART_STIFFNESS";
+        let k = lookup(&part_map, d.part, "part", by)?;
+        if !d.coef.is_finite() {
+            return Err(ShellError::value(
+                format!("stiffness damping of part {}", d.part),
+                format!("coefficient must be finite, got {}", d.coef),
+            ));
+        }
+        if std::mem::replace(&mut damped[k], true) {
+            return Err(ShellError::Reference {
+                what: "part",
+                id: d.part,
+                message: "has stiffness damping defined more than once".into(),
+            });
+        }
+        parts[k].stiffness_damping = d.coef;
     }
 
     // Elements, masses, inertias.
@@ -357,13 +385,19 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
                 format!("friction must be >= 0, got {}", w.friction),
             ));
         }
-        if let WallMethod::Penalty { alpha } = w.method
-            && !(alpha > 0.0 && alpha <= 1.0)
-        {
-            return Err(ShellError::value(
-                by,
-                format!("penalty factor must lie in (0, 1], got {alpha}"),
-            ));
+        if let WallMethod::Penalty { alpha, damping } = w.method {
+            if !(alpha > 0.0 && alpha <= 1.0) {
+                return Err(ShellError::value(
+                    by,
+                    format!("penalty factor must lie in (0, 1], got {alpha}"),
+                ));
+            }
+            if !((0.0..=1.0).contains(&damping)) {
+                return Err(ShellError::value(
+                    by,
+                    format!("contact damping must lie in [0, 1] of critical, got {damping}"),
+                ));
+            }
         }
         let nodes = match w.nodes {
             None => (0..nn as u32).filter(|&i| mass[i as usize] > 0.0).collect(),
@@ -445,6 +479,7 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         elem_ids: model.shells.iter().map(|s| s.id).collect(),
         elems,
         parts,
+        part_ids: model.parts.iter().map(|p| p.id).collect(),
         mass,
         inertia,
         fixed,

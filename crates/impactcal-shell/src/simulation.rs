@@ -49,7 +49,8 @@ pub struct Energies {
     pub contact: f64,
     /// The friction share of `contact`.
     pub friction: f64,
-    /// Energy removed by mass-proportional damping.
+    /// Energy removed by damping: mass-proportional (`*DAMPING_GLOBAL`) and
+    /// stiffness-proportional (`*DAMPING_PART_STIFFNESS`).
     pub damping: f64,
     /// Work of the external (body) forces.
     pub external_work: f64,
@@ -110,6 +111,19 @@ pub struct RunSummary {
     pub mass: f64,
 }
 
+/// Energies of one part, summed over its shells.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PartEnergies {
+    /// Part id.
+    pub part: u64,
+    /// Internal (strain and plastic) energy.
+    pub internal: f64,
+    /// Hourglass energy.
+    pub hourglass: f64,
+    /// Energy removed by stiffness-proportional damping.
+    pub damping: f64,
+}
+
 /// The outputs of a run: sampled nodal histories (when history nodes were requested), the
 /// energy table and a summary.
 #[derive(Debug, Clone)]
@@ -125,6 +139,8 @@ pub struct RunResult {
     /// energy_ratio, wall_force, wall_fx, wall_fy, wall_fz` (the wall force is the force of
     /// the walls on the structure; `wall_force` is its normal component).
     pub energies: Histories,
+    /// Final energies of each part, in model order.
+    pub parts: Vec<PartEnergies>,
     /// Summary figures.
     pub summary: RunSummary,
 }
@@ -185,6 +201,8 @@ pub struct Simulation {
     out: Vec<ElementOutput>,
     /// Per-element faults of the last element pass.
     faults: Vec<Option<ElementFault>>,
+    /// Per-element accumulated internal, hourglass and damping energy.
+    elem_energy: Vec<[f64; 3]>,
     chunks: Vec<ChunkSum>,
     /// Per-chunk partial sums of the node loops.
     node_sums: Vec<f64>,
@@ -209,6 +227,9 @@ pub struct Simulation {
     cycle: u64,
     dt_half: f64,
     dt_first: f64,
+    /// The smallest element step of the undeformed model (before TSSFAC): the reference
+    /// step of penalty walls.
+    dt_ref: f64,
     dt_min: f64,
     dt_max: f64,
     energies: Energies,
@@ -232,6 +253,7 @@ struct KickSum {
 struct ChunkSum {
     internal: f64,
     hourglass: f64,
+    damping: f64,
     dt_min: f64,
     /// Element (global index) of `dt_min`.
     arg: usize,
@@ -244,6 +266,7 @@ impl Default for ChunkSum {
         ChunkSum {
             internal: 0.0,
             hourglass: 0.0,
+            damping: 0.0,
             dt_min: f64::INFINITY,
             arg: 0,
             problem: None,
@@ -307,12 +330,14 @@ impl Simulation {
             kernel: KernelOptions {
                 projection: model.control.warping_projection,
                 isdo_diagonal: model.control.isdo_diagonal,
+                invariant: model.control.invariant_numbering,
             },
             interval,
             stride,
             state: vec![0.0; stride * ne],
             out: vec![ElementOutput::default(); ne],
             faults: vec![None; ne],
+            elem_energy: vec![[0.0; 3]; ne],
             chunks: vec![ChunkSum::default(); ne.div_ceil(ELEMENT_CHUNK)],
             node_sums: vec![0.0; nn.div_ceil(NODE_CHUNK)],
             kick_sums: vec![KickSum::default(); nn.div_ceil(NODE_CHUNK)],
@@ -340,6 +365,7 @@ impl Simulation {
             cycle: 0,
             dt_half: 0.0,
             dt_first: 0.0,
+            dt_ref: 0.0,
             dt_min: f64::INFINITY,
             dt_max: 0.0,
             energies: Energies::default(),
@@ -403,6 +429,54 @@ impl Simulation {
         self.wall_force
     }
 
+    /// The accumulated internal, hourglass and damping energies of each part, in model
+    /// order (sums over its shells in element order).
+    pub fn part_energies(&self) -> Vec<PartEnergies> {
+        let mut parts: Vec<PartEnergies> = self
+            .c
+            .part_ids
+            .iter()
+            .map(|&part| PartEnergies {
+                part,
+                ..Default::default()
+            })
+            .collect();
+        for (e, acc) in self.c.elems.iter().zip(&self.elem_energy) {
+            let p = &mut parts[e.part as usize];
+            p.internal += acc[0];
+            p.hourglass += acc[1];
+            p.damping += acc[2];
+        }
+        parts
+    }
+
+    /// The elastic (recoverable) strain energy stored in the shells now: at every thickness
+    /// point `(s_xx^2 + s_yy^2 - 2 nu s_xx s_yy) / (2 E) + s_xy^2 / (2 G)` integrated over
+    /// the thickness and the current area, plus the transverse shear `Q^2 / (2 k_s G t)` per
+    /// unit area. The internal energy less this is the plastic work (hourglass energy is
+    /// booked apart).
+    pub fn elastic_energy(&self) -> f64 {
+        let mut total = 0.0;
+        for (k, e) in self.c.elems.iter().enumerate() {
+            let p = &self.c.parts[e.part as usize];
+            let n = if e.tri { 3 } else { 4 };
+            let xs: Vec<[f64; 3]> = e.nodes[..n].iter().map(|&i| self.x[i as usize]).collect();
+            let area = crate::geometry::polygon_area(&xs);
+            let st = &self.state[k * self.stride..(k + 1) * self.stride];
+            let (ym, nu, g) = (p.mat.e, p.mat.nu, p.mat.g);
+            let mut density = 0.0;
+            for (j, w) in p.w.iter().enumerate() {
+                let s = &st[STATE_HEAD + STATE_PER_POINT * j..];
+                density += w
+                    * ((s[0] * s[0] + s[1] * s[1] - 2.0 * nu * s[0] * s[1]) / (2.0 * ym)
+                        + s[2] * s[2] / (2.0 * g));
+            }
+            let shear = (st[0] * st[0] + st[1] * st[1]) / (2.0 * p.shear_factor * g * p.t);
+            total += area * (p.t * density + shear);
+        }
+        total
+    }
+
     /// Stress state `[s_xx, s_yy, s_xy, eps_p]` of thickness point `k` of element index `e`
     /// (model order), in the element frame.
     pub fn point_state(&self, e: usize, k: usize) -> Option<[f64; 4]> {
@@ -434,9 +508,10 @@ impl Simulation {
             .par_chunks_mut(stride * ELEMENT_CHUNK)
             .zip(self.out.par_chunks_mut(ELEMENT_CHUNK))
             .zip(self.faults.par_chunks_mut(ELEMENT_CHUNK))
+            .zip(self.elem_energy.par_chunks_mut(ELEMENT_CHUNK))
             .zip(self.chunks.par_iter_mut())
             .enumerate()
-            .for_each(|(ci, (((st, out), faults), sum))| {
+            .for_each(|(ci, ((((st, out), faults), acc), sum))| {
                 let first = ci * ELEMENT_CHUNK;
                 let n = out.len();
                 let mut k = 0;
@@ -453,7 +528,7 @@ impl Simulation {
                         };
                         let es = &mut st[k * stride..(k + 1) * stride];
                         (out[k], faults[k]) =
-                            match element::triangle(&g(x), &g(v), &g(w), props, es, dt) {
+                            match element::triangle(&g(x), &g(v), &g(w), props, es, dt, kernel) {
                                 Ok(o) => (o, None),
                                 Err(f) => (ElementOutput::default(), Some(f)),
                             };
@@ -479,8 +554,12 @@ impl Simulation {
                 }
                 let mut cs = ChunkSum::default();
                 for (j, (o, f)) in out.iter().zip(faults.iter()).enumerate() {
+                    acc[j][0] += o.internal;
+                    acc[j][1] += o.hourglass;
+                    acc[j][2] += o.damping;
                     cs.internal += o.internal;
                     cs.hourglass += o.hourglass;
+                    cs.damping += o.damping;
                     if cs.problem.is_none() && (f.is_some() || !(o.dt >= 0.0)) {
                         cs.problem = Some(first + j);
                     }
@@ -496,6 +575,7 @@ impl Simulation {
     /// Gathers slot forces into accelerations (before walls and constraints).
     fn gather(&mut self, t: f64) {
         let g = self.body_accel(t);
+
         let (out, csr, start) = (&self.out, &self.csr, &self.csr_start);
         let (inv_mass, inv_inertia) = (&self.inv_mass, &self.inv_inertia);
         let damping = self.damping;
@@ -556,11 +636,18 @@ impl Simulation {
                         }
                         (vmin, vmin - vn)
                     }
-                    WallMethod::Penalty { alpha } => {
+                    WallMethod::Penalty { alpha, damping } => {
                         if d0 >= 0.0 {
                             continue;
                         }
-                        let dvn = -alpha * d0 / dt_v;
+                        // Spring k = alpha m / dt_ref^2 and dashpot c = 2 zeta sqrt(k m) on
+                        // the predicted normal velocity; together they never pull the node
+                        // toward the wall.
+                        let w2 = alpha / (self.dt_ref * self.dt_ref);
+                        let spring = -w2 * d0 * dt_v;
+                        // Dashpot on the mean of the normal velocities before and after.
+                        let c = 2.0 * damping * w2.sqrt() * dt_v;
+                        let dvn = ((spring - c * vn) / (1.0 + 0.5 * c)).max(0.0);
                         (vn + dvn, dvn)
                     }
                 };
@@ -665,6 +752,11 @@ impl Simulation {
     fn start(&mut self) -> Result<()> {
         self.element_loop(0.0);
         let dt = self.next_dt()?;
+        self.dt_ref = self
+            .chunks
+            .iter()
+            .map(|c| c.dt_min)
+            .fold(f64::INFINITY, f64::min);
         self.gather(0.0);
         self.kick(0.0, dt);
         self.energies.initial = self.energies.kinetic;
@@ -755,13 +847,15 @@ impl Simulation {
         self.cycle += 1;
         self.element_loop(dt);
         let dt_next = self.next_dt()?;
-        let (mut die, mut dhg) = (0.0, 0.0);
+        let (mut die, mut dhg, mut ddp) = (0.0, 0.0, 0.0);
         for c in &self.chunks {
             die += c.internal;
             dhg += c.hourglass;
+            ddp += c.damping;
         }
         self.energies.internal += die;
         self.energies.hourglass += dhg;
+        self.energies.damping += ddp;
         let g1 = self.body_accel(self.time);
         self.energies.external_work += 0.5 * (g0 + g1) * mdz;
         self.gather(self.time);
@@ -919,6 +1013,7 @@ impl Simulation {
         let e = self.energies;
         let mut it = nodal.into_iter();
         Ok(RunResult {
+            parts: self.part_energies(),
             displacement: it.next().flatten(),
             velocity: it.next().flatten(),
             acceleration: it.next().flatten(),
@@ -1077,7 +1172,7 @@ fn eval_element(
     let n = e.nodes.map(|i| i as usize);
     let res = if e.tri {
         let g = |a: &[[f64; 3]]| [a[n[0]], a[n[1]], a[n[2]]];
-        element::triangle(&g(x), &g(v), &g(w), props, st, dt)
+        element::triangle(&g(x), &g(v), &g(w), props, st, dt, kernel)
     } else {
         let g = |a: &[[f64; 3]]| [a[n[0]], a[n[1]], a[n[2]], a[n[3]]];
         element::quad(&g(x), &g(v), &g(w), props, st, dt, kernel)

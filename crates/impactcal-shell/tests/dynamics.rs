@@ -249,30 +249,8 @@ fn cantilever_strip_first_frequency() {
 fn simply_supported_plate_frequency_and_energy_conservation() {
     let (a, t) = (1.0, 0.01);
     let n = 12;
-    let mut m = plate(n, n, a, a, [0.0; 3]);
-    with_section(&mut m, t, aluminium(1));
-    let edge: Vec<u64> = m
-        .nodes
-        .iter()
-        .filter(|p| p.x[0] < 1e-9 || p.x[1] < 1e-9 || p.x[0] > a - 1e-9 || p.x[1] > a - 1e-9)
-        .map(|p| p.id)
-        .collect();
-    m.node_sets.push(NodeSet { id: 1, nodes: edge });
-    m.spcs.push(Spc {
-        target: NodeTarget::NodeSet(1),
-        dofs: [false, false, true, false, false, false],
-    });
+    let mut m = simply_supported_plate_in_first_mode(a, t, n);
     let pi = std::f64::consts::PI;
-    for p in m.nodes.clone() {
-        // Mode shape with the consistent rotations (no transverse shear):
-        // omega_x = d vz / dy, omega_y = -d vz / dx.
-        let (sx, cx) = (pi * p.x[0] / a).sin_cos();
-        let (sy, cy) = (pi * p.x[1] / a).sin_cos();
-        let mut iv =
-            InitialVelocity::translation(VelocityTarget::Node(p.id), [0.0, 0.0, 0.1 * sx * sy]);
-        iv.rotation = [0.1 * pi / a * sx * cy, -0.1 * pi / a * cx * sy, 0.0];
-        m.initial_velocities.push(iv);
-    }
     m.control.end_time = 0.05;
     m.output.interval = 2e-5;
     let centre = node_id(n, n / 2, n / 2);

@@ -12,8 +12,9 @@ mod common;
 use common::*;
 use impactcal_shell::keyword::{parse_deck, write_deck};
 use impactcal_shell::{
-    CowperSymonds, HourglassForm, InitialVelocity, Material, MaterialLaw, NodeSet, NodeTarget,
-    RigidWall, Section, ShellError, Simulation, Spc, VelocityTarget, WallMethod,
+    BulkViscosity, CowperSymonds, HourglassForm, InitialVelocity, Material, MaterialLaw, NodeSet,
+    NodeTarget, PartStiffnessDamping, RigidWall, Section, ShellError, Simulation, Spc,
+    VelocityTarget, WallMethod,
 };
 
 fn full_model() -> impactcal_shell::ShellModel {
@@ -89,6 +90,15 @@ fn full_model() -> impactcal_shell::ShellModel {
     });
     m.set_gravity(9.81);
     m.damping = 2.5;
+    m.stiffness_damping = vec![
+        PartStiffnessDamping { part: 1, coef: 0.1 },
+        PartStiffnessDamping {
+            part: 2,
+            coef: -2.5e-6,
+        },
+    ];
+    m.bulk_viscosity = Some(BulkViscosity { q1: 1.2, q2: 0.05 });
+    m.control.invariant_numbering = true;
     m.hourglass.form = HourglassForm::Viscous;
     m.hourglass.membrane = 0.1;
     m.hourglass.transverse = 0.1;
@@ -174,6 +184,117 @@ fn a_hand_written_deck_with_both_card_formats_runs() {
     assert_eq!(vz.samples(), 21);
     // Landed, not through the floor.
     assert!(vz.channel(2)[20].abs() < 1.0);
+}
+
+/// The damping, bulk viscosity, invariant numbering and penalty cards, as LS-DYNA users
+/// write them, with defaults for blank fields.
+#[test]
+fn damping_bulk_viscosity_accuracy_and_penalty_cards() {
+    let extra = "\
+*DAMPING_PART_STIFFNESS
+$      pid      coef
+         1      0.08
+*CONTROL_BULK_VISCOSITY
+$       q1        q2      type
+                        -2
+*CONTROL_ACCURACY
+$      osu       inn
+         0         2
+*CONTROL_CONTACT
+$   slsfac    rwpnal
+       0.1      0.25
+*END
+";
+    let text = DECK.replace("*END\n", extra);
+    let deck = parse_deck(&text, "extra.k").unwrap();
+    let m = &deck.model;
+    assert_eq!(
+        m.stiffness_damping,
+        vec![PartStiffnessDamping {
+            part: 1,
+            coef: 0.08
+        }]
+    );
+    assert_eq!(m.bulk_viscosity, Some(BulkViscosity { q1: 1.5, q2: 0.06 }));
+    assert!(m.control.invariant_numbering);
+    assert_eq!(
+        m.walls[0].method,
+        WallMethod::Penalty {
+            alpha: 0.25,
+            damping: 0.0
+        }
+    );
+    // SLSFAC is not used: a warning says so.
+    assert!(
+        deck.warnings.iter().any(|w| w.contains("RWPNAL")),
+        "{:?}",
+        deck.warnings
+    );
+    // Written and read again: the same model; and it runs.
+    let back = parse_deck(&write_deck(m).unwrap(), "again.k")
+        .unwrap()
+        .model;
+    assert_eq!(&back, m);
+    let r = Simulation::new(m).unwrap().run().unwrap();
+    assert!((r.summary.energy_ratio - 1.0).abs() < 0.05);
+    // TYPE 1 (the LS-DYNA default) acts on solids only: no shell bulk viscosity, a warning.
+    let solids = text.replace("                        -2", "                         1");
+    let d = parse_deck(&solids, "solids.k").unwrap();
+    assert_eq!(d.model.bulk_viscosity, None);
+    assert!(d.warnings.iter().any(|w| w.contains("solids only")));
+    // Bad values are typed errors naming the keyword and line.
+    for (from, to, keyword) in [
+        (
+            "                        -2",
+            "                         7",
+            "*CONTROL_BULK_VISCOSITY",
+        ),
+        (
+            "         0         2",
+            "         0         9",
+            "*CONTROL_ACCURACY",
+        ),
+        (
+            "       0.1      0.25",
+            "       0.1       1.5",
+            "*CONTROL_CONTACT",
+        ),
+        (
+            "         1      0.08",
+            "         1       abc",
+            "*DAMPING_PART_STIFFNESS",
+        ),
+    ] {
+        match parse_deck(&text.replace(from, to), "bad.k") {
+            Err(ShellError::Keyword { keyword: k, .. }) => assert_eq!(k, keyword),
+            other => panic!("{keyword}: {other:?}"),
+        }
+    }
+    // Damping of an undefined part, twice for one part, or a non-finite coefficient.
+    let undefined = text.replace("         1      0.08", "         9      0.08");
+    assert!(matches!(
+        err(&undefined),
+        ShellError::Reference {
+            what: "part",
+            id: 9,
+            ..
+        }
+    ));
+    let twice = text.replace(
+        "         1      0.08",
+        "         1      0.08\n         1      0.02",
+    );
+    assert!(matches!(err(&twice), ShellError::Reference { id: 1, .. }));
+    // Features the cards cannot express are refused by the writer.
+    let mut damped = m.clone();
+    damped.walls[0].method = WallMethod::Penalty {
+        alpha: 0.25,
+        damping: 0.2,
+    };
+    assert!(write_deck(&damped).is_err());
+    let mut zero = m.clone();
+    zero.bulk_viscosity = Some(BulkViscosity { q1: 0.0, q2: 0.06 });
+    assert!(write_deck(&zero).is_err());
 }
 
 fn err(text: &str) -> ShellError {

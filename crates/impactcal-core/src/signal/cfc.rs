@@ -33,7 +33,8 @@ use crate::histories::Histories;
 /// SAE J211-1's appendix writes the pre-warp factor as 2.0775 instead of `1.25 / 0.6`; the
 /// corners differ by 0.3 %. This implementation follows ISO 6487 and agrees with pyisomme's
 /// ISO-6487 filter to 1e-12 of the peak (see `docs/validation.md`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(into = "u32", try_from = "u32")]
 pub enum Cfc {
     /// CFC 60.
     Cfc60,
@@ -43,6 +44,20 @@ pub enum Cfc {
     Cfc600,
     /// CFC 1000.
     Cfc1000,
+}
+
+impl From<Cfc> for u32 {
+    fn from(c: Cfc) -> u32 {
+        c.class()
+    }
+}
+
+impl TryFrom<u32> for Cfc {
+    type Error = CoreError;
+
+    fn try_from(class: u32) -> Result<Cfc> {
+        Cfc::from_class(class)
+    }
 }
 
 /// Ratio of the pre-warped design frequency to the class number (ISO 6487 Annex A).

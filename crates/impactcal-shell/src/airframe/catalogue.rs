@@ -337,6 +337,24 @@ impl Preset {
     }
 }
 
+/// The structural quantities of the catalogue: the five concentrated masses and every part's
+/// `t`, `E`, `Et` and `sigy`, in catalogue order (61 quantities). These make up "the model"
+/// as opposed to the test conditions (impact, attitude, ground) and the solver settings,
+/// and are what a jitter ensemble perturbs to measure the airframe's own noise.
+///
+/// # Errors
+/// Never (the catalogue's ranges are valid).
+pub fn structural_space() -> Result<ParameterSpace> {
+    let names: Vec<String> = catalogue()
+        .into_iter()
+        .map(|a| a.name)
+        .filter(|n| {
+            n.starts_with("mass.") || [".t", ".E", ".Et", ".sigy"].iter().any(|f| n.ends_with(f))
+        })
+        .collect();
+    space_of(&names)
+}
+
 /// A parameter space of catalogue entries by name, with their nominal values and ranges.
 ///
 /// # Errors

@@ -39,12 +39,14 @@ mod svg;
 
 use impactcal_core::{CoreError, Histories, Model, ParameterSpace};
 
-pub use catalogue::{Adjustable, AirframeValues, GRAVITY, Preset, catalogue, space_of};
+pub use catalogue::{
+    Adjustable, AirframeValues, GRAVITY, Preset, catalogue, space_of, structural_space,
+};
 
 use crate::error::{Result, ShellError};
 use crate::model::{
-    CowperSymonds, InitialVelocity, Material, MaterialLaw, Part, RigidWall, Section, ShellModel,
-    VelocityTarget, WallMethod,
+    BulkViscosity, CowperSymonds, InitialVelocity, Material, MaterialLaw, Part, RigidWall, Section,
+    ShellModel, VelocityTarget, WallMethod,
 };
 use crate::simulation::{RunResult, Simulation};
 use mesh::{Counts, MassSite, Mesh};
@@ -311,6 +313,18 @@ impl Airframe {
             .collect()
     }
 
+    /// The part a node belongs to (the first part, in [`AirframePart::ALL`] order, with a
+    /// shell on it), for grouping sensor channels; `None` for an unknown node id.
+    pub fn part_of_node(&self, node: u64) -> Option<AirframePart> {
+        let i = usize::try_from(node.checked_sub(1)?).ok()?;
+        self.mesh
+            .shells
+            .iter()
+            .filter(|(n, _)| n.contains(&(i as u32)))
+            .map(|(_, p)| *p)
+            .min()
+    }
+
     /// The undeformed node coordinates at level attitude (id = index + 1).
     pub fn node_positions(&self) -> &[[f64; 3]] {
         &self.mesh.nodes
@@ -341,7 +355,8 @@ impl Airframe {
     }
 
     /// The runnable model at `values`: sections, materials, masses, attitude, initial
-    /// velocity, gravity, the ground, damping and the sensor outputs.
+    /// velocity, gravity, the ground, damping and the sensor outputs, with invariant node
+    /// numbering and shell bulk viscosity (Q1 1.5, Q2 0.06) switched on.
     ///
     /// The airframe is rotated by the pitch (nose up) and roll (right side down) about the
     /// cabin centre, then lifted so that its lowest node lies `ground_gap` above the ground.
@@ -430,6 +445,12 @@ impl Airframe {
         ));
         m.set_gravity(GRAVITY);
         m.damping = values.global("damping");
+        // Invariant node numbering keeps the mirror-symmetric mesh's response symmetric
+        // (the edge-based frames of mirrored elements differ); bulk viscosity spreads the
+        // membrane shock of the impact, which makes the first 10 ms insensitive to the
+        // time step (docs/airframe.md, "Predictability").
+        m.control.invariant_numbering = true;
+        m.bulk_viscosity = Some(BulkViscosity::default());
         m.walls.push(RigidWall {
             nodes: None,
             point: [0.0; 3],

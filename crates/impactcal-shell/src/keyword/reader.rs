@@ -4,9 +4,9 @@ use std::path::Path;
 
 use crate::error::{Result, ShellError};
 use crate::model::{
-    BodyLoadZ, CowperSymonds, Curve, HourglassForm, InitialVelocity, Material, MaterialLaw,
-    NodeSet, NodeTarget, Part, PointMass, RigidWall, Section, ShellModel, Spc, ThicknessRule,
-    VelocityTarget, WallMethod,
+    BodyLoadZ, BulkViscosity, CowperSymonds, Curve, HourglassForm, InitialVelocity, Material,
+    MaterialLaw, NodeSet, NodeTarget, Part, PartStiffnessDamping, PointMass, RigidWall, Section,
+    ShellModel, Spc, ThicknessRule, VelocityTarget, WallMethod,
 };
 
 /// Output-only keywords that are skipped with a warning (their cards are ignored).
@@ -192,6 +192,8 @@ const W10: &[usize] = &[10];
 pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
     let mut model = ShellModel::new("");
     let mut warnings = Vec::new();
+    // *CONTROL_CONTACT RWPNAL, applied to every rigid wall once all are read.
+    let mut rwpnal = 0.0;
     let mut lines = text.lines().enumerate().peekable();
     // Skip anything before *KEYWORD (LS-DYNA ignores it too).
     let mut blocks: Vec<(usize, String, Vec<Card<'a>>)> = Vec::new();
@@ -602,6 +604,87 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     ));
                 }
             }
+            "*DAMPING_PART_STIFFNESS" => {
+                for c in &cards {
+                    let f = card(c, W10);
+                    model.stiffness_damping.push(PartStiffnessDamping {
+                        part: f.id(0, "PID")?,
+                        coef: f.real(1, "COEF", 0.0)?,
+                    });
+                }
+            }
+            "*CONTROL_BULK_VISCOSITY" => {
+                need(1)?;
+                let f = card(&cards[0], W10);
+                let q1 = f.real(0, "Q1", 1.5)?;
+                let q2 = f.real(1, "Q2", 0.06)?;
+                let b = BulkViscosity {
+                    q1: if q1 == 0.0 { 1.5 } else { q1 },
+                    q2: if q2 == 0.0 { 0.06 } else { q2 },
+                };
+                model.bulk_viscosity = match f.int(2, "TYPE", 1)? {
+                    -2 | -1 => Some(b),
+                    1 | 2 => {
+                        warnings.push(format!(
+                            "{name}: line {}: *CONTROL_BULK_VISCOSITY TYPE 1 or 2 acts on solids only: no bulk viscosity on the shells (TYPE -2 applies it to shells)",
+                            cards[0].line
+                        ));
+                        None
+                    }
+                    v => {
+                        return Err(ctx.err(
+                            cards[0].line,
+                            format!("field TYPE: {v} is not supported (1, 2, -1 or -2)"),
+                        ));
+                    }
+                };
+            }
+            "*CONTROL_ACCURACY" => {
+                need(1)?;
+                let f = card(&cards[0], W10);
+                if f.int(0, "OSU", 0)? != 0 {
+                    warnings.push(format!(
+                        "{name}: line {}: *CONTROL_ACCURACY OSU ignored (shell stresses are corotational)",
+                        cards[0].line
+                    ));
+                }
+                model.control.invariant_numbering = match f.int(1, "INN", 1)? {
+                    0 | 1 => false,
+                    2..=4 => true,
+                    v => {
+                        return Err(ctx.err(
+                            cards[0].line,
+                            format!("field INN: {v} is not supported (1 off, 2 to 4 on)"),
+                        ));
+                    }
+                };
+                f.must_be_zero(2, "PIDOSU")?;
+                f.must_be_zero(3, "IACC")?;
+            }
+            "*CONTROL_CONTACT" => {
+                need(1)?;
+                let f = card(&cards[0], W10);
+                rwpnal = f.real(1, "RWPNAL", 0.0)?;
+                if !(0.0..=1.0).contains(&rwpnal) {
+                    return Err(ctx.err(
+                        cards[0].line,
+                        format!(
+                            "field RWPNAL: {rwpnal} is not supported (0: constraint method, \
+                             0 < RWPNAL <= 1: penalty walls with that stiffness factor)"
+                        ),
+                    ));
+                }
+                let other = (0..8)
+                    .filter(|&k| k != 1)
+                    .map(|k| f.real(k, "SLSFAC-ENMASS", 0.0))
+                    .collect::<Result<Vec<_>>>()?;
+                if other.iter().any(|&v| v != 0.0) || cards.len() > 1 {
+                    warnings.push(format!(
+                        "{name}: line {}: *CONTROL_CONTACT: only RWPNAL is used (there are no contact interfaces)",
+                        cards[0].line
+                    ));
+                }
+            }
             "*CONTROL_TERMINATION" => {
                 need(1)?;
                 let f = card(&cards[0], W10);
@@ -676,6 +759,14 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     keyword: k.to_string(),
                 });
             }
+        }
+    }
+    if rwpnal > 0.0 {
+        for w in &mut model.walls {
+            w.method = WallMethod::Penalty {
+                alpha: rwpnal,
+                damping: 0.0,
+            };
         }
     }
     Ok(Deck { model, warnings })

@@ -32,6 +32,36 @@ fn int(v: u64, w: usize) -> String {
     format!("{v:>w$}")
 }
 
+fn int_signed(v: i64, w: usize) -> String {
+    format!("{v:>w$}")
+}
+
+/// The penalty factor of the walls, written as `*CONTROL_CONTACT` RWPNAL (which applies to
+/// every wall), or `None` when all walls are kinematic.
+fn penalty_factor(model: &ShellModel) -> Result<Option<f64>> {
+    let mut alpha = None;
+    for (k, wall) in model.walls.iter().enumerate() {
+        let this = match wall.method {
+            WallMethod::Kinematic => None,
+            WallMethod::Penalty { damping, .. } if damping != 0.0 => {
+                return Err(unrepresentable(
+                    format!("rigid wall {}", k + 1),
+                    "contact damping (rigid walls have no VDC field)",
+                ));
+            }
+            WallMethod::Penalty { alpha, .. } => Some(alpha),
+        };
+        if k > 0 && this != alpha {
+            return Err(unrepresentable(
+                "rigid walls",
+                "a mix of kinematic and penalty walls, or penalty factors that differ (RWPNAL applies to all walls)",
+            ));
+        }
+        alpha = this;
+    }
+    Ok(alpha)
+}
+
 fn unrepresentable(what: impl Into<String>, why: &str) -> ShellError {
     ShellError::value(what, format!("cannot be written as a keyword deck: {why}"))
 }
@@ -42,8 +72,8 @@ fn unrepresentable(what: impl Into<String>, why: &str) -> ShellError {
 ///
 /// # Errors
 /// [`ShellError::Value`] for model features the supported keywords cannot express: Lobatto
-/// thickness integration, penalty walls, a fixed time step, different hourglass
-/// coefficients per mode, initial spins on single nodes or on all nodes, an ids too large
+/// thickness integration, penalty walls with contact damping or with different factors (or
+/// mixed with kinematic walls), a fixed time step, different hourglass coefficients per mode, initial spins on single nodes or on all nodes, an ids too large
 /// for its field.
 pub fn write_deck(model: &ShellModel) -> Result<String> {
     let mut s = String::new();
@@ -88,6 +118,35 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
     if model.damping != 0.0 {
         w("*DAMPING_GLOBAL".into());
         w(format!("{}{}", int(0, 10), real(model.damping, 10)));
+    }
+    if !model.stiffness_damping.is_empty() {
+        w("*DAMPING_PART_STIFFNESS".into());
+        for d in &model.stiffness_damping {
+            w(format!("{}{}", int(d.part, 10), real(d.coef, 10)));
+        }
+    }
+    if let Some(b) = model.bulk_viscosity {
+        if !(b.q1 > 0.0 && b.q2 > 0.0) {
+            return Err(unrepresentable(
+                "bulk viscosity",
+                "a zero coefficient (0 means the default in *CONTROL_BULK_VISCOSITY)",
+            ));
+        }
+        w("*CONTROL_BULK_VISCOSITY".into());
+        w(format!(
+            "{}{}{}",
+            real(b.q1, 10),
+            real(b.q2, 10),
+            int_signed(-2, 10)
+        ));
+    }
+    if c.invariant_numbering {
+        w("*CONTROL_ACCURACY".into());
+        w(format!("{}{}", int(0, 10), int(2, 10)));
+    }
+    if let Some(alpha) = penalty_factor(model)? {
+        w("*CONTROL_CONTACT".into());
+        w(format!("{}{}", real(0.0, 10), real(alpha, 10)));
     }
     if model.output.interval > 0.0 {
         w("*DATABASE_NODOUT".into());
@@ -282,12 +341,6 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
         }
     }
     for (k, wall) in model.walls.iter().enumerate() {
-        if let WallMethod::Penalty { .. } = wall.method {
-            return Err(unrepresentable(
-                format!("rigid wall {}", k + 1),
-                "penalty enforcement",
-            ));
-        }
         if !(wall.friction.is_infinite() || wall.friction < 1.0) {
             return Err(unrepresentable(
                 format!("rigid wall {}", k + 1),

@@ -1,7 +1,10 @@
 //! Mesh builders shared by the verification tests.
 #![allow(dead_code)]
 
-use impactcal_shell::{Material, MaterialLaw, Section, ShellModel};
+use impactcal_shell::{
+    InitialVelocity, Material, MaterialLaw, NodeSet, NodeTarget, Section, ShellModel, Spc,
+    VelocityTarget,
+};
 
 /// Aluminium of the reference notes: E 70 GPa, rho 2700, nu 0.33.
 pub const E: f64 = 70e9;
@@ -42,6 +45,35 @@ pub fn plate(nx: u64, ny: u64, lx: f64, ly: f64, origin: [f64; 3]) -> ShellModel
         }
     }
     m.add_part(1, 1, 1);
+    m
+}
+
+/// A simply supported square aluminium plate, side `a`, thickness `t`, `n x n` quads
+/// (section 1 added), started in its first mode: centre velocity 0.1 with the consistent
+/// rotations (no transverse shear), `omega_x = d vz / dy`, `omega_y = -d vz / dx`.
+pub fn simply_supported_plate_in_first_mode(a: f64, t: f64, n: u64) -> ShellModel {
+    let mut m = plate(n, n, a, a, [0.0; 3]);
+    with_section(&mut m, t, aluminium(1));
+    let edge: Vec<u64> = m
+        .nodes
+        .iter()
+        .filter(|p| p.x[0] < 1e-9 || p.x[1] < 1e-9 || p.x[0] > a - 1e-9 || p.x[1] > a - 1e-9)
+        .map(|p| p.id)
+        .collect();
+    m.node_sets.push(NodeSet { id: 1, nodes: edge });
+    m.spcs.push(Spc {
+        target: NodeTarget::NodeSet(1),
+        dofs: [false, false, true, false, false, false],
+    });
+    let pi = std::f64::consts::PI;
+    for p in m.nodes.clone() {
+        let (sx, cx) = (pi * p.x[0] / a).sin_cos();
+        let (sy, cy) = (pi * p.x[1] / a).sin_cos();
+        let mut iv =
+            InitialVelocity::translation(VelocityTarget::Node(p.id), [0.0, 0.0, 0.1 * sx * sy]);
+        iv.rotation = [0.1 * pi / a * sx * cy, -0.1 * pi / a * cx * sy, 0.0];
+        m.initial_velocities.push(iv);
+    }
     m
 }
 
