@@ -26,5 +26,6 @@
 
 pub mod error;
 pub mod metrics;
+pub mod report;
 
 pub use error::{CalibrateError, Result};
