@@ -27,6 +27,25 @@ pub enum CalibrateError {
         /// What is wrong with the lengths.
         reason: String,
     },
+    /// A report document that cannot be drawn as given: an invalid or repeated figure name,
+    /// an interval or matrix cell outside its plot, a band whose upper edge lies below its
+    /// lower edge, abscissae out of order, a blank axis label, negative values to stack.
+    /// Wrong lengths, NaN/inf and empty data are the shared [`CoreError`] kinds.
+    #[error("{what}: {reason}")]
+    Report {
+        /// The part of the document (for example ``figure `fig-m1`, series `test` ``).
+        what: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// The plotting library failed to draw a figure of a valid document.
+    #[error("figure `{figure}`: drawing failed: {message}")]
+    Render {
+        /// The figure's name.
+        figure: String,
+        /// The plotting library's message.
+        message: String,
+    },
 }
 
 /// `Result` with [`CalibrateError`].
@@ -50,15 +69,17 @@ impl CalibrateError {
         }
     }
 
-    /// What kind of fault this is: the kind of a wrapped [`CoreError`], otherwise
-    /// [`ErrorKind::BadInput`] (a curve on which a metric is undefined, or lengths that do
-    /// not fit, are the input's fault).
+    /// What kind of fault this is: the kind of a wrapped [`CoreError`];
+    /// [`ErrorKind::Numerical`] for a figure the plotting library failed to draw; otherwise
+    /// [`ErrorKind::BadInput`] (a curve on which a metric is undefined, lengths that do not
+    /// fit, or a report document that cannot be drawn, are the input's fault).
     pub fn kind(&self) -> ErrorKind {
         match self {
             CalibrateError::Core(e) => e.kind(),
-            CalibrateError::Degenerate { .. } | CalibrateError::Length { .. } => {
-                ErrorKind::BadInput
-            }
+            CalibrateError::Degenerate { .. }
+            | CalibrateError::Length { .. }
+            | CalibrateError::Report { .. } => ErrorKind::BadInput,
+            CalibrateError::Render { .. } => ErrorKind::Numerical,
         }
     }
 }

@@ -1,0 +1,69 @@
+//! A band (an ensemble's min/max) with curves over it and shaded intervals (where the test
+//! leaves the band).
+
+use plotters::prelude::*;
+
+use super::{Drawn, WIDTH, abscissa, cartesian, colour, legend, line, padded};
+use crate::Result;
+use crate::report::document::Envelope;
+
+/// Height of an envelope figure in pixels.
+const HEIGHT: u32 = 540;
+
+/// Fill of the band.
+pub(crate) const BAND: RGBColor = RGBColor(120, 150, 200);
+
+/// Fill of the marked intervals.
+pub(crate) const MARK: RGBColor = RGBColor(213, 94, 0);
+
+/// Draws the marked intervals as translucent full-height strips, then the band as one
+/// filled polygon (upper edge forwards, lower edge backwards), then the curves in palette
+/// order; one legend entry each for the band, the intervals (if any) and every curve.
+pub(super) fn draw(p: &Envelope, svg: &mut String, name: &str) -> Result<()> {
+    let root = SVGBackend::with_string(svg, (WIDTH, HEIGHT)).into_drawing_area();
+    root.fill(&WHITE).drawn(name)?;
+    let all = p
+        .lower
+        .iter()
+        .chain(&p.upper)
+        .chain(p.series.iter().flat_map(|s| &s.values))
+        .copied();
+    let y = padded(all);
+    let mut chart = cartesian(
+        &root,
+        abscissa(&p.x),
+        y.clone(),
+        Some(&p.x_axis.label),
+        &p.y_axis.label,
+        name,
+    )?;
+    if !p.marked.is_empty() {
+        let strip = MARK.mix(0.15).filled();
+        chart
+            .draw_series(
+                p.marked
+                    .iter()
+                    .map(|&(a, b)| Rectangle::new([(a, y.start), (b, y.end)], strip)),
+            )
+            .drawn(name)?
+            .label("outside the band")
+            .legend(move |(x, y)| Rectangle::new([(x, y - 7), (x + 24, y + 7)], strip));
+    }
+    let band = BAND.mix(0.45).filled();
+    let outline: Vec<(f64, f64)> =
+        p.x.iter()
+            .copied()
+            .zip(p.upper.iter().copied())
+            .chain(p.x.iter().copied().zip(p.lower.iter().copied()).rev())
+            .collect();
+    chart
+        .draw_series(std::iter::once(Polygon::new(outline, band)))
+        .drawn(name)?
+        .label(p.band_name.as_str())
+        .legend(move |(x, y)| Rectangle::new([(x, y - 7), (x + 24, y + 7)], band));
+    for (i, s) in p.series.iter().enumerate() {
+        line(&mut chart, &p.x, &s.values, &s.name, colour(i), name)?;
+    }
+    legend(&mut chart, name)?;
+    root.present().drawn(name)
+}
