@@ -48,7 +48,7 @@ pub fn render_markdown(report: &Report) -> Result<String> {
 /// open or close inline markup anywhere (`` \ ` * _ [ ] < > | & ~ ``) are backslash-escaped
 /// (CommonMark allows it before any ASCII punctuation), and so is what would make the line a
 /// heading, list item, quote or rule (a leading `#`, `-`, `+`, `=`, or the `.`/`)` after
-/// leading digits). `|` is escaped too, so a table cell never splits.
+/// leading digits that ends a list number). `|` is escaped too, so a table cell never splits.
 pub fn escape_markdown(text: &str) -> String {
     let mut out = String::with_capacity(text.len() + 8);
     let digits = text.bytes().take_while(u8::is_ascii_digit).count();
@@ -58,7 +58,10 @@ pub fn escape_markdown(text: &str) -> String {
             '\\' | '`' | '*' | '_' | '[' | ']' | '<' | '>' | '|' | '&' | '~'
         );
         let at_start = i == 0 && matches!(c, '#' | '-' | '+' | '=');
-        let list_number = digits > 0 && i == digits && matches!(c, '.' | ')');
+        let list_number = digits > 0
+            && i == digits
+            && matches!(c, '.' | ')')
+            && text[i + 1..].chars().next().is_none_or(char::is_whitespace);
         if always || at_start || list_number {
             out.push('\\');
         }

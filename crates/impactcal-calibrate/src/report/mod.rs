@@ -43,6 +43,9 @@ mod html;
 mod markdown;
 mod validate;
 
+#[cfg(test)]
+mod tests;
+
 use std::fs;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};

@@ -3,18 +3,13 @@
 
 use plotters::prelude::*;
 
+use super::{BAND, MARK};
 use super::{Drawn, WIDTH, abscissa, cartesian, colour, legend, line, padded};
 use crate::Result;
 use crate::report::document::Envelope;
 
 /// Height of an envelope figure in pixels.
 const HEIGHT: u32 = 540;
-
-/// Fill of the band.
-pub(crate) const BAND: RGBColor = RGBColor(120, 150, 200);
-
-/// Fill of the marked intervals.
-pub(crate) const MARK: RGBColor = RGBColor(213, 94, 0);
 
 /// Draws the marked intervals as translucent full-height strips, then the band as one
 /// filled polygon (upper edge forwards, lower edge backwards), then the curves in palette

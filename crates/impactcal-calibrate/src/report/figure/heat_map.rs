@@ -4,6 +4,7 @@
 use plotters::coord::ranged1d::SegmentValue;
 use plotters::prelude::*;
 
+use super::OUTLINE;
 use super::{
     Area, BAR, BOTTOM_AREA, Drawn, LEFT_AREA, MARGIN, WIDTH, centred, colour_bar, dark, label_font,
     sequential, tick_font,
@@ -17,8 +18,6 @@ const BAR_PANEL: u32 = 100;
 /// Height of the panel of column weights, and of the key strip when there is no such panel.
 const COLUMN_PANEL: u32 = 150;
 const KEY_STRIP: u32 = 44;
-/// Outline of marked cells.
-pub(crate) const OUTLINE: RGBColor = RGBColor(220, 20, 60);
 
 /// Draws the heat map of `p`: cells coloured on a sequential scale over `p.range` (values
 /// outside it take the end colours), the marked cells outlined, values written in the

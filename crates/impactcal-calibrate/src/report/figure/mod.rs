@@ -85,6 +85,18 @@ pub(crate) const GREY: RGBColor = RGBColor(150, 150, 150);
 /// Fill of weight bars.
 pub(crate) const BAR: RGBColor = RGBColor(70, 110, 160);
 
+/// Fill of an envelope's band.
+pub(crate) const BAND: RGBColor = RGBColor(120, 150, 200);
+
+/// Fill of an envelope's marked intervals.
+pub(crate) const MARK: RGBColor = RGBColor(213, 94, 0);
+
+/// Outline of a heat map's marked cells.
+pub(crate) const OUTLINE: RGBColor = RGBColor(220, 20, 60);
+
+/// Colour of structure markers without a value.
+pub(crate) const PLAIN: RGBColor = PALETTE[4];
+
 /// Font family of every label (the viewer's sans-serif face).
 pub(crate) const FAMILY: &str = "sans-serif";
 

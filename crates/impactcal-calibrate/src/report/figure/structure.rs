@@ -5,9 +5,10 @@ use std::ops::Range;
 
 use plotters::prelude::*;
 
+use super::PLAIN;
 use super::{
-    Area, BOTTOM_AREA, Drawn, GREY, LEFT_AREA, MARGIN, WIDTH, cartesian, colour, colour_bar,
-    diverging, padded, tick_font,
+    Area, BOTTOM_AREA, Drawn, GREY, LEFT_AREA, MARGIN, WIDTH, cartesian, colour_bar, diverging,
+    padded, tick_font,
 };
 use crate::Result;
 use crate::report::document::Structure;
@@ -20,11 +21,6 @@ const MAX_PLOT: f64 = 380.0;
 /// Radius of a marker and of a structure point.
 const MARKER: i32 = 7;
 const POINT: i32 = 2;
-
-/// Plain markers (without a value) take this colour.
-pub(crate) fn plain() -> RGBColor {
-    colour(4)
-}
 
 /// Draws the plan view above the side view, both at one scale per view (a unit of length
 /// is as long across as up), structure points small and grey, markers large with their
@@ -102,7 +98,7 @@ fn draw_view(
     }
     let fill = |value: Option<f64>| match (value, scale) {
         (Some(x), Some(l)) => diverging(x / l),
-        _ => plain(),
+        _ => PLAIN,
     };
     chart
         .draw_series(p.marked.iter().map(|m| {
