@@ -107,7 +107,7 @@ fn structure(points: usize, markers: usize, values: bool) -> Structure {
             .map(|m| Marker {
                 label: format!("{}.z", 100 + m),
                 at: [m as f64 * 10.0, 5.0, 3.0 * m as f64],
-                value: values.then(|| m as f64 - 1.0),
+                value: values.then_some(m as f64 - 1.0),
             })
             .collect(),
     }
@@ -730,6 +730,9 @@ fn write_puts_html_markdown_and_one_svg_per_figure_in_the_folder() {
 
 // ----- faults -----
 
+/// A fault case: which figure, how to break its plot, the message expected.
+type Case = (usize, Box<dyn Fn(&mut Plot)>, &'static str);
+
 /// The report with its `index`-th figure's plot changed by `f`.
 fn broken(f: impl FnOnce(&mut Plot), index: usize) -> Report {
     let mut report = sample();
@@ -878,7 +881,7 @@ fn figure_names_must_be_valid_and_unique() {
 
 #[test]
 fn empty_data_and_blank_axes_are_refused() {
-    let cases: Vec<(usize, Box<dyn Fn(&mut Plot)>, &str)> = vec![
+    let cases: Vec<Case> = vec![
         (
             3,
             Box::new(|p| {
@@ -953,7 +956,7 @@ fn empty_data_and_blank_axes_are_refused() {
 
 #[test]
 fn kind_specific_faults_say_where() {
-    let cases: Vec<(usize, Box<dyn Fn(&mut Plot)>, &str)> = vec![
+    let cases: Vec<Case> = vec![
         (
             0,
             Box::new(|p| {
