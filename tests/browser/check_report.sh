@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Renders a sample report with every kind of figure in headless Chromium and checks that the
+# page is not blank and shows every figure (tests/browser/check_report.py), then that the
+# check rejects deliberately broken copies of the page. Installs Chromium (Debian package
+# `chromium`) with apt-get when it is missing and this user can.
+#
+#   bash tests/browser/check_report.sh [OUT_DIR]
+#
+# Exit status: 0 when every figure is shown and every broken page is rejected; 1 otherwise.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+find_chromium() {
+    for c in chromium chromium-browser google-chrome-stable google-chrome; do
+        if command -v "$c" >/dev/null 2>&1; then
+            command -v "$c"
+            return 0
+        fi
+    done
+    return 1
+}
+
+if ! CHROMIUM=$(find_chromium); then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        echo "chromium not found: installing the Debian package"
+        start=$(date +%s)
+        export DEBIAN_FRONTEND=noninteractive
+        apt-get update -qq
+        apt-get install -y -qq chromium >/dev/null
+        echo "chromium installed in $(( $(date +%s) - start )) s"
+        CHROMIUM=$(find_chromium)
+    else
+        echo "check_report: chromium is not installed and cannot be installed here (needs root and apt-get)" >&2
+        exit 1
+    fi
+fi
+"$CHROMIUM" --version 2>/dev/null || true
+
+if [ $# -ge 1 ]; then
+    OUT="$1"
+    mkdir -p "$OUT"
+else
+    OUT=$(mktemp -d -t impactcal-report-XXXXXX)
+    trap 'rm -rf "$OUT"' EXIT
+fi
+
+cargo run --quiet --example report_gallery -- "$OUT/report" >/dev/null
+python3 tests/browser/check_report.py --chromium "$CHROMIUM" --report "$OUT/report" --negative-controls
