@@ -19,19 +19,6 @@ fn pulse(t: f64, amplitude: f64, frequency: f64, decay: f64) -> f64 {
     amplitude * (-decay * t).exp() * (2.0 * PI * frequency * t).sin().abs() + 0.2 * amplitude
 }
 
-fn axis(label: &str) -> Axis {
-    Axis {
-        label: label.to_owned(),
-    }
-}
-
-fn series(name: &str, values: Vec<f64>) -> Series {
-    Series {
-        name: name.to_owned(),
-        values,
-    }
-}
-
 fn figure(name: &str, caption: &str, plot: Plot) -> Block {
     Block::Figure(Figure {
         name: name.to_owned(),
@@ -73,12 +60,12 @@ fn envelope(t: &[f64], test: &[f64]) -> Envelope {
     }
     Envelope {
         x: t.to_vec(),
-        x_axis: axis("time (s)"),
-        y_axis: axis("Q (in/s)"),
+        x_axis: Axis::new("time (s)"),
+        y_axis: Axis::new("Q (in/s)"),
         band_name: "ensemble min/max (40 runs)".into(),
         lower,
         upper,
-        series: vec![series("test Q_e", test.to_vec())],
+        series: vec![Series::new("test Q_e", test.to_vec())],
         marked,
     }
 }
@@ -121,8 +108,8 @@ fn mac_map() -> HeatMap {
     HeatMap {
         values,
         range: (0.0, 1.0),
-        row_axis: axis("test shape"),
-        column_axis: axis("baseline model shape"),
+        row_axis: Axis::new("test shape"),
+        column_axis: Axis::new("baseline model shape"),
         row_weights: weights.clone(),
         column_weights: weights.iter().map(|w| 0.9 * w).collect(),
         marked,
@@ -139,16 +126,16 @@ fn indices(t: &[f64], q: &[f64]) -> Stacked {
     };
     Stacked {
         x: t.to_vec(),
-        x_axis: axis("time (s)"),
-        y_axis: axis("first-order index (-)"),
+        x_axis: Axis::new("time (s)"),
+        y_axis: Axis::new("first-order index (-)"),
         stacked: vec![
-            series("floor thickness", bump(0.005, 0.006)),
-            series("frame thickness", bump(0.018, 0.008)),
-            series("skin thickness", bump(0.032, 0.008)),
-            series("mass of seats", bump(0.045, 0.006)),
+            Series::new("floor thickness", bump(0.005, 0.006)),
+            Series::new("frame thickness", bump(0.018, 0.008)),
+            Series::new("skin thickness", bump(0.032, 0.008)),
+            Series::new("mass of seats", bump(0.045, 0.006)),
         ],
-        top_axis: axis("Q (in/s)"),
-        top: series("baseline Q(t)", q.to_vec()),
+        top_axis: Axis::new("Q (in/s)"),
+        top: Series::new("baseline Q(t)", q.to_vec()),
     }
 }
 
@@ -253,12 +240,12 @@ fn gallery() -> Report {
                         "Q(t) of test, baseline and calibrated model.",
                         Plot::Lines(Lines {
                             x: t.clone(),
-                            x_axis: axis("time (s)"),
-                            y_axis: axis("Q (in/s)"),
+                            x_axis: Axis::new("time (s)"),
+                            y_axis: Axis::new("Q (in/s)"),
                             series: vec![
-                                series("test", test.clone()),
-                                series("baseline", baseline.clone()),
-                                series("calibrated", calibrated),
+                                Series::new("test", test.clone()),
+                                Series::new("baseline", baseline.clone()),
+                                Series::new("calibrated", calibrated),
                             ],
                         }),
                     ),
@@ -267,12 +254,12 @@ fn gallery() -> Report {
                         "Sensor 1021.z: test, baseline and calibrated histories.",
                         Plot::Lines(Lines {
                             x: t.clone(),
-                            x_axis: axis("time (s)"),
-                            y_axis: axis("velocity (in/s)"),
+                            x_axis: Axis::new("time (s)"),
+                            y_axis: Axis::new("velocity (in/s)"),
                             series: vec![
-                                series("test", sensor(120.0, 42.0)),
-                                series("baseline", sensor(100.0, 40.0)),
-                                series("calibrated", sensor(115.0, 41.5)),
+                                Series::new("test", sensor(120.0, 42.0)),
+                                Series::new("baseline", sensor(100.0, 40.0)),
+                                Series::new("calibrated", sensor(115.0, 41.5)),
                             ],
                         }),
                     ),

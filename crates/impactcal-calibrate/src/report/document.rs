@@ -86,11 +86,30 @@ pub struct Series {
     pub values: Vec<f64>,
 }
 
+impl Series {
+    /// A curve named `name` with ordinates `values`.
+    pub fn new(name: impl Into<String>, values: Vec<f64>) -> Self {
+        Series {
+            name: name.into(),
+            values,
+        }
+    }
+}
+
 /// An axis: its label with the unit, e.g. `"time (s)"`, `"Q (in/s)"`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
     /// Label including the unit in parentheses.
     pub label: String,
+}
+
+impl Axis {
+    /// An axis labelled `label` (quantity and unit, e.g. `"time (s)"`).
+    pub fn new(label: impl Into<String>) -> Self {
+        Axis {
+            label: label.into(),
+        }
+    }
 }
 
 /// Curves over a common abscissa.

@@ -13,19 +13,6 @@ use crate::CalibrateError;
 
 // ----- building documents -----
 
-fn axis(label: &str) -> Axis {
-    Axis {
-        label: label.to_owned(),
-    }
-}
-
-fn series(name: &str, values: Vec<f64>) -> Series {
-    Series {
-        name: name.to_owned(),
-        values,
-    }
-}
-
 fn time(n: usize) -> Vec<f64> {
     (0..n).map(|k| k as f64 * 1e-3).collect()
 }
@@ -39,10 +26,10 @@ fn wave(n: usize, a: f64, f: f64) -> Vec<f64> {
 fn lines(k: usize) -> Lines {
     Lines {
         x: time(100),
-        x_axis: axis("time (s)"),
-        y_axis: axis("Q (in/s)"),
+        x_axis: Axis::new("time (s)"),
+        y_axis: Axis::new("Q (in/s)"),
         series: (0..k)
-            .map(|i| series(&format!("curve {i}"), wave(100, 1.0 + i as f64, 40.0)))
+            .map(|i| Series::new(format!("curve {i}"), wave(100, 1.0 + i as f64, 40.0)))
             .collect(),
     }
 }
@@ -51,12 +38,12 @@ fn envelope(marked: Vec<(f64, f64)>) -> Envelope {
     let mid = wave(100, 2.0, 50.0);
     Envelope {
         x: time(100),
-        x_axis: axis("time (s)"),
-        y_axis: axis("Q (in/s)"),
+        x_axis: Axis::new("time (s)"),
+        y_axis: Axis::new("Q (in/s)"),
         band_name: "ensemble min/max (20 runs)".into(),
         lower: mid.iter().map(|v| v - 1.0).collect(),
         upper: mid.iter().map(|v| v + 1.0).collect(),
-        series: vec![series("test", wave(100, 2.5, 50.0))],
+        series: vec![Series::new("test", wave(100, 2.5, 50.0))],
         marked,
     }
 }
@@ -72,8 +59,8 @@ fn heat_map(rows: usize, cols: usize) -> HeatMap {
             })
             .collect(),
         range: (0.0, 1.0),
-        row_axis: axis("test shape"),
-        column_axis: axis("model shape"),
+        row_axis: Axis::new("test shape"),
+        column_axis: Axis::new("model shape"),
         row_weights: (0..rows).map(|i| 50.0 / (i + 1) as f64).collect(),
         column_weights: (0..cols).map(|j| 40.0 / (j + 1) as f64).collect(),
         marked: (0..rows.min(cols)).map(|i| (i, i)).collect(),
@@ -84,13 +71,13 @@ fn heat_map(rows: usize, cols: usize) -> HeatMap {
 fn stacked(k: usize) -> Stacked {
     Stacked {
         x: time(80),
-        x_axis: axis("time (s)"),
-        y_axis: axis("first-order index (-)"),
+        x_axis: Axis::new("time (s)"),
+        y_axis: Axis::new("first-order index (-)"),
         stacked: (0..k)
-            .map(|i| series(&format!("p{i}"), vec![0.8 / k as f64; 80]))
+            .map(|i| Series::new(format!("p{i}"), vec![0.8 / k as f64; 80]))
             .collect(),
-        top_axis: axis("Q (in/s)"),
-        top: series("baseline Q(t)", wave(80, 3.0, 30.0)),
+        top_axis: Axis::new("Q (in/s)"),
+        top: Series::new("baseline Q(t)", wave(80, 3.0, 30.0)),
     }
 }
 
@@ -507,9 +494,9 @@ fn degenerate_but_valid_data_renders() {
     // One sample, constant curves, a single cell, a structure of one marker.
     let one = Lines {
         x: vec![0.5],
-        x_axis: axis("t (s)"),
-        y_axis: axis("v (in/s)"),
-        series: vec![series("only", vec![3.0])],
+        x_axis: Axis::new("t (s)"),
+        y_axis: Axis::new("v (in/s)"),
+        series: vec![Series::new("only", vec![3.0])],
     };
     parse(&svg_of(Plot::Lines(one)));
     let mut flat = lines(2);
@@ -545,7 +532,7 @@ proptest! {
                 Series { name: format!("s{j}"), values }
             })
             .collect();
-        let svg = svg_of(Plot::Lines(Lines { x, x_axis: axis("x (m)"), y_axis: axis("y (m)"), series }));
+        let svg = svg_of(Plot::Lines(Lines { x, x_axis: Axis::new("x (m)"), y_axis: Axis::new("y (m)"), series }));
         let doc = parse(&svg);
         prop_assert_eq!(count(&doc, "polyline", &[("stroke-width", "2")]), 2 * k);
     }

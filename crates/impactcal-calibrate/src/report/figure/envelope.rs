@@ -3,7 +3,7 @@
 
 use plotters::prelude::*;
 
-use super::{BAND, MARK};
+use super::{BAND, MARK, band};
 use super::{Drawn, WIDTH, abscissa, cartesian, colour, legend, line, padded};
 use crate::Result;
 use crate::report::document::Envelope;
@@ -44,18 +44,16 @@ pub(super) fn draw(p: &Envelope, svg: &mut String, name: &str) -> Result<()> {
             .label("outside the band")
             .legend(move |(x, y)| Rectangle::new([(x, y - 7), (x + 24, y + 7)], strip));
     }
-    let band = BAND.mix(0.45).filled();
-    let outline: Vec<(f64, f64)> =
-        p.x.iter()
-            .copied()
-            .zip(p.upper.iter().copied())
-            .chain(p.x.iter().copied().zip(p.lower.iter().copied()).rev())
-            .collect();
-    chart
-        .draw_series(std::iter::once(Polygon::new(outline, band)))
-        .drawn(name)?
-        .label(p.band_name.as_str())
-        .legend(move |(x, y)| Rectangle::new([(x, y - 7), (x + 24, y + 7)], band));
+    let fill = BAND.mix(0.45).filled();
+    band(
+        &mut chart,
+        &p.x,
+        &p.upper,
+        &p.lower,
+        &p.band_name,
+        fill,
+        name,
+    )?;
     for (i, s) in p.series.iter().enumerate() {
         line(&mut chart, &p.x, &s.values, &s.name, colour(i), name)?;
     }

@@ -183,6 +183,32 @@ pub(crate) fn line(
     Ok(())
 }
 
+/// Fills the region between `upper` and `lower` over `x` as one polygon (the upper edge
+/// forwards, the lower edge backwards: `2 x.len()` vertices) in `fill`, with a legend entry
+/// `label` drawn as a swatch.
+pub(crate) fn band(
+    chart: &mut Chart<'_, '_>,
+    x: &[f64],
+    upper: &[f64],
+    lower: &[f64],
+    label: &str,
+    fill: ShapeStyle,
+    name: &str,
+) -> Result<()> {
+    let outline: Vec<(f64, f64)> = x
+        .iter()
+        .copied()
+        .zip(upper.iter().copied())
+        .chain(x.iter().copied().zip(lower.iter().copied()).rev())
+        .collect();
+    chart
+        .draw_series(std::iter::once(Polygon::new(outline, fill)))
+        .drawn(name)?
+        .label(label)
+        .legend(move |(x, y)| Rectangle::new([(x, y - 7), (x + 24, y + 7)], fill));
+    Ok(())
+}
+
 /// Draws the legend of `chart` in its upper right corner, over a translucent white box.
 pub(crate) fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, name: &str) -> Result<()> {
     chart

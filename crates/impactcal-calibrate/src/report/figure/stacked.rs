@@ -3,6 +3,7 @@
 
 use plotters::prelude::*;
 
+use super::band;
 use super::{Drawn, WIDTH, abscissa, cartesian, colour, legend, line, padded};
 use crate::Result;
 use crate::report::document::Stacked;
@@ -58,17 +59,7 @@ pub(super) fn draw(p: &Stacked, svg: &mut String, name: &str) -> Result<()> {
     )?;
     for (k, (s, (from, to))) in p.stacked.iter().zip(&sums).enumerate() {
         let fill = colour(k + 1).mix(0.85).filled();
-        let outline: Vec<(f64, f64)> =
-            p.x.iter()
-                .copied()
-                .zip(to.iter().copied())
-                .chain(p.x.iter().copied().zip(from.iter().copied()).rev())
-                .collect();
-        chart
-            .draw_series(std::iter::once(Polygon::new(outline, fill)))
-            .drawn(name)?
-            .label(s.name.as_str())
-            .legend(move |(x, y)| Rectangle::new([(x, y - 7), (x + 24, y + 7)], fill));
+        band(&mut chart, &p.x, to, from, &s.name, fill, name)?;
     }
     legend(&mut chart, name)?;
     root.present().drawn(name)
