@@ -500,12 +500,13 @@ mod tests {
         let a: Vec<f64> = pts.iter().map(|p| p[0]).collect();
         let mean = a.iter().sum::<f64>() / 16.0;
         let sd = (a.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 15.0).sqrt();
-        for k in [0usize, 10, 50, 100] {
-            let t = k as f64 * 0.01;
+        // Samples every 1 ms: sample k is t = k / 1000.
+        for k in [0usize, 100, 500, 1000] {
+            let t = k as f64 * 0.001;
             assert!((noise.spread[0][k] - sd * t).abs() <= 1e-12, "k = {k}");
         }
         // The growing channel: spread of (a - 1) exp(g t) with g jittered too; within 2 %.
-        let k = 80;
+        let k = 800;
         let vals: Vec<f64> = pts
             .iter()
             .map(|p| 1.0 + (p[0] - 1.0) * (p[1] * 0.8).exp())
