@@ -5,9 +5,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use impactcal::shell::element::{
-    ElementOutput, KernelOptions, PartProps, quad_batch,
-};
+use impactcal::shell::element::{ElementOutput, KernelOptions, PartProps, quad_batch};
 use impactcal::shell::{Hourglass, Simulation};
 
 #[path = "common/shell_plate.rs"]
