@@ -284,16 +284,19 @@ pub(crate) fn section_response<L: Lane, const N: usize>(
     let (mxx, myy, mxy) = (ta * mxx, ta * myy, ta * mxy);
     let inv_n = 1.0 / N as f64;
     let (qxa, qya) = (area * qxf * inv_n, area * qyf * inv_n);
-    let f = std::array::from_fn(|i| {
-        [
+    // Plain loops rather than `array::from_fn`, whose closure the compiler does not always
+    // inline in this hot path.
+    let mut f = [[z; 6]; N];
+    for i in 0..N {
+        f[i] = [
             b1[i] * nxx + b2[i] * nxy,
             b2[i] * nyy + b1[i] * nxy,
             area * (b1[i] * qxf + b2[i] * qyf),
             -b2[i] * myy - b1[i] * mxy - qya,
             b1[i] * mxx + b2[i] * mxy + qxa,
             z,
-        ]
-    });
+        ];
+    }
     SectionResponse {
         f,
         internal,
@@ -307,10 +310,12 @@ pub(crate) fn section_response<L: Lane, const N: usize>(
 #[inline(always)]
 pub(crate) fn to_global<L: Lane, const N: usize>(e: &[L3<L>; 3], f: &[[L; 6]; N]) -> [[L; 6]; N] {
     let [e1, e2, e3] = e;
-    std::array::from_fn(|i| {
-        std::array::from_fn(|c| {
-            let (k, o) = (c % 3, 3 * (c / 3));
-            e1[k] * f[i][o] + e2[k] * f[i][o + 1] + e3[k] * f[i][o + 2]
-        })
-    })
+    let mut g = [[L::default(); 6]; N];
+    for i in 0..N {
+        for k in 0..3 {
+            g[i][k] = e1[k] * f[i][0] + e2[k] * f[i][1] + e3[k] * f[i][2];
+            g[i][3 + k] = e1[k] * f[i][3] + e2[k] * f[i][4] + e3[k] * f[i][5];
+        }
+    }
+    g
 }
