@@ -5,9 +5,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use impactcal::shell::element::{
-    ElementOutput, KernelOptions, PartProps, STATE_HEAD, STATE_PER_POINT, quad_batch,
-};
+use impactcal::shell::element::{ElementOutput, KernelOptions, PartProps, quad_batch};
 use impactcal::shell::{Hourglass, Simulation};
 
 #[path = "common/shell_plate.rs"]
@@ -19,7 +17,7 @@ mod shell_plate;
 fn kernel(c: &mut Criterion) {
     let m = shell_plate::plate();
     let n = m.shells.len();
-    let props = PartProps::new(&m.sections[0], &m.materials[0], &Hourglass::default());
+    let props = PartProps::new(&m.sections[0], &m.materials[0], &Hourglass::default()).unwrap();
     let index = |id: u64| (id - 1) as u32;
     let elems: Vec<[u32; 4]> = m.shells.iter().map(|s| s.nodes.map(index)).collect();
     let x: Vec<[f64; 3]> = m.nodes.iter().map(|p| p.x).collect();
@@ -29,7 +27,7 @@ fn kernel(c: &mut Criterion) {
         .map(|iv| iv.translation)
         .collect();
     let w = vec![[0.0; 3]; x.len()];
-    let stride = STATE_HEAD + STATE_PER_POINT * props.z.len();
+    let stride = props.state_len();
     let mut state = vec![0.0; stride * n];
     let mut out = vec![ElementOutput::default(); n];
     let opts = KernelOptions {

@@ -112,6 +112,7 @@ fn shell_kind(e: &ShellError) -> ErrorKind {
         ShellError::Core(c) => c.kind(),
         ShellError::Keyword { .. }
         | ShellError::UnsupportedKeyword { .. }
+        | ShellError::UnsupportedKeywords { .. }
         | ShellError::Reference { .. }
         | ShellError::Element { .. }
         | ShellError::Value { .. } => ErrorKind::BadInput,

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
 use impactcal::shell::airframe::{Airframe, AirframeOptions, AirframeValues, MeshDensity};
-use impactcal::shell::keyword::read_deck;
-use impactcal::shell::{Quantity, ShellError, ShellModel, Simulation};
+use impactcal::shell::keyword::{Deck, read_deck};
+use impactcal::shell::{Energies, Quantity, ShellError, ShellModel, Simulation};
 
 use crate::error::CliError;
 
@@ -91,13 +91,18 @@ impl Source {
         Ok((airframe, values))
     }
 
-    /// The deck's model, with its warnings printed on stderr.
-    pub fn deck_model(&self, path: &std::path::Path) -> Result<ShellModel, CliError> {
+    /// The deck, with its warnings printed on stderr.
+    pub fn deck(&self, path: &std::path::Path) -> Result<Deck, CliError> {
         let deck = read_deck(path)?;
         for w in &deck.warnings {
             eprintln!("impactcal: warning: {w}");
         }
-        Ok(deck.model)
+        Ok(deck)
+    }
+
+    /// The deck's model, with its warnings printed on stderr.
+    pub fn deck_model(&self, path: &std::path::Path) -> Result<ShellModel, CliError> {
+        Ok(self.deck(path)?.model)
     }
 }
 
@@ -193,7 +198,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let s = &result.summary;
     eprintln!(
         "impactcal: {} shells, {} cycles to t = {:.4e}; time step {:.3e} (first {:.3e}, max {:.3e}); \
-         energy ratio {:.4}; hourglass/internal {:.2}%; peak wall force {:.4e}; \
+         energy ratio {:.4}; {}; peak wall force {:.4e}; \
          {:.2} s wall time on {} threads ({:.3} us per element-cycle)",
         s.elements,
         s.cycles,
@@ -202,11 +207,44 @@ pub fn run(args: Args) -> Result<(), CliError> {
         s.dt_first,
         s.dt_max,
         s.energy_ratio,
-        100.0 * s.hourglass_share,
+        hourglass_message(&s.energies, s.hourglass_share),
         s.peak_wall_force,
         wall,
         pool.current_num_threads(),
         1e6 * wall / (s.cycles.max(1) as f64 * s.elements.max(1) as f64)
     );
     Ok(())
+}
+
+/// The hourglass share of the internal energy, or a note that the internal energy is
+/// negligible (below 1e-6 of the initial energy: a share of it would mean nothing).
+fn hourglass_message(e: &Energies, share: f64) -> String {
+    let scale = e.initial.abs().max(e.kinetic.abs());
+    if e.internal > 1e-6 * scale {
+        format!("hourglass/internal {:.2}%", 100.0 * share)
+    } else {
+        format!(
+            "internal energy negligible ({:.3e}, initial {:.3e}): no hourglass share",
+            e.internal, e.initial
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_hourglass_share_is_printed_only_for_a_real_internal_energy() {
+        let mut e = Energies {
+            initial: 100.0,
+            kinetic: 90.0,
+            internal: 10.0,
+            ..Energies::default()
+        };
+        assert_eq!(hourglass_message(&e, 0.0312), "hourglass/internal 3.12%");
+        e.internal = 1e-9;
+        let m = hourglass_message(&e, 0.5);
+        assert!(m.starts_with("internal energy negligible"), "{m}");
+    }
 }

@@ -73,3 +73,61 @@ fn a_bad_deck_is_an_input_error_naming_the_line() {
         "{err}"
     );
 }
+
+#[test]
+fn every_unsupported_keyword_is_named_on_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("many.k");
+    std::fs::write(
+        &bad,
+        "*KEYWORD\n*CONTACT_AUTOMATIC_SINGLE_SURFACE\n1\n*SECTION_SOLID\n2\n*MAT_024\n3\n*END\n",
+    )
+    .unwrap();
+    let out = impactcal(&["simulate", "--deck", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    for (kw, line) in [
+        ("*CONTACT_AUTOMATIC_SINGLE_SURFACE", 2),
+        ("*SECTION_SOLID", 4),
+        ("*MAT_024", 6),
+    ] {
+        assert!(err.contains(&format!("{kw} (")), "{err}");
+        assert!(err.contains(&format!("line {line})")), "{err}");
+    }
+}
+
+#[test]
+fn a_latin1_deck_runs_with_a_warning_and_a_motion_without_strain_has_no_hourglass_share() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(example_file("decks", "strip_drop.k")).unwrap();
+    // Free flight: no wall, so no strain and no internal energy; a Latin-1 title.
+    let text = text
+        .replace(
+            "*RIGIDWALL_PLANAR\n         0\n       0.0       0.0       0.0       0.0       0.0       1.0       0.3\n",
+            "",
+        )
+        .replace("strip drop\n", "strip in free flight, \u{e9}l\u{e8}ve\n")
+        .replace("    2.0e-3\n", "    2.0e-4\n");
+    assert!(!text.contains("RIGIDWALL"));
+    let bytes: Vec<u8> = text
+        .chars()
+        .map(|c| u8::try_from(u32::from(c)).unwrap())
+        .collect();
+    let deck = dir.path().join("latin1.k");
+    std::fs::write(&deck, bytes).unwrap();
+    let out = impactcal(&["simulate", "--deck", deck.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("line 4") && err.contains("Latin-1"), "{err}");
+    assert!(err.contains("internal energy negligible"), "{err}");
+    assert!(!err.contains("hourglass/internal"), "{err}");
+    // The dropped strip deforms: its share is printed.
+    let out = impactcal(&[
+        "simulate",
+        "--deck",
+        example_file("decks", "strip_drop.k").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("hourglass/internal"), "{err}");
+}

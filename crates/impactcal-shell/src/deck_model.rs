@@ -9,7 +9,12 @@
 //!   elastic-plastic material (`Et` only where it is not zero);
 //! - `mass.<id>`: every non-zero concentrated mass (`*ELEMENT_MASS`).
 //!
-//! Each has the bounds +-20 % about its value in the model. These are the quantities a crash
+//! Each has the bounds +-20 % about its value in the model.
+//!
+//! A deck with `*PARAMETER` cards speaks for itself instead ([`DeckModel::from_deck`]): its
+//! real (`R`) parameters are the quantities, under the deck's own names, with the bounds
+//! +-20 % about the deck's values unless the caller gives bounds; a run reads the deck
+//! again with the point's values in its parameters. These are the quantities a crash
 //! analyst would call "the model" as opposed to the test conditions (impact velocity,
 //! attitude, ground, controls), and the ones a jitter ensemble perturbs
 //! ([`impactcal_core::noise`]).
@@ -35,6 +40,7 @@
 use impactcal_core::{CoreError, Histories, Model, Parameter, ParameterSpace};
 
 use crate::error::{Result, ShellError};
+use crate::keyword::Deck;
 use crate::model::{MaterialLaw, ShellModel};
 use crate::simulation::{Quantity, Simulation};
 
@@ -56,6 +62,8 @@ pub struct DeckModel {
     space: ParameterSpace,
     targets: Vec<Target>,
     quantity: Quantity,
+    /// A parameterised deck: its parameters are the quantities, in the order of `space`.
+    deck: Option<Deck>,
 }
 
 impl DeckModel {
@@ -127,6 +135,73 @@ impl DeckModel {
             base: model,
             targets,
             quantity: Quantity::Velocity,
+            deck: None,
+        })
+    }
+
+    /// The model of a deck: with `*PARAMETER` cards, the deck's real (`R`) parameters are
+    /// the quantities (names as in the deck; `bounds`, when given, names some or all of
+    /// them with their bounds and nominal values, the others keep the deck's values; else
+    /// each is bounded +-20 % about the deck's value); without, as [`DeckModel::new`] on the
+    /// deck's model (`bounds` must then be `None`). The output is the velocity of the
+    /// history nodes.
+    ///
+    /// # Errors
+    /// [`ShellError::Value`] when the model has no history nodes, a bound names a parameter
+    /// the deck does not define (or the deck defines none), or a deck value of 0 would be
+    /// bounded without bounds given.
+    pub fn from_deck(deck: Deck, bounds: Option<&ParameterSpace>) -> Result<Self> {
+        let reals: Vec<_> = deck.parameters.iter().filter(|p| !p.integer).collect();
+        if reals.is_empty() {
+            if bounds.is_some() {
+                return Err(ShellError::value(
+                    "deck",
+                    "defines no real *PARAMETER to take the given bounds",
+                ));
+            }
+            return DeckModel::new(deck.model);
+        }
+        if deck.model.output.history_nodes.is_empty() {
+            return Err(ShellError::value(
+                "model",
+                "has no history nodes (*DATABASE_HISTORY_NODE): nothing to output",
+            ));
+        }
+        let space = match bounds {
+            Some(space) => {
+                for n in space.names() {
+                    if !reals.iter().any(|p| p.name.eq_ignore_ascii_case(n)) {
+                        return Err(ShellError::value(
+                            format!("parameter {n}"),
+                            "is not a real *PARAMETER of the deck",
+                        ));
+                    }
+                }
+                space.clone()
+            }
+            None => {
+                let mut params = Vec::with_capacity(reals.len());
+                for p in &reals {
+                    let v = p.value;
+                    if v == 0.0 {
+                        return Err(ShellError::value(
+                            format!("parameter {} ({}: line {})", p.name, p.file, p.line),
+                            "is 0 in the deck: +-20 % bounds are empty, give its bounds",
+                        ));
+                    }
+                    let (lo, hi) = ((0.8 * v).min(1.2 * v), (0.8 * v).max(1.2 * v));
+                    params.push(Parameter::new(p.name.clone(), lo, hi, v)?);
+                }
+                ParameterSpace::new(params)?
+            }
+        };
+        let base = deck.model.clone();
+        Ok(DeckModel {
+            space,
+            base,
+            targets: Vec::new(),
+            quantity: Quantity::Velocity,
+            deck: Some(deck),
         })
     }
 
@@ -148,6 +223,15 @@ impl DeckModel {
     /// A core dimension or finiteness error for a bad point.
     pub fn model_at(&self, point: &[f64]) -> Result<ShellModel> {
         self.space.to_unit(point)?;
+        if let Some(deck) = &self.deck {
+            let values: Vec<(&str, f64)> = self
+                .space
+                .names()
+                .into_iter()
+                .zip(point.iter().copied())
+                .collect();
+            return Ok(deck.with_parameters(&values)?.model);
+        }
         let mut m = self.base.clone();
         for (&t, &v) in self.targets.iter().zip(point) {
             match t {

@@ -31,6 +31,14 @@ pub enum ShellError {
         /// The keyword as written.
         keyword: String,
     },
+    /// Several keywords this reader does not support, all listed with their lines.
+    #[error("{file}: {} unsupported keywords: {}", found.len(), list_unsupported(found))]
+    UnsupportedKeywords {
+        /// The deck file.
+        file: String,
+        /// Each unsupported keyword and where it stands, in the order of the deck.
+        found: Vec<UnsupportedAt>,
+    },
     /// An id that is referenced but never defined (or defined twice).
     #[error("{what} {id}: {message}")]
     Reference {
@@ -93,4 +101,23 @@ impl ShellError {
             message: message.into(),
         }
     }
+}
+
+/// An unsupported keyword and where it stands.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnsupportedAt {
+    /// The file (the deck or a file it includes).
+    pub file: String,
+    /// 1-based line number of the keyword.
+    pub line: usize,
+    /// The keyword as written (upper case).
+    pub keyword: String,
+}
+
+fn list_unsupported(found: &[UnsupportedAt]) -> String {
+    let parts: Vec<String> = found
+        .iter()
+        .map(|u| format!("{} ({}: line {})", u.keyword, u.file, u.line))
+        .collect();
+    parts.join(", ")
 }

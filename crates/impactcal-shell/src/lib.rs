@@ -79,15 +79,15 @@ pub mod deck_model;
 pub mod element;
 pub mod error;
 mod geometry;
-mod kernel;
 pub mod keyword;
 pub mod material;
 pub mod model;
 mod setup;
 pub mod simulation;
+mod validate;
 
 pub use deck_model::DeckModel;
-pub use error::{Result, ShellError};
+pub use error::{Result, ShellError, UnsupportedAt};
 pub use model::{
     BodyLoadZ, BulkViscosity, Control, CowperSymonds, Curve, Hourglass, HourglassForm,
     InitialVelocity, Material, MaterialLaw, Node, NodeSet, NodeTarget, Output, Part,

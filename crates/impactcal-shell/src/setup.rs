@@ -5,9 +5,8 @@ use std::collections::HashMap;
 use crate::element::{self, ElementFault, PartProps};
 use crate::error::{Result, ShellError};
 use crate::geometry::{dot, norm, sub};
-use crate::model::{
-    MaterialLaw, NodeTarget, ShellModel, ThicknessRule, VelocityTarget, WallMethod,
-};
+use crate::model::{NodeTarget, ShellModel, VelocityTarget, WallMethod};
+use crate::validate::{check_hourglass, check_material, check_section, non_negative, positive};
 
 /// An element in solver form: node indices, triangle flag, part index.
 #[derive(Debug, Clone, Copy)]
@@ -70,28 +69,6 @@ fn lookup(map: &HashMap<u64, usize>, id: u64, what: &'static str, by: &str) -> R
     })
 }
 
-fn positive(what: String, v: f64) -> Result<()> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(ShellError::value(
-            what,
-            format!("must be finite and positive, got {v}"),
-        ))
-    }
-}
-
-fn non_negative(what: String, v: f64) -> Result<()> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(ShellError::value(
-            what,
-            format!("must be finite and non-negative, got {v}"),
-        ))
-    }
-}
-
 /// Validates `model` and builds the solver's form.
 pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
     let node_map = unique(&model.nodes, |n| n.id, "node")?;
@@ -113,70 +90,21 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         }
     }
 
-    // Materials and sections.
+    // Materials and sections (every one, referenced or not).
     for m in &model.materials {
-        let w = |f: &str| format!("material {}, {f}", m.id);
-        positive(w("density"), m.density)?;
-        positive(w("Young's modulus"), m.youngs)?;
-        if !(m.poisson > -1.0 && m.poisson < 0.5) {
-            return Err(ShellError::value(
-                w("nu"),
-                format!("must lie in (-1, 0.5), got {}", m.poisson),
-            ));
-        }
-        if let MaterialLaw::Plastic {
-            yield_stress,
-            tangent_modulus,
-            rate,
-        } = m.law
-        {
-            positive(w("yield stress"), yield_stress)?;
-            if !(tangent_modulus.is_finite()
-                && tangent_modulus >= 0.0
-                && tangent_modulus < m.youngs)
-            {
-                return Err(ShellError::value(
-                    w("tangent modulus"),
-                    format!("must satisfy 0 <= Et < E, got {tangent_modulus}"),
-                ));
-            }
-            if let Some(r) = rate {
-                positive(w("Cowper-Symonds C"), r.c)?;
-                positive(w("Cowper-Symonds p"), r.p)?;
-            }
-        }
+        check_material(m)?;
     }
     for s in &model.sections {
-        let w = |f: &str| format!("section {}, {f}", s.id);
-        positive(w("thickness"), s.thickness)?;
-        positive(w("shear factor"), s.shear_factor)?;
-        if !(1..=10).contains(&s.nip) {
-            return Err(ShellError::value(
-                w("NIP"),
-                format!("must be 1 to 10, got {}", s.nip),
-            ));
-        }
-        if s.rule == ThicknessRule::Lobatto && s.nip < 2 {
-            return Err(ShellError::value(
-                w("NIP"),
-                "Lobatto integration needs at least 2 points",
-            ));
-        }
+        check_section(s)?;
     }
     let hg = &model.hourglass;
-    for (name, v) in [
-        ("membrane", hg.membrane),
-        ("transverse", hg.transverse),
-        ("rotation", hg.rotation),
-    ] {
-        non_negative(format!("hourglass {name} coefficient"), v)?;
-    }
+    check_hourglass(hg)?;
     let mut parts = Vec::with_capacity(model.parts.len());
     for p in &model.parts {
         let by = format!("part {}", p.id);
         let sec = &model.sections[lookup(&sec_map, p.section, "section", &by)?];
         let mat = &model.materials[lookup(&mat_map, p.material, "material", &by)?];
-        parts.push(PartProps::new(sec, mat, hg));
+        parts.push(PartProps::new(sec, mat, hg)?);
     }
     if let Some(b) = model.bulk_viscosity {
         for (name, v) in [("Q1", b.q1), ("Q2", b.q2)] {

@@ -21,12 +21,12 @@
 use impactcal_core::Histories;
 use rayon::prelude::*;
 
+use crate::element::quad_lanes::{Block, LANES, quad_block};
 use crate::element::{
     self, ElementFault, ElementOutput, KernelOptions, STATE_HEAD, STATE_PER_POINT,
 };
 use crate::error::{Result, ShellError};
 use crate::geometry::{dot, sub};
-use crate::kernel::{Block, LANES, quad_block};
 use crate::model::{Curve, ShellModel, WallMethod};
 use crate::setup::{Compiled, Elem, compile};
 
@@ -91,7 +91,7 @@ pub struct RunSummary {
     pub cycles: u64,
     /// Time reached.
     pub end_time: f64,
-    /// First, smallest and largest time step.
+    /// Time step of the first cycle.
     pub dt_first: f64,
     /// Smallest time step used.
     pub dt_min: f64,
@@ -609,7 +609,9 @@ impl Simulation {
 
     /// Rigid walls, constraints and the velocity update over `dt_v` (from `v^{n-1/2}` to
     /// `v^{n+1/2}`), with `h_prev` the part of it before `t^n` and `dt_next` the next
-    /// position step. Returns the contact and friction energy removed.
+    /// position step. Adds the work of the walls (contact, friction) and of the global
+    /// damping over the step to the running energies and sets the kinetic energy of the new
+    /// velocities; returns nothing.
     fn kick(&mut self, h_prev: f64, dt_next: f64) {
         let dt_v = h_prev + 0.5 * dt_next;
         let mut force = [0.0; 3];

@@ -12,46 +12,16 @@ mod common;
 
 use common::*;
 use impactcal_shell::element::{self, KernelOptions, PartProps, STATE_HEAD, STATE_PER_POINT};
-use impactcal_shell::material::MaterialProps;
-use impactcal_shell::{HourglassForm, InitialVelocity, ShellError, Simulation, VelocityTarget};
+use impactcal_shell::{
+    Hourglass, InitialVelocity, Section, ShellError, Simulation, VelocityTarget,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 fn props(t: f64, nip: usize) -> PartProps {
-    // Gauss points for 5; tests use 5.
-    assert_eq!(nip, 5);
-    let zeta = [
-        -0.906_179_845_938_664,
-        -0.538_469_310_105_683,
-        0.0,
-        0.538_469_310_105_683,
-        0.906_179_845_938_664,
-    ];
-    let w = [
-        0.236_926_885_056_189,
-        0.478_628_670_499_366,
-        0.568_888_888_888_889,
-        0.478_628_670_499_366,
-        0.236_926_885_056_189,
-    ];
-    let z: Vec<f64> = zeta.iter().map(|z| 0.5 * t * z).collect();
-    let w: Vec<f64> = w.iter().map(|w| 0.5 * w).collect();
-    let z_moments = [
-        z.iter().zip(&w).map(|(z, w)| w * z).sum(),
-        z.iter().zip(&w).map(|(z, w)| w * z * z).sum(),
-    ];
-    PartProps {
-        t,
-        z,
-        w,
-        shear_factor: 5.0 / 6.0,
-        mat: MaterialProps::new(&aluminium(1)),
-        hg_form: HourglassForm::Stiffness,
-        hg: [0.05, 0.05, 0.05],
-        stiffness_damping: 0.0,
-        z_moments,
-        bulk: [0.0, 0.0],
-    }
+    let mut section = Section::new(1, t);
+    section.nip = nip;
+    PartProps::new(&section, &aluminium(1), &Hourglass::default()).unwrap()
 }
 
 fn rotation(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
@@ -154,7 +124,7 @@ fn constant_membrane_and_bending_patches_are_exact() {
     let quads = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]];
     let t = 0.01;
     let p = props(t, 5);
-    let mat = p.mat;
+    let mat = p.material();
     let dt = 1e-6;
     // Membrane: v = L x with L = [[a, b], [c, d]].
     let (la, lb, lc, ld) = (3.0, 1.0, -2.0, 0.5);
@@ -225,9 +195,9 @@ fn constant_membrane_and_bending_patches_are_exact() {
         let (mut mxx, mut myy, mut nxx) = (0.0, 0.0, 0.0);
         for k in 0..5 {
             let s = &st[STATE_HEAD + STATE_PER_POINT * k..];
-            mxx += t * p.w[k] * p.z[k] * s[0];
-            myy += t * p.w[k] * p.z[k] * s[1];
-            nxx += t * p.w[k] * s[0];
+            mxx += t * p.weights()[k] * p.heights()[k] * s[0];
+            myy += t * p.weights()[k] * p.heights()[k] * s[1];
+            nxx += t * p.weights()[k] * s[0];
         }
         let exx = d * (kx + mat.nu * ky) * dt;
         let eyy = d * (ky + mat.nu * kx) * dt;

@@ -170,8 +170,10 @@ anything after *END is ignored
 #[test]
 fn a_hand_written_deck_with_both_card_formats_runs() {
     let deck = parse_deck(DECK, "inline.k").unwrap();
-    assert_eq!(deck.warnings.len(), 1);
+    // The ignored output keyword, and the hourglass default (no *CONTROL_HOURGLASS).
+    assert_eq!(deck.warnings.len(), 2, "{:?}", deck.warnings);
     assert!(deck.warnings[0].contains("*DATABASE_GLSTAT"));
+    assert!(deck.warnings[1].contains("no *CONTROL_HOURGLASS"));
     let m = &deck.model;
     assert_eq!(m.title, "strip on the floor");
     assert_eq!(m.nodes[2].x, [0.05, 0.05, 0.005]);

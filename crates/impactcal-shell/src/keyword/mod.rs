@@ -14,8 +14,9 @@
 // Deck flags and defaults are exact values (0, 1): compare them exactly.
 #[allow(clippy::float_cmp)]
 mod reader;
+mod source;
 #[allow(clippy::float_cmp)]
 mod writer;
 
-pub use reader::{Deck, IGNORED_KEYWORDS, parse_deck, read_deck};
+pub use reader::{Deck, DeckParameter, IGNORED_KEYWORDS, parse_deck, read_deck};
 pub use writer::{write_deck, write_deck_file};

@@ -1,8 +1,12 @@
 //! Reading keyword decks.
 
+use std::cell::RefCell;
+use std::collections::HashMap;
 use std::path::Path;
 
-use crate::error::{Result, ShellError};
+use super::source::Source;
+
+use crate::error::{Result, ShellError, UnsupportedAt};
 use crate::model::{
     BodyLoadZ, BulkViscosity, CowperSymonds, Curve, HourglassForm, InitialVelocity, Material,
     MaterialLaw, NodeSet, NodeTarget, Part, PartStiffnessDamping, PointMass, RigidWall, Section,
@@ -30,37 +34,83 @@ pub const IGNORED_KEYWORDS: &[&str] = &[
     "*CONTROL_ENERGY",
 ];
 
-/// A parsed deck: the model and the warnings raised while reading it.
+/// A parameter of a deck (`*PARAMETER`): its name as written, its value, whether it is an
+/// integer (`I`) or a real (`R`) parameter, and where it is defined.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeckParameter {
+    /// The name, as written (references `&name` match it without regard to case).
+    pub name: String,
+    /// The value.
+    pub value: f64,
+    /// `I` parameter (integer) rather than `R` (real).
+    pub integer: bool,
+    /// The file that defines it.
+    pub file: String,
+    /// Its line there.
+    pub line: usize,
+}
+
+/// A parsed deck: the model, its parameters and the warnings raised while reading it.
 #[derive(Debug, Clone)]
 pub struct Deck {
     /// The model.
     pub model: ShellModel,
-    /// Warnings (ignored output-only keywords, fields read with a simplification).
+    /// Warnings (ignored output-only keywords, fields read with a simplification, defaults
+    /// used for missing control cards, numbers running across field boundaries).
     pub warnings: Vec<String>,
+    /// The `*PARAMETER` definitions of the deck and its includes, in the order read.
+    pub parameters: Vec<DeckParameter>,
+    /// The deck's lines, to read it again with other parameter values.
+    source: Source,
 }
 
-/// Reads a deck file.
+impl Deck {
+    /// The deck read again with the parameters `values` (name, value) in place of the
+    /// values of its `*PARAMETER` cards (names without regard to case; integer parameters
+    /// take the value rounded to the nearest integer).
+    ///
+    /// # Errors
+    /// [`ShellError::Value`] naming a parameter the deck does not define, otherwise as
+    /// [`parse_deck`].
+    pub fn with_parameters(&self, values: &[(&str, f64)]) -> Result<Deck> {
+        let mut overrides = HashMap::new();
+        for (name, v) in values {
+            let key = name.to_uppercase();
+            if !self.parameters.iter().any(|p| p.name.to_uppercase() == key) {
+                return Err(ShellError::value(
+                    format!("parameter {name}"),
+                    "is not defined by the deck (*PARAMETER)",
+                ));
+            }
+            overrides.insert(key, *v);
+        }
+        parse_source(self.source.clone(), &overrides)
+    }
+}
+
+/// Reads a deck file (with the files it includes).
 ///
 /// # Errors
 /// [`ShellError::Io`] when the file cannot be read, otherwise as [`parse_deck`].
 pub fn read_deck(path: impl AsRef<Path>) -> Result<Deck> {
-    let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| ShellError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
-    parse_deck(&text, &path.display().to_string())
+    parse_source(Source::from_file(path.as_ref())?, &HashMap::new())
 }
 
-/// One data card: its line number and fields.
+/// One data card: its line number and text.
 struct Card<'a> {
     line: usize,
     text: &'a str,
 }
 
+/// The values of the deck's parameters by upper-case name.
+type Params = HashMap<String, f64>;
+
 struct Ctx<'a> {
     file: &'a str,
     keyword: String,
+    params: &'a Params,
+    /// Warnings raised while splitting cards (numbers across field boundaries).
+    notes: &'a RefCell<Vec<String>>,
 }
 
 impl Ctx<'_> {
@@ -74,10 +124,11 @@ impl Ctx<'_> {
     }
 }
 
-/// The fields of a card, split by commas or by the fixed `widths` (the last width repeats).
-fn fields<'a>(text: &'a str, widths: &[usize]) -> Vec<&'a str> {
+/// The fields of a card, split by commas or by the fixed `widths` (the last width repeats),
+/// each with its first column (0-based; 0 for comma-separated fields).
+fn fields<'a>(text: &'a str, widths: &[usize]) -> Vec<(&'a str, usize)> {
     if text.contains(',') {
-        return text.split(',').map(str::trim).collect();
+        return text.split(',').map(|f| (f.trim(), 0)).collect();
     }
     let mut out = Vec::new();
     let mut pos = 0;
@@ -86,22 +137,125 @@ fn fields<'a>(text: &'a str, widths: &[usize]) -> Vec<&'a str> {
     while pos < bytes {
         let w = widths[k.min(widths.len() - 1)];
         let end = (pos + w).min(bytes);
-        out.push(text.get(pos..end).unwrap_or("").trim());
+        out.push((text.get(pos..end).unwrap_or("").trim(), pos));
         pos = end;
         k += 1;
     }
     out
 }
 
-struct Fields<'a, 'c> {
-    f: Vec<&'a str>,
+/// A number in LS-DYNA's forms: Rust's, `d`/`D` exponents, and Fortran's exponent without
+/// a letter (`2.00000-3` = 2e-3, `1.5+2` = 150).
+fn parse_number(s: &str) -> Option<f64> {
+    let t = s.replace(['d', 'D'], "e");
+    if let Ok(v) = t.parse::<f64>() {
+        return Some(v);
+    }
+    // A sign after a digit or a point starts the exponent.
+    let b = t.as_bytes();
+    let k = (1..b.len()).rev().find(|&k| {
+        (b[k] == b'+' || b[k] == b'-') && (b[k - 1].is_ascii_digit() || b[k - 1] == b'.')
+    })?;
+    format!("{}e{}", &t[..k], &t[k..]).parse().ok()
+}
+
+/// The fixed-format boundaries of `text` that a number runs across: where the last column
+/// of one field and the first of the next are both part of one run of characters that
+/// reads as a single number with a decimal point or an exponent (a value wider than its
+/// field). Returns the run and the indices of the fields it covers.
+fn overflows(text: &str, f: &[(&str, usize)]) -> Vec<(String, usize, usize)> {
+    let b = text.as_bytes();
+    // (run, first field, last field, start column)
+    let mut out: Vec<(String, usize, usize, usize)> = Vec::new();
+    for k in 1..f.len() {
+        let at = f[k].1;
+        if at == 0 || at >= b.len() || b[at - 1] == b' ' || b[at] == b' ' {
+            continue;
+        }
+        let start = b[..at]
+            .iter()
+            .rposition(|&c| c == b' ')
+            .map_or(0, |p| p + 1);
+        if let Some(o) = out.last_mut().filter(|o| o.3 == start) {
+            o.2 = k;
+            continue;
+        }
+        let end = b[at..]
+            .iter()
+            .position(|&c| c == b' ')
+            .map_or(b.len(), |p| at + p);
+        let Some(run) = text.get(start..end) else {
+            continue;
+        };
+        if run.contains(['.', 'e', 'E']) && parse_number(run).is_some() {
+            let first = f.iter().rposition(|x| x.1 <= start).unwrap_or(0);
+            out.push((run.to_string(), first, k, start));
+        }
+    }
+    out.into_iter().map(|(r, a, z, _)| (r, a, z)).collect()
+}
+
+struct Fields<'c> {
+    /// Each field's text after `&name` references are replaced, or the message of an
+    /// unknown reference.
+    f: Vec<std::result::Result<String, String>>,
     line: usize,
     ctx: &'c Ctx<'c>,
 }
 
-impl Fields<'_, '_> {
-    fn raw(&self, i: usize) -> Option<&str> {
-        self.f.get(i).copied().filter(|s| !s.is_empty())
+impl Fields<'_> {
+    fn new<'c>(c: &Card<'_>, widths: &[usize], ctx: &'c Ctx<'c>) -> Fields<'c> {
+        let raw = fields(c.text, widths);
+        if !c.text.contains(',') {
+            for (run, first, last) in overflows(c.text, &raw) {
+                let read: Vec<String> = raw[first..=last]
+                    .iter()
+                    .map(|(s, _)| format!("`{s}`"))
+                    .collect();
+                ctx.notes.borrow_mut().push(format!(
+                    "{}: line {}: {}: `{run}` runs across fields {} to {} (columns {} to {}), read as {}",
+                    ctx.file,
+                    c.line,
+                    ctx.keyword,
+                    first + 1,
+                    last + 1,
+                    raw[first].1 + 1,
+                    raw[last].1 + widths[last.min(widths.len() - 1)],
+                    read.join(", ")
+                ));
+            }
+        }
+        let f = raw
+            .iter()
+            .map(|(s, _)| {
+                let (neg, name) = match s.strip_prefix("-&") {
+                    Some(n) => (true, n),
+                    None => match s.strip_prefix('&') {
+                        Some(n) => (false, n),
+                        None => return Ok((*s).to_string()),
+                    },
+                };
+                match ctx.params.get(&name.trim().to_uppercase()) {
+                    Some(v) => Ok(format!("{:e}", if neg { -v } else { *v })),
+                    None => Err(format!("`{s}` refers to no *PARAMETER")),
+                }
+            })
+            .collect();
+        Fields {
+            f,
+            line: c.line,
+            ctx,
+        }
+    }
+
+    fn raw(&self, i: usize, name: &str) -> Result<Option<&str>> {
+        match self.f.get(i) {
+            None => Ok(None),
+            Some(Ok(s)) => Ok(Some(s.as_str()).filter(|s| !s.is_empty())),
+            Some(Err(m)) => Err(self
+                .ctx
+                .err(self.line, format!("field {name} (field {}): {m}", i + 1))),
+        }
     }
 
     /// Three consecutive real fields from `first` (a vector such as VX, VY, VZ), each
@@ -115,10 +269,10 @@ impl Fields<'_, '_> {
     }
 
     fn real(&self, i: usize, name: &str, default: f64) -> Result<f64> {
-        match self.raw(i) {
+        match self.raw(i, name)? {
             None => Ok(default),
             Some(s) => {
-                let v: f64 = s.replace(['d', 'D'], "e").parse().map_err(|_| {
+                let v = parse_number(s).ok_or_else(|| {
                     self.ctx
                         .err(self.line, format!("field {name}: `{s}` is not a number"))
                 })?;
@@ -134,7 +288,7 @@ impl Fields<'_, '_> {
     }
 
     fn int(&self, i: usize, name: &str, default: i64) -> Result<i64> {
-        match self.raw(i) {
+        match self.raw(i, name)? {
             None => Ok(default),
             Some(s) => s.parse::<i64>().or_else(|_| {
                 let v = self.real(i, name, 0.0)?;
@@ -183,65 +337,310 @@ impl Fields<'_, '_> {
 
 const W10: &[usize] = &[10];
 
-/// Parses a deck from text; `name` is used in messages.
-///
-/// # Errors
-/// [`ShellError::Keyword`] for a malformed card (naming line, keyword and field),
-/// [`ShellError::UnsupportedKeyword`] for a keyword outside the subset. References between
-/// ids are checked later, by [`crate::Simulation::new`].
-pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
-    let mut model = ShellModel::new("");
-    let mut warnings = Vec::new();
-    // *CONTROL_CONTACT RWPNAL, applied to every rigid wall once all are read.
-    let mut rwpnal = 0.0;
-    let mut lines = text.lines().enumerate().peekable();
-    // Skip anything before *KEYWORD (LS-DYNA ignores it too).
-    let mut blocks: Vec<(usize, String, Vec<Card<'a>>)> = Vec::new();
-    while let Some((i, l)) = lines.next() {
-        if l.starts_with('$') {
-            continue;
-        }
-        if let Some(kw) = l.strip_prefix('*') {
-            let kw = format!(
-                "*{}",
-                kw.split_whitespace().next().unwrap_or("").to_uppercase()
-            );
-            let mut cards = Vec::new();
-            while let Some((j, c)) = lines.peek() {
-                if c.starts_with('*') {
-                    break;
-                }
-                if !c.starts_with('$') {
-                    cards.push(Card {
-                        line: j + 1,
-                        text: c.trim_end(),
-                    });
-                }
-                lines.next();
-            }
-            // Trailing blank lines are not cards.
-            while cards.last().is_some_and(|c| c.text.trim().is_empty()) {
-                cards.pop();
-            }
-            let end = kw == "*END";
-            blocks.push((i + 1, kw, cards));
-            if end {
-                break;
+/// Keywords with a `_TITLE` variant (a title line ahead of each definition) and the number
+/// of cards of one definition (0: one definition per keyword, title first).
+const TITLED: &[(&str, usize)] = &[
+    ("*SECTION_SHELL", 2),
+    ("*MAT_ELASTIC", 1),
+    ("*MAT_001", 1),
+    ("*MAT_PLASTIC_KINEMATIC", 2),
+    ("*MAT_003", 2),
+    ("*DEFINE_CURVE", 0),
+    ("*SET_NODE_LIST", 0),
+];
+
+/// Keywords with an `_ID` variant (an id card `ID, HEADING` ahead of each definition) and
+/// the number of cards of one definition. `*DATABASE_HISTORY_NODE_ID` is different: one
+/// node per card, `ID` then a heading.
+const WITH_ID: &[(&str, usize)] = &[
+    ("*RIGIDWALL_PLANAR", 2),
+    ("*BOUNDARY_SPC_NODE", 1),
+    ("*BOUNDARY_SPC_SET", 1),
+];
+
+/// Every keyword this reader reads (beside the `_TITLE` and `_ID` variants above and the
+/// output-only ones it skips).
+const SUPPORTED: &[&str] = &[
+    "*KEYWORD",
+    "*END",
+    "*TITLE",
+    "*PARAMETER",
+    "*NODE",
+    "*ELEMENT_SHELL",
+    "*PART",
+    "*SECTION_SHELL",
+    "*MAT_ELASTIC",
+    "*MAT_001",
+    "*MAT_PLASTIC_KINEMATIC",
+    "*MAT_003",
+    "*ELEMENT_MASS",
+    "*SET_NODE_LIST",
+    "*INITIAL_VELOCITY",
+    "*INITIAL_VELOCITY_GENERATION",
+    "*INITIAL_VELOCITY_NODE",
+    "*BOUNDARY_SPC_NODE",
+    "*BOUNDARY_SPC_SET",
+    "*RIGIDWALL_PLANAR",
+    "*LOAD_BODY_Z",
+    "*DEFINE_CURVE",
+    "*DAMPING_GLOBAL",
+    "*DAMPING_PART_STIFFNESS",
+    "*CONTROL_BULK_VISCOSITY",
+    "*CONTROL_ACCURACY",
+    "*CONTROL_CONTACT",
+    "*CONTROL_TERMINATION",
+    "*CONTROL_TIMESTEP",
+    "*CONTROL_HOURGLASS",
+    "*DATABASE_HISTORY_NODE",
+    "*DATABASE_NODOUT",
+];
+
+/// A keyword's base name and the number of cards of one definition ahead of which a title
+/// or id card stands (`Some(0)`: one title card first), or `None` for a plain keyword.
+fn variant(kw: &str) -> (String, Option<usize>, bool) {
+    if kw == "*DATABASE_HISTORY_NODE_ID" {
+        return ("*DATABASE_HISTORY_NODE".into(), None, true);
+    }
+    for (suffix, table) in [("_TITLE", TITLED), ("_ID", WITH_ID)] {
+        if let Some(base) = kw.strip_suffix(suffix) {
+            if let Some(&(b, n)) = table.iter().find(|(b, _)| *b == base) {
+                return (b.to_string(), Some(n), false);
             }
         }
     }
-    for (line, kw, cards) in blocks {
+    (kw.to_string(), None, false)
+}
+
+/// Parses a deck from text; `name` is used in messages, and `*INCLUDE` paths are relative
+/// to its directory.
+///
+/// What the reader accepts beyond the plain cards: the `_TITLE` variants of the sections,
+/// materials, curves and node sets and the `_ID` variants of the walls, constraints and
+/// history nodes; `*INCLUDE` (nested); `*PARAMETER` (`R`/`I` names, in pairs of 10-column
+/// fields, 4 pairs a line) and `&name` / `-&name` references in any numeric field;
+/// Fortran exponents (`2.00000-3`); LS-PrePost's `ENDMAS` 1.0e8.
+///
+/// # Errors
+/// [`ShellError::Keyword`] for a malformed card (naming file, line, keyword and field), an
+/// unknown parameter reference, an unreadable or circular include;
+/// [`ShellError::UnsupportedKeyword`] for a keyword outside the subset, or
+/// [`ShellError::UnsupportedKeywords`] listing all of them with their lines when there are
+/// several. References between ids are checked later, by [`crate::Simulation::new`].
+pub fn parse_deck(text: &str, name: &str) -> Result<Deck> {
+    parse_source(Source::from_text(text, name)?, &HashMap::new())
+}
+
+/// A keyword and its cards: the keyword's file index and line, its upper-case name.
+struct Block<'a> {
+    file: usize,
+    line: usize,
+    kw: String,
+    cards: Vec<Card<'a>>,
+}
+
+/// The deck's blocks, from the first keyword to `*END` (anything before the first keyword
+/// is skipped, as LS-DYNA does).
+fn blocks(src: &Source) -> Vec<Block<'_>> {
+    let mut lines = src.lines.iter().peekable();
+    let mut blocks = Vec::new();
+    while let Some(l) = lines.next() {
+        let Some(kw) = l.text.strip_prefix('*') else {
+            continue;
+        };
+        let kw = format!(
+            "*{}",
+            kw.split_whitespace().next().unwrap_or("").to_uppercase()
+        );
+        let mut cards = Vec::new();
+        while let Some(c) = lines.peek() {
+            if c.text.starts_with('*') {
+                break;
+            }
+            if !c.text.starts_with('$') {
+                cards.push(Card {
+                    line: c.line,
+                    text: c.text.trim_end(),
+                });
+            }
+            lines.next();
+        }
+        // Trailing blank lines are not cards.
+        while cards.last().is_some_and(|c| c.text.trim().is_empty()) {
+            cards.pop();
+        }
+        let end = kw == "*END";
+        blocks.push(Block {
+            file: l.file,
+            line: l.line,
+            kw,
+            cards,
+        });
+        if end {
+            break;
+        }
+    }
+    blocks
+}
+
+/// The `*PARAMETER` definitions of the blocks, with `overrides` (upper-case names) in
+/// place of the deck's values.
+fn parameters(
+    src: &Source,
+    blocks: &[Block<'_>],
+    overrides: &Params,
+) -> Result<(Vec<DeckParameter>, Params)> {
+    let mut list: Vec<DeckParameter> = Vec::new();
+    let mut values = Params::new();
+    let empty = Params::new();
+    let notes = RefCell::new(Vec::new());
+    for b in blocks.iter().filter(|b| b.kw == "*PARAMETER") {
+        let ctx = Ctx {
+            file: &src.files[b.file],
+            keyword: b.kw.clone(),
+            params: &empty,
+            notes: &notes,
+        };
+        for c in &b.cards {
+            let f = Fields::new(c, W10, &ctx);
+            for pair in 0..f.f.len().div_ceil(2) {
+                let k = 2 * pair;
+                let field = format!("PRMR{}", pair + 1);
+                let Some(head) = f.raw(k, &field)? else {
+                    continue;
+                };
+                let (kind, pname) = head.split_at(1);
+                let pname = pname.trim();
+                let integer = match kind {
+                    "R" | "r" => false,
+                    "I" | "i" => true,
+                    _ => {
+                        return Err(ctx.err(
+                            c.line,
+                            format!(
+                                "field {field}: `{head}`: a parameter is `R name` (real) or \
+                                 `I name` (integer); character parameters are not supported"
+                            ),
+                        ));
+                    }
+                };
+                if pname.is_empty()
+                    || !pname
+                        .chars()
+                        .all(|ch| ch.is_ascii_alphanumeric() || ch == '_')
+                {
+                    return Err(ctx.err(
+                        c.line,
+                        format!("field {field}: `{head}` has no valid parameter name"),
+                    ));
+                }
+                let key = pname.to_uppercase();
+                if let Some(p) = list.iter().find(|p| p.name.to_uppercase() == key) {
+                    return Err(ctx.err(
+                        c.line,
+                        format!(
+                            "parameter {pname} is already defined ({}: line {})",
+                            p.file, p.line
+                        ),
+                    ));
+                }
+                let value = f.real(k + 1, &format!("VAL{}", pair + 1), 0.0)?;
+                let used = overrides
+                    .get(&key)
+                    .map_or(value, |&v| if integer { v.round() } else { v });
+                values.insert(key, used);
+                list.push(DeckParameter {
+                    name: pname.to_string(),
+                    value,
+                    integer,
+                    file: src.files[b.file].clone(),
+                    line: c.line,
+                });
+            }
+        }
+    }
+    Ok((list, values))
+}
+
+/// Parses the lines of a deck with the parameter values `overrides` (upper-case names).
+fn parse_source(src: Source, overrides: &Params) -> Result<Deck> {
+    let mut model = ShellModel::new("");
+    let mut warnings = src.warnings.clone();
+    let blocks = blocks(&src);
+    // Every unsupported keyword, before any card is read.
+    let unsupported: Vec<UnsupportedAt> = blocks
+        .iter()
+        .filter(|b| {
+            let (base, _, _) = variant(&b.kw);
+            !SUPPORTED.contains(&base.as_str()) && !IGNORED_KEYWORDS.contains(&b.kw.as_str())
+        })
+        .map(|b| UnsupportedAt {
+            file: src.files[b.file].clone(),
+            line: b.line,
+            keyword: b.kw.clone(),
+        })
+        .collect();
+    match unsupported.len() {
+        0 => {}
+        1 => {
+            let u = &unsupported[0];
+            return Err(ShellError::UnsupportedKeyword {
+                file: u.file.clone(),
+                line: u.line,
+                keyword: u.keyword.clone(),
+            });
+        }
+        _ => {
+            return Err(ShellError::UnsupportedKeywords {
+                file: src.files[0].clone(),
+                found: unsupported,
+            });
+        }
+    }
+    let (parameters, params) = parameters(&src, &blocks, overrides)?;
+    let notes = RefCell::new(Vec::new());
+    let (mut termination, mut hourglass) = (false, false);
+    // *CONTROL_CONTACT RWPNAL, applied to every rigid wall once all are read.
+    let mut rwpnal = 0.0;
+    for Block {
+        file,
+        line,
+        kw: written,
+        cards,
+    } in &blocks
+    {
+        let (line, name) = (*line, src.files[*file].as_str());
+        let (kw, titled, history_id) = variant(written);
         let ctx = Ctx {
             file: name,
-            keyword: kw.clone(),
+            keyword: written.clone(),
+            params: &params,
+            notes: &notes,
         };
-        let card = |c: &Card<'a>, widths: &[usize]| -> Fields<'a, '_> {
-            Fields {
-                f: fields(c.text, widths),
-                line: c.line,
-                ctx: &ctx,
+        // Drop the title or id cards of the _TITLE and _ID variants.
+        let cards: Vec<&Card<'_>> = match titled {
+            None => cards.iter().collect(),
+            Some(0) => cards.iter().skip(1).collect(),
+            Some(n) => {
+                if cards.len() % (n + 1) != 0 {
+                    return Err(ctx.err(
+                        line,
+                        format!(
+                            "each definition needs a title or id card and {n} data card(s), found {} card(s)",
+                            cards.len()
+                        ),
+                    ));
+                }
+                cards
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| i % (n + 1) != 0)
+                    .map(|(_, c)| c)
+                    .collect()
             }
         };
+        termination |= kw == "*CONTROL_TERMINATION";
+        hourglass |= kw == "*CONTROL_HOURGLASS";
+        let card = |c: &Card<'_>, widths: &[usize]| -> Fields<'_> { Fields::new(c, widths, &ctx) };
         let need = |n: usize| -> Result<()> {
             if cards.len() < n {
                 Err(ctx.err(line, format!("expected {n} card(s), found {}", cards.len())))
@@ -250,7 +649,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
         };
         match kw.as_str() {
-            "*KEYWORD" | "*END" => {}
+            "*KEYWORD" | "*END" | "*PARAMETER" => {}
             "*TITLE" => {
                 model.title = cards
                     .first()
@@ -297,7 +696,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     return Err(ctx.err(line, "each part needs a title card and a data card"));
                 }
                 for pair in cards.chunks(2) {
-                    let f = card(&pair[1], W10);
+                    let f = card(pair[1], W10);
                     let id = f.id(0, "PID")?;
                     let section = f.id(1, "SECID")?;
                     let material = f.id(2, "MID")?;
@@ -321,7 +720,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     return Err(ctx.err(line, "each section needs two cards"));
                 }
                 for pair in cards.chunks(2) {
-                    let f = card(&pair[0], W10);
+                    let f = card(pair[0], W10);
                     let id = f.id(0, "SECID")?;
                     let elform = f.int(1, "ELFORM", 2)?;
                     if ![0, 2, 4].contains(&elform) {
@@ -332,7 +731,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     let nip = if nip == 0 { 2 } else { nip };
                     f.must_be_zero(5, "QR/IRID")?;
                     f.must_be_zero(6, "ICOMP")?;
-                    let g = card(&pair[1], W10);
+                    let g = card(pair[1], W10);
                     let t1 = g.real(0, "T1", 0.0)?;
                     let ts = [
                         t1,
@@ -375,7 +774,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     return Err(ctx.err(line, "each material needs two cards"));
                 }
                 for pair in cards.chunks(2) {
-                    let f = card(&pair[0], W10);
+                    let f = card(pair[0], W10);
                     let id = f.id(0, "MID")?;
                     let beta = f.real(6, "BETA", 0.0)?;
                     if beta != 1.0 {
@@ -384,7 +783,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                             pair[0].line
                         ));
                     }
-                    let g = card(&pair[1], W10);
+                    let g = card(pair[1], W10);
                     let (src, srp) = (g.real(0, "SRC", 0.0)?, g.real(1, "SRP", 0.0)?);
                     if g.real(2, "FS", 0.0)? != 0.0 {
                         warnings.push(format!("{name}: line {}: material {id}: failure strain FS ignored (no erosion)", pair[1].line));
@@ -421,7 +820,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*SET_NODE_LIST" => {
                 need(1)?;
-                let id = card(&cards[0], W10).id(0, "SID")?;
+                let id = card(cards[0], W10).id(0, "SID")?;
                 let mut nodes = Vec::new();
                 for c in &cards[1..] {
                     let f = card(c, W10);
@@ -436,12 +835,12 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*INITIAL_VELOCITY" => {
                 need(2)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 let nsid = f.opt_id(0, "NSID")?;
                 f.must_be_zero(1, "NSIDEX")?;
                 f.must_be_zero(2, "BOXID")?;
                 f.must_be_zero(4, "ICID")?;
-                let g = card(&cards[1], W10);
+                let g = card(cards[1], W10);
                 let mut iv = InitialVelocity::translation(
                     if nsid == 0 {
                         VelocityTarget::All
@@ -458,7 +857,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     return Err(ctx.err(line, "each generation needs two cards"));
                 }
                 for pair in cards.chunks(2) {
-                    let f = card(&pair[0], W10);
+                    let f = card(pair[0], W10);
                     let id = f.id(0, "ID")?;
                     let target = match f.int(1, "STYP", 0)? {
                         2 => VelocityTarget::Part(id),
@@ -472,7 +871,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     };
                     f.must_be_zero(6, "IVATN")?;
                     f.must_be_zero(7, "ICID")?;
-                    let g = card(&pair[1], W10);
+                    let g = card(pair[1], W10);
                     let mut iv =
                         InitialVelocity::translation(target, f.real3(3, ["VX", "VY", "VZ"])?);
                     iv.omega = f.real(2, "OMEGA", 0.0)?;
@@ -525,7 +924,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                     return Err(ctx.err(line, "each wall needs two cards"));
                 }
                 for pair in cards.chunks(2) {
-                    let f = card(&pair[0], W10);
+                    let f = card(pair[0], W10);
                     let nsid = f.opt_id(0, "NSID")?;
                     f.must_be_zero(1, "NSIDEX")?;
                     f.must_be_zero(2, "BOXID")?;
@@ -538,7 +937,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
                             "field DEATH: a finite death time is not supported",
                         ));
                     }
-                    let g = card(&pair[1], W10);
+                    let g = card(pair[1], W10);
                     let point = g.real3(0, ["XT", "YT", "ZT"])?;
                     let head = g.real3(3, ["XH", "YH", "ZH"])?;
                     let fric = g.real(6, "FRIC", 0.0)?;
@@ -563,7 +962,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*LOAD_BODY_Z" => {
                 need(1)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 let curve = f.id(0, "LCID")?;
                 let scale = f.real(1, "SF", 1.0)?;
                 f.must_be_zero(2, "LCIDDR")?;
@@ -572,7 +971,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*DEFINE_CURVE" => {
                 need(1)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 let id = f.id(0, "LCID")?;
                 f.must_be_zero(1, "SIDR")?;
                 f.must_be_zero(6, "DATTYP")?;
@@ -591,7 +990,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*DAMPING_GLOBAL" => {
                 need(1)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 f.must_be_zero(0, "LCID")?;
                 model.damping = f.real(1, "VALDMP", 0.0)?;
                 let s: Vec<f64> = (2..8)
@@ -615,7 +1014,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*CONTROL_BULK_VISCOSITY" => {
                 need(1)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 let q1 = f.real(0, "Q1", 1.5)?;
                 let q2 = f.real(1, "Q2", 0.06)?;
                 let b = BulkViscosity {
@@ -641,7 +1040,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*CONTROL_ACCURACY" => {
                 need(1)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 if f.int(0, "OSU", 0)? != 0 {
                     warnings.push(format!(
                         "{name}: line {}: *CONTROL_ACCURACY OSU ignored (shell stresses are corotational)",
@@ -663,7 +1062,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*CONTROL_CONTACT" => {
                 need(1)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 rwpnal = f.real(1, "RWPNAL", 0.0)?;
                 if !(0.0..=1.0).contains(&rwpnal) {
                     return Err(ctx.err(
@@ -687,16 +1086,24 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*CONTROL_TERMINATION" => {
                 need(1)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 model.control.end_time = f.real(0, "ENDTIM", 0.0)?;
                 model.control.end_cycles = f.opt_id(1, "ENDCYC")?;
                 model.control.dtmin_factor = f.real(2, "DTMIN", 0.0)?;
                 f.must_be_zero(3, "ENDENG")?;
-                f.must_be_zero(4, "ENDMAS")?;
+                // ENDMAS acts only with mass scaling, which this solver does not do;
+                // LS-PrePost writes 1.0e8 by default.
+                let endmas = f.real(4, "ENDMAS", 0.0)?;
+                if endmas != 0.0 && endmas != 1.0e8 {
+                    warnings.push(format!(
+                        "{name}: line {}: *CONTROL_TERMINATION ENDMAS {endmas} ignored (it acts only with mass scaling)",
+                        cards[0].line
+                    ));
+                }
             }
             "*CONTROL_TIMESTEP" => {
                 need(1)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 let tssfac = f.real(1, "TSSFAC", 0.9)?;
                 model.control.tssfac = if tssfac == 0.0 { 0.9 } else { tssfac };
                 model.control.isdo_diagonal = match f.int(2, "ISDO", 0)? {
@@ -714,7 +1121,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*CONTROL_HOURGLASS" => {
                 need(1)?;
-                let f = card(&cards[0], W10);
+                let f = card(cards[0], W10);
                 let form = match f.int(0, "IHQ", 0)? {
                     0..=3 => HourglassForm::Viscous,
                     4..=6 => HourglassForm::Stiffness,
@@ -735,7 +1142,8 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             "*DATABASE_HISTORY_NODE" => {
                 for c in &cards {
                     let f = card(c, W10);
-                    for k in 0..8 {
+                    // The _ID variant: one node a card, then its heading.
+                    for k in 0..if history_id { 1 } else { 8 } {
                         match f.opt_id(k, "ID")? {
                             0 => {}
                             n => model.output.history_nodes.push(n),
@@ -745,7 +1153,7 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
             "*DATABASE_NODOUT" => {
                 need(1)?;
-                model.output.interval = card(&cards[0], W10).real(0, "DT", 0.0)?;
+                model.output.interval = card(cards[0], W10).real(0, "DT", 0.0)?;
             }
             k if IGNORED_KEYWORDS.contains(&k) => {
                 warnings.push(format!(
@@ -761,6 +1169,25 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             }
         }
     }
+    let top = &src.files[0];
+    if !termination {
+        warnings.push(format!(
+            "{top}: no *CONTROL_TERMINATION: the run ends at the default time {:e}",
+            model.control.end_time
+        ));
+    }
+    if !hourglass {
+        let h = &model.hourglass;
+        warnings.push(format!(
+            "{top}: no *CONTROL_HOURGLASS: the default hourglass control is used ({} form, coefficient {})",
+            match h.form {
+                HourglassForm::Stiffness => "stiffness",
+                HourglassForm::Viscous => "viscous",
+            },
+            h.membrane
+        ));
+    }
+    warnings.extend(notes.into_inner());
     if rwpnal > 0.0 {
         for w in &mut model.walls {
             w.method = WallMethod::Penalty {
@@ -769,5 +1196,10 @@ pub fn parse_deck<'a>(text: &'a str, name: &str) -> Result<Deck> {
             };
         }
     }
-    Ok(Deck { model, warnings })
+    Ok(Deck {
+        model,
+        warnings,
+        parameters,
+        source: src,
+    })
 }

@@ -1,130 +1,21 @@
 //! The Belytschko-Lin-Tsay quad evaluated on blocks of [`LANES`] elements at once.
 //!
-//! The arithmetic is that of [`crate::element`] (see its module docs for the equations),
-//! written on [`V`], a short vector of one value per element, so that the compiler can issue
-//! packed instructions across the elements of a block (structure of arrays). Every lane is
-//! computed independently with plain IEEE operations (no fused multiply-add), so an
-//! element's result does not depend on the block it sits in, the lane it occupies or the
-//! number of threads. Only the plastic return, needed by few points, runs lane by lane.
+//! The frame, the centre derivatives, the characteristic length, the hourglass control and
+//! the warping projection are the quad's own; the rates, the section response and the
+//! nodal forces are the shared pieces of [`super::resultants`], here on [`V`] lanes (see
+//! [`crate::element`]'s module docs for the equations). Every lane is computed
+//! independently with plain IEEE operations, so an element's result does not depend on the
+//! block it sits in, the lane it occupies or the number of threads. Only the plastic
+//! return, needed by few points, runs lane by lane.
 
-use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
-
-use crate::element::{
-    ElementFault, ElementOutput, KernelOptions, PartProps, STATE_HEAD, STATE_PER_POINT,
-};
+pub(crate) use super::lanes::LANES;
+use super::lanes::{Lane, V, cross3, dot3, sub3};
+use super::output::{ElementFault, ElementOutput, KernelOptions};
+use super::props::{PartProps, STATE_HEAD};
+use super::resultants::{StateSlots, rates, section_response, to_global};
 use crate::model::HourglassForm;
 
-/// Elements per block.
-pub(crate) const LANES: usize = 2;
-
-/// One value per element of a block.
-#[derive(Debug, Clone, Copy, Default)]
-#[repr(align(16))]
-pub(crate) struct V(pub [f64; LANES]);
-
-impl V {
-    #[inline(always)]
-    fn splat(a: f64) -> V {
-        V([a; LANES])
-    }
-
-    #[inline(always)]
-    fn map(self, f: impl Fn(f64) -> f64) -> V {
-        V(self.0.map(f))
-    }
-
-    #[inline(always)]
-    fn zip(self, o: V, f: impl Fn(f64, f64) -> f64) -> V {
-        let mut r = [0.0; LANES];
-        for l in 0..LANES {
-            r[l] = f(self.0[l], o.0[l]);
-        }
-        V(r)
-    }
-
-    #[inline(always)]
-    fn sqrt(self) -> V {
-        self.map(f64::sqrt)
-    }
-
-    #[inline(always)]
-    fn max(self, o: V) -> V {
-        self.zip(o, |a, b| if a >= b { a } else { b })
-    }
-}
-
-macro_rules! binop {
-    ($tr:ident, $f:ident, $op:tt) => {
-        impl $tr for V {
-            type Output = V;
-            #[inline(always)]
-            fn $f(self, o: V) -> V {
-                self.zip(o, |a, b| a $op b)
-            }
-        }
-        impl $tr<f64> for V {
-            type Output = V;
-            #[inline(always)]
-            fn $f(self, o: f64) -> V {
-                self.map(|a| a $op o)
-            }
-        }
-        impl $tr<V> for f64 {
-            type Output = V;
-            #[inline(always)]
-            fn $f(self, o: V) -> V {
-                o.map(|b| self $op b)
-            }
-        }
-    };
-}
-binop!(Add, add, +);
-binop!(Sub, sub, -);
-binop!(Mul, mul, *);
-binop!(Div, div, /);
-
-impl Neg for V {
-    type Output = V;
-    #[inline(always)]
-    fn neg(self) -> V {
-        self.map(|a| -a)
-    }
-}
-
-impl AddAssign for V {
-    #[inline(always)]
-    fn add_assign(&mut self, o: V) {
-        *self = *self + o;
-    }
-}
-
-impl SubAssign for V {
-    #[inline(always)]
-    fn sub_assign(&mut self, o: V) {
-        *self = *self - o;
-    }
-}
-
 type V3 = [V; 3];
-
-#[inline(always)]
-fn sub3(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline(always)]
-fn dot3(a: V3, b: V3) -> V {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline(always)]
-fn cross3(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
 
 /// Where a block's data lives: the element node indices per lane, the lanes in use, and
 /// each lane's element position in `state` / `out` (unused lanes repeat lane 0).
@@ -271,38 +162,10 @@ pub(crate) fn quad_block(
         (gi, dot3(gi[0], bs), dot3(gi[1], bs), zg)
     });
 
-    // Rates.
-    let (mut dxx, mut dyy, mut gxy) = (V::default(), V::default(), V::default());
-    let (mut kxx, mut kyy, mut kxy) = (V::default(), V::default(), V::default());
-    let (mut gxz, mut gyz) = (V::default(), V::default());
-    let (mut thx, mut thy) = (V::default(), V::default());
-    for i in 0..4 {
-        let [vx, vy, vz] = u[i];
-        let [tx, ty, _] = th[i];
-        dxx += b1[i] * vx;
-        dyy += b2[i] * vy;
-        gxy += b2[i] * vx + b1[i] * vy;
-        kxx += b1[i] * ty;
-        kyy -= b2[i] * tx;
-        kxy += b2[i] * ty - b1[i] * tx;
-        gxz += b1[i] * vz;
-        gyz += b2[i] * vz;
-        thx += tx;
-        thy += ty;
-    }
-    gxz += thy * 0.25;
-    gyz -= thx * 0.25;
-
+    let rt = rates(&b1, &b2, &u, &th);
     let mat = &props.mat;
     let t = props.t;
-    let factor = if mat.rate.0 > 0.0 {
-        let m = dxx * dxx + dyy * dyy + dxx * dyy + 0.25 * gxy * gxy;
-        let b = kxx * kxx + kyy * kyy + kxx * kyy + 0.25 * kxy * kxy;
-        let eff = (4.0 / 3.0 * m + t * t / 9.0 * b).map(|q| q.max(0.0).sqrt());
-        eff.map(|q| mat.rate_factor(q))
-    } else {
-        V::splat(1.0)
-    };
+    let g = mat.g;
 
     // Characteristic length: sqrt is monotonic, so the longest length is the root of the
     // largest square.
@@ -318,141 +181,32 @@ pub(crate) fn quad_block(
             .max(diag2)
     };
     let len = area / len2.sqrt();
-    let mut dt_e = len / mat.wave_speed;
-    // Stiffness-proportional damping: Rayleigh beta per lane and the damped stable step.
-    let mut step_factor = V::splat(1.0);
-    let beta = (props.stiffness_damping != 0.0).then(|| {
-        let mut beta = V::default();
-        for l in 0..LANES {
-            (beta.0[l], step_factor.0[l]) = props.damping_beta(dt_e.0[l]);
-        }
-        beta
-    });
 
-    // Through the thickness.
+    // The section: thickness points, transverse shear, damping, bulk viscosity, forces.
     let base = blk.slot.map(|e| e * stride);
-    let (c11, c12, g) = (mat.c11, mat.nu * mat.c11, mat.g);
-    let plastic = mat.is_plastic();
-    let (mut nxx, mut nyy, mut nxy) = (V::default(), V::default(), V::default());
-    let (mut mxx, mut myy, mut mxy) = (V::default(), V::default(), V::default());
-    let mut work = V::default();
-    for (k, (&zk, &wk)) in props.z.iter().zip(&props.w).enumerate() {
-        let off = STATE_HEAD + STATE_PER_POINT * k;
-        let mut old = [V::default(); 4];
-        for l in 0..LANES {
-            let st = &state[base[l] + off..base[l] + off + STATE_PER_POINT];
-            for q in 0..4 {
-                old[q].0[l] = st[q];
-            }
-        }
-        let de0 = dt * (dxx + zk * kxx);
-        let de1 = dt * (dyy + zk * kyy);
-        let de2 = dt * (gxy + zk * kxy);
-        // Elastic predictor, as in `MaterialProps::update`.
-        let mut sx = old[0] + c11 * de0 + c12 * de1;
-        let mut sy = old[1] + c12 * de0 + c11 * de1;
-        let mut txy = old[2] + g * de2;
-        let mut p = old[3];
-        if plastic {
-            let ss = sx + sy;
-            let dd = sx - sy;
-            let vm2 = 0.25 * ss * ss + (0.75 * dd * dd + 3.0 * txy * txy);
-            let sy0 = (mat.yield0 + mat.hardening * p) * factor;
-            for l in 0..LANES {
-                if vm2.0[l] > sy0.0[l] * sy0.0[l] {
-                    let mut e = p.0[l];
-                    let sig = mat.plastic_return([sx.0[l], sy.0[l], txy.0[l]], &mut e, factor.0[l]);
-                    sx.0[l] = sig[0];
-                    sy.0[l] = sig[1];
-                    txy.0[l] = sig[2];
-                    p.0[l] = e;
-                }
-            }
-        }
-        for l in 0..blk.active {
-            let st = &mut state[base[l] + off..base[l] + off + STATE_PER_POINT];
-            st[0] = sx.0[l];
-            st[1] = sy.0[l];
-            st[2] = txy.0[l];
-            st[3] = p.0[l];
-        }
-        work += wk * ((old[0] + sx) * de0 + (old[1] + sy) * de1 + (old[2] + txy) * de2);
-        let wz = wk * zk;
-        nxx += wk * sx;
-        nyy += wk * sy;
-        nxy += wk * txy;
-        mxx += wz * sx;
-        myy += wz * sy;
-        mxy += wz * txy;
-    }
-    let mut internal = 0.5 * work * t * area;
-
-    // Transverse shear, elastic, as resultants; hourglass generalised forces.
+    let resp = section_response(
+        &b1,
+        &b2,
+        area,
+        &rt,
+        len,
+        props,
+        &mut StateSlots {
+            state: &mut *state,
+            base: &base,
+            active: blk.active,
+        },
+        dt,
+    );
+    let (mut f, mut damping, beta, dt_e) = (resp.f, resp.damping, resp.beta, resp.dt);
+    let internal = resp.internal;
+    // The hourglass generalised forces of the state.
     let mut head = [V::default(); STATE_HEAD];
     for l in 0..LANES {
         let st = &state[base[l]..base[l] + STATE_HEAD];
-        for q in 0..STATE_HEAD {
+        for q in 2..STATE_HEAD {
             head[q].0[l] = st[q];
         }
-    }
-    let ks = props.shear_factor * g * t * dt;
-    let (qx0, qy0) = (head[0], head[1]);
-    let qx = qx0 + ks * gxz;
-    let qy = qy0 + ks * gyz;
-    internal += 0.5 * area * dt * ((qx0 + qx) * gxz + (qy0 + qy) * gyz);
-
-    // Damping resultants beta C (rates), added to the forces, not to the state.
-    let mut damping = V::default();
-    let (mut qxf, mut qyf) = (qx, qy);
-    if let Some(beta) = beta {
-        let [z1, z2] = props.z_moments;
-        let sm = [c11 * dxx + c12 * dyy, c12 * dxx + c11 * dyy, g * gxy];
-        let sb = [c11 * kxx + c12 * kyy, c12 * kxx + c11 * kyy, g * kxy];
-        let n_d = [0, 1, 2].map(|k| beta * (sm[k] + z1 * sb[k]));
-        let m_d = [0, 1, 2].map(|k| beta * (z1 * sm[k] + z2 * sb[k]));
-        let qs = beta * (props.shear_factor * g * t);
-        let (qdx, qdy) = (qs * gxz, qs * gyz);
-        let power = t * (n_d[0] * dxx + n_d[1] * dyy + n_d[2] * gxy)
-            + t * (m_d[0] * kxx + m_d[1] * kyy + m_d[2] * kxy)
-            + qdx * gxz
-            + qdy * gyz;
-        damping = dt * area * power;
-        nxx += n_d[0];
-        nyy += n_d[1];
-        nxy += n_d[2];
-        mxx += m_d[0];
-        myy += m_d[1];
-        mxy += m_d[2];
-        qxf += qdx;
-        qyf += qdy;
-    }
-    // Bulk viscosity: an in-plane pressure while the area shrinks, and its smaller step.
-    if props.bulk != [0.0, 0.0] {
-        let rate = dxx + dyy;
-        for l in 0..LANES {
-            let (q, dt_b) = props.bulk_pressure(rate.0[l], len.0[l]);
-            dt_e.0[l] = dt_b;
-            damping.0[l] -= dt * area.0[l] * t * q * rate.0[l];
-            nxx.0[l] -= q;
-            nyy.0[l] -= q;
-        }
-    }
-    dt_e = dt_e * step_factor;
-
-    let ta = t * area;
-    let (nxx, nyy, nxy) = (ta * nxx, ta * nyy, ta * nxy);
-    let (mxx, myy, mxy) = (ta * mxx, ta * myy, ta * mxy);
-    let (qxa, qya) = (area * qxf * 0.25, area * qyf * 0.25);
-    let mut f = [[V::default(); 6]; 4];
-    for i in 0..4 {
-        f[i] = [
-            b1[i] * nxx + b2[i] * nxy,
-            b2[i] * nyy + b1[i] * nxy,
-            area * (b1[i] * qxf + b2[i] * qyf),
-            -b2[i] * myy - b1[i] * mxy - qya,
-            b1[i] * mxx + b2[i] * mxy + qxa,
-            V::default(),
-        ];
     }
 
     // Hourglass rates: membrane x, y; out-of-plane w; rotation x, y.
@@ -513,8 +267,6 @@ pub(crate) fn quad_block(
     }
     for l in 0..blk.active {
         let st = &mut state[base[l]..base[l] + STATE_HEAD];
-        st[0] = qx.0[l];
-        st[1] = qy.0[l];
         for k in 0..5 {
             st[2 + k] = hg[k].0[l];
         }
@@ -550,13 +302,7 @@ pub(crate) fn quad_block(
     }
 
     // Back to the global frame, into the slots.
-    let mut gf = [[V::default(); 6]; 4];
-    for i in 0..4 {
-        for k in 0..3 {
-            gf[i][k] = e1[k] * f[i][0] + e2[k] * f[i][1] + e3[k] * f[i][2];
-            gf[i][3 + k] = e1[k] * f[i][3] + e2[k] * f[i][4] + e3[k] * f[i][5];
-        }
-    }
+    let gf = to_global(&[e1, e2, e3], &f);
     for l in 0..blk.active {
         let o = &mut out[blk.slot[l]];
         for i in 0..4 {
@@ -661,6 +407,7 @@ pub(crate) fn quad_run(
 
 #[cfg(test)]
 mod tests {
+    use super::super::props::STATE_PER_POINT;
     use super::*;
     use crate::material::MaterialProps;
     use crate::model::{Material, MaterialLaw};
