@@ -2,7 +2,7 @@
 //! their numbers, rendered to one self-contained HTML file (inline SVG) and to Markdown with
 //! SVG files beside it.
 //!
-//! A study or a closed loop builds the document; [`write`] checks it (every fault is a typed
+//! A study or a closed loop builds the document; [`write()`] checks it (every fault is a typed
 //! error naming the figure, series and index: nothing is drawn blank), draws each figure
 //! once with plotters' SVG backend, and writes `report.html`, `report.md` and one
 //! `<figure name>.svg` per figure. Text in SVG stays `<text>` for the viewer to lay out, so
@@ -63,7 +63,7 @@ pub use validate::{check_figure, check_report, check_table};
 
 use crate::Result;
 
-/// The files [`write`] wrote.
+/// The files [`write()`] wrote.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReportFiles {
     /// `dir/report.html`: the whole report in one self-contained file.
