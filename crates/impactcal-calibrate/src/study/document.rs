@@ -516,3 +516,79 @@ fn reconcile_section(r: &StudyResult) -> Section {
         blocks,
     }
 }
+
+/// One parameter of a reveal: its nominal value, the value the test was made with, and the
+/// value calibration found.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Revealed {
+    /// The parameter.
+    pub name: String,
+    /// Nominal value (the baseline model's).
+    pub nominal: f64,
+    /// The value of the hidden test.
+    pub hidden: f64,
+    /// The calibrated value.
+    pub calibrated: f64,
+}
+
+impl Revealed {
+    /// Relative change of the test from nominal.
+    pub fn changed_by(&self) -> f64 {
+        self.hidden / self.nominal - 1.0
+    }
+
+    /// Relative move of calibration from nominal.
+    pub fn moved_by(&self) -> f64 {
+        self.calibrated / self.nominal - 1.0
+    }
+}
+
+/// The reveal of a study on a synthetic test (the source paper's §5.4): what was changed to
+/// make the test, against what calibration moved. A parameter counts as changed or moved
+/// when it differs from nominal by more than `threshold` (relative).
+pub fn reveal_section(items: &[Revealed], threshold: f64) -> Section {
+    let changed: Vec<&str> = items
+        .iter()
+        .filter(|r| r.changed_by().abs() > threshold)
+        .map(|r| r.name.as_str())
+        .collect();
+    let moved: Vec<&str> = items
+        .iter()
+        .filter(|r| r.moved_by().abs() > threshold)
+        .map(|r| r.name.as_str())
+        .collect();
+    let both = changed.iter().filter(|c| moved.contains(c)).count();
+    let rows = items
+        .iter()
+        .map(|r| {
+            vec![
+                r.name.clone(),
+                g(r.nominal),
+                g(r.hidden),
+                pct(r.changed_by()),
+                g(r.calibrated),
+                pct(r.moved_by()),
+            ]
+        })
+        .collect();
+    Section {
+        heading: "The reveal: what was changed, what calibration moved".into(),
+        blocks: vec![
+            Block::Paragraph(format!(
+                "The test was the model with {} changed ({}); calibration moved {} by more than \
+                 {:.0} % ({}); {} of the changed parameters were among them.",
+                changed.len(),
+                changed.join(", "),
+                moved.len(),
+                100.0 * threshold,
+                if moved.is_empty() { "none".to_string() } else { moved.join(", ") },
+                both
+            )),
+            table(
+                "Hidden and calibrated values",
+                &["parameter", "nominal", "test (hidden)", "change", "calibrated", "move"],
+                rows,
+            ),
+        ],
+    }
+}

@@ -34,6 +34,7 @@ pub mod reconcile;
 pub mod result;
 pub mod sensitivity;
 pub mod sensors;
+pub mod subspace;
 pub mod surrogates;
 
 use std::path::Path;
@@ -51,6 +52,7 @@ pub use journal::{Journal, RunOutcome};
 pub use m1::{M1, Verdict};
 pub use options::{StudyOptions, ValidStudyOptions};
 pub use result::StudyResult;
+pub use subspace::Subspace;
 
 use channels::{indices_of, q_of, relative_error, relative_l2, test_on_model};
 use execute::{Runs, histories_of};
