@@ -2,12 +2,16 @@
 //! here from the same runs, M1 intervals of a test pushed out of the envelope, recovery of
 //! a known interior point, resume after an interrupted study, failed runs.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
+
 use std::path::Path;
 
 use impactcal_calibrate::CalibrateError;
 use impactcal_calibrate::study::{self, M1, StudyOptions, TestData, Verdict};
 use impactcal_core::sampling::sample;
-use impactcal_core::{CoreError, Histories, Model, ParamGuard, Parameter, ParameterSpace, SamplingMethod};
+use impactcal_core::{
+    CoreError, Histories, Model, ParamGuard, Parameter, ParameterSpace, SamplingMethod,
+};
 
 const NODES: usize = 6;
 const SAMPLES: usize = 161;
@@ -59,12 +63,21 @@ impl Model for Drop {
                         let modal: f64 = (0..3)
                             .map(|i| {
                                 let ph = std::f64::consts::PI * s * (i + 1) as f64;
-                                let shape = if d == 0 { 0.3 * ph.cos() + 0.1 } else { ph.sin() + 0.1 * i as f64 };
+                                let shape = if d == 0 {
+                                    0.3 * ph.cos() + 0.1
+                                } else {
+                                    ph.sin() + 0.1 * i as f64
+                                };
                                 let w = 2.0 * std::f64::consts::PI * freqs[i];
                                 amps[i] * shape * (-zetas[i] * w * t).exp() * (w * t).sin()
                             })
                             .sum();
-                        modal - if d == 1 { 312.0 * (-t / 0.02).exp() } else { -100.0 }
+                        modal
+                            - if d == 1 {
+                                312.0 * (-t / 0.02).exp()
+                            } else {
+                                -100.0
+                            }
                     })
                     .collect();
                 channels.push(y);
@@ -77,7 +90,15 @@ impl Model for Drop {
 /// The histories rounded to single precision, as the journal keeps runs.
 fn single(h: &Histories) -> Histories {
     let data = h.data().iter().map(|v| f64::from(*v as f32)).collect();
-    Histories::new(h.labels().to_vec(), h.samples(), h.dt(), h.start(), h.unit(), data).unwrap()
+    Histories::new(
+        h.labels().to_vec(),
+        h.samples(),
+        h.dt(),
+        h.start(),
+        h.unit(),
+        data,
+    )
+    .unwrap()
 }
 
 fn options(ensemble: usize, reconcile: usize) -> StudyOptions {
@@ -94,7 +115,12 @@ fn options(ensemble: usize, reconcile: usize) -> StudyOptions {
     }
 }
 
-fn run(model: &Drop, test: &Histories, o: StudyOptions, dir: &Path) -> Result<study::StudyResult, CalibrateError> {
+fn run(
+    model: &Drop,
+    test: &Histories,
+    o: StudyOptions,
+    dir: &Path,
+) -> Result<study::StudyResult, CalibrateError> {
     study::run_model(
         model,
         "analytic drop",
@@ -111,12 +137,19 @@ fn run(model: &Drop, test: &Histories, o: StudyOptions, dir: &Path) -> Result<st
 
 fn ensemble_points(model: &Drop, n: usize, seed: u64) -> Vec<Vec<f64>> {
     let s = sample(model.space(), SamplingMethod::ScrambledHalton, n, seed).unwrap();
-    (0..n).map(|i| s.points.row(i).iter().copied().collect()).collect()
+    (0..n)
+        .map(|i| s.points.row(i).iter().copied().collect())
+        .collect()
 }
 
 fn q(h: &Histories) -> Vec<f64> {
     (0..h.samples())
-        .map(|k| (0..h.channels()).map(|c| h.value(c, k).powi(2)).sum::<f64>().sqrt())
+        .map(|k| {
+            (0..h.channels())
+                .map(|c| h.value(c, k).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
         .collect()
 }
 
@@ -130,15 +163,26 @@ fn envelope_and_verdict_match_the_runs_and_a_pushed_test_gives_its_interval() {
     let mut o = options(12, 0);
     o.screen_only = true;
     let r = run(&model, &test, o.clone(), dir.path()).unwrap();
-    let qs: Vec<Vec<f64>> = points.iter().map(|p| q(&single(&model.simulate(p).unwrap()))).collect();
+    let qs: Vec<Vec<f64>> = points
+        .iter()
+        .map(|p| q(&single(&model.simulate(p).unwrap())))
+        .collect();
     for k in 0..SAMPLES {
         let lo = qs.iter().map(|q| q[k]).fold(f64::INFINITY, f64::min);
         let hi = qs.iter().map(|q| q[k]).fold(f64::NEG_INFINITY, f64::max);
         assert!((r.m1.lower[k] - lo).abs() <= 1e-9 * hi, "{k}");
         assert!((r.m1.upper[k] - hi).abs() <= 1e-9 * hi, "{k}");
     }
-    let M1 { verdict, n_runs, exceedance_fraction, .. } = r.m1;
-    assert_eq!((verdict, n_runs, exceedance_fraction), (Verdict::CanExplain, 12, 0.0));
+    let M1 {
+        verdict,
+        n_runs,
+        exceedance_fraction,
+        ..
+    } = r.m1;
+    assert_eq!(
+        (verdict, n_runs, exceedance_fraction),
+        (Verdict::CanExplain, 12, 0.0)
+    );
     assert!((r.m1.probability_bound - 1.0 / 12.0).abs() < 1e-15);
     assert!(r.sensors.is_none() && r.reconcile.is_none());
 
@@ -169,10 +213,18 @@ fn reconciliation_recovers_an_interior_point_and_a_resumed_study_is_identical() 
     let widths = [0.6, 0.9, 0.4];
     for i in 0..3 {
         let off = (c.calibrated_point[i] - truth[i]).abs() / widths[i];
-        assert!(off < 0.05, "parameter {i}: {} vs {}", c.calibrated_point[i], truth[i]);
+        assert!(
+            off < 0.05,
+            "parameter {i}: {} vs {}",
+            c.calibrated_point[i],
+            truth[i]
+        );
     }
     let e = r.errors.as_ref().unwrap();
-    assert!(e.calibrated.prediction_error < 0.05 * e.baseline.prediction_error, "{e:?}");
+    assert!(
+        e.calibrated.prediction_error < 0.05 * e.baseline.prediction_error,
+        "{e:?}"
+    );
     assert!(e.calibrated.iso18571_r > e.baseline.iso18571_r);
     let m2 = r.m2.as_ref().unwrap();
     assert!(m2.calibrated.as_ref().unwrap().matched_above_0_9 >= m2.baseline.matched_above_0_9);
@@ -232,11 +284,27 @@ fn bad_studies_are_refused() {
     let before = std::fs::read(dir.path().join("journal/fingerprint")).unwrap();
     let e = run(&model, &test, options(7, 0), dir.path()).unwrap_err();
     assert!(matches!(e, CalibrateError::ForeignJournal { .. }), "{e}");
-    assert_eq!(std::fs::read(dir.path().join("journal/fingerprint")).unwrap(), before);
+    assert_eq!(
+        std::fs::read(dir.path().join("journal/fingerprint")).unwrap(),
+        before
+    );
     // A budget of 0.
     assert!(options(0, 0).check().is_err());
     // A test with no channel in common.
-    let other = Histories::from_channels(vec!["9.q".into()], vec![vec![1.0; SAMPLES]], DT, 0.0, "in/s").unwrap();
-    let e = run(&model, &other, options(6, 0), tempfile::tempdir().unwrap().path()).unwrap_err();
+    let other = Histories::from_channels(
+        vec!["9.q".into()],
+        vec![vec![1.0; SAMPLES]],
+        DT,
+        0.0,
+        "in/s",
+    )
+    .unwrap();
+    let e = run(
+        &model,
+        &other,
+        options(6, 0),
+        tempfile::tempdir().unwrap().path(),
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("no channel in common"), "{e}");
 }

@@ -125,11 +125,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     .check()?;
     let (s1, s2) = (setup(Preset::Table1)?, setup(Preset::Table2)?);
-    eprintln!("impactcal: Table 1 ({} runs): does M1 let this parameter set explain the test?", table1.ensemble);
+    eprintln!(
+        "impactcal: Table 1 ({} runs): does M1 let this parameter set explain the test?",
+        table1.ensemble
+    );
     let dir1 = args.out.join("table1");
     let r1 = pool.install(|| execute(&s1, &table1, &dir1))?;
     finish(&r1, &s1, &dir1)?;
-    eprintln!("impactcal: Table 2 ({} runs), sensitivity, reconciliation", table2.ensemble);
+    eprintln!(
+        "impactcal: Table 2 ({} runs), sensitivity, reconciliation",
+        table2.ensemble
+    );
     let dir2 = args.out.join("table2");
     let r2 = pool.install(|| execute(&s2, &table2, &dir2))?;
     finish(&r2, &s2, &dir2)?;
@@ -141,7 +147,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map(|(i, p)| Revealed {
             name: p.name.clone(),
             nominal: p.nominal,
-            hidden: full.index_of(&p.name).map_or(p.nominal, |k| hidden_point[k]),
+            hidden: full
+                .index_of(&p.name)
+                .map_or(p.nominal, |k| hidden_point[k]),
             calibrated: r2
                 .reconcile
                 .as_ref()
@@ -163,7 +171,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         prediction_error_after: e.map(|e| e.calibrated.prediction_error),
         reduction: e.map(|e| e.reduction),
         m2_above_0_9_before: m2.map(|m| m.baseline.matched_above_0_9),
-        m2_above_0_9_after: m2.and_then(|m| m.calibrated.as_ref()).map(|c| c.matched_above_0_9),
+        m2_above_0_9_after: m2
+            .and_then(|m| m.calibrated.as_ref())
+            .map(|c| c.matched_above_0_9),
         reveal: &reveal,
     };
     let json = serde_json::to_string_pretty(&summary)
@@ -181,7 +191,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
 }
 
 /// The demo's report: Table 1's M1 screening, Table 2's whole study, the reveal.
-pub fn demo_report(t1: &StudyResult, t2: &StudyResult, reveal: &[Revealed], setup: &Setup) -> Report {
+pub fn demo_report(
+    t1: &StudyResult,
+    t2: &StudyResult,
+    reveal: &[Revealed],
+    setup: &Setup,
+) -> Report {
     let geometry = match &setup.model {
         Built::Airframe(_, g) => Some(g),
         Built::Deck(_) => None,
@@ -219,4 +234,3 @@ pub fn demo_report(t1: &StudyResult, t2: &StudyResult, reveal: &[Revealed], setu
         sections,
     }
 }
-

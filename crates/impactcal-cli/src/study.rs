@@ -37,7 +37,9 @@ use impactcal::calibrate::study::journal::fingerprint;
 use impactcal::calibrate::study::{
     Observer, StudyOptions, StudyResult, Subspace, TestData, ValidStudyOptions, run_model,
 };
-use impactcal::core::{Cfc, ChannelMap, Histories, IsoMme, Model, ParamGuard, Parameter, ParameterSpace, TestRecord};
+use impactcal::core::{
+    Cfc, ChannelMap, Histories, IsoMme, Model, ParamGuard, Parameter, ParameterSpace, TestRecord,
+};
 use impactcal::shell::DeckModel;
 use impactcal::shell::airframe::{
     Airframe, AirframeModel, AirframeOptions, AirframeValues, MeshDensity, Preset, catalogue,
@@ -149,10 +151,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let text = std::fs::read_to_string(&args.config)
         .map_err(|e| CliError::io(format!("{}: {e}", args.config.display())))?;
     let name = args.config.display().to_string();
-    let config: Config =
-        toml::from_str(&text).map_err(|e| CliError::input(format!("{name}: {}", one_line(&e.to_string()))))?;
+    let config: Config = toml::from_str(&text)
+        .map_err(|e| CliError::input(format!("{name}: {}", one_line(&e.to_string()))))?;
     let base = args.config.parent().unwrap_or(Path::new("."));
-    let options = config.study.clone().check().map_err(|e| CliError::from(e).context(&name))?;
+    let options = config
+        .study
+        .clone()
+        .check()
+        .map_err(|e| CliError::from(e).context(&name))?;
     let setup = setup(&config, base).map_err(|e| e.context(&name))?;
     let pool = thread_pool(args.threads)?;
     let result = pool.install(|| execute(&setup, &options, &args.out))?;
@@ -182,7 +188,11 @@ pub fn study_report(result: &StudyResult, setup: &Setup) -> Report {
 }
 
 /// Runs the study of `setup` in `out`.
-pub fn execute(setup: &Setup, options: &ValidStudyOptions, out: &Path) -> Result<StudyResult, CliError> {
+pub fn execute(
+    setup: &Setup,
+    options: &ValidStudyOptions,
+    out: &Path,
+) -> Result<StudyResult, CliError> {
     std::fs::create_dir_all(out).map_err(|e| CliError::io(format!("{}: {e}", out.display())))?;
     let test = TestData {
         histories: &setup.test,
@@ -191,8 +201,22 @@ pub fn execute(setup: &Setup, options: &ValidStudyOptions, out: &Path) -> Result
     };
     let progress = Progress::new();
     let result = match &setup.model {
-        Built::Airframe(m, _) => run_model(m.as_ref(), &setup.description, test, options, out, &progress),
-        Built::Deck(m) => run_model(m.as_ref(), &setup.description, test, options, out, &progress),
+        Built::Airframe(m, _) => run_model(
+            m.as_ref(),
+            &setup.description,
+            test,
+            options,
+            out,
+            &progress,
+        ),
+        Built::Deck(m) => run_model(
+            m.as_ref(),
+            &setup.description,
+            test,
+            options,
+            out,
+            &progress,
+        ),
     };
     progress.done();
     Ok(result?)
@@ -203,7 +227,11 @@ fn one_line(s: &str) -> String {
 }
 
 fn resolve(base: &Path, p: &Path) -> PathBuf {
-    if p.is_absolute() { p.to_path_buf() } else { base.join(p) }
+    if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        base.join(p)
+    }
 }
 
 /// Builds the model, reads the test, the map and the CFC class of a study file whose
@@ -261,16 +289,24 @@ fn read_test(path: &Path) -> Result<Histories, CliError> {
 
 fn study_space(config: &Config, base: &Path) -> Result<Option<ParameterSpace>, CliError> {
     match (&config.space.preset, &config.space.bounds) {
-        (Some(p), None) => Ok(Some(Preset::parse(p).and_then(|p| p.space()).map_err(CliError::input)?)),
+        (Some(p), None) => Ok(Some(
+            Preset::parse(p)
+                .and_then(|p| p.space())
+                .map_err(CliError::input)?,
+        )),
         (None, Some(b)) => Ok(Some(ParameterSpace::read_csv(resolve(base, b))?)),
         (None, None) => Ok(None),
-        (Some(_), Some(_)) => Err(CliError::input("[space]: give `preset` or `bounds`, not both")),
+        (Some(_), Some(_)) => Err(CliError::input(
+            "[space]: give `preset` or `bounds`, not both",
+        )),
     }
 }
 
 fn airframe(config: &Config, mesh: &str, base: &Path) -> Result<(Built, String), CliError> {
     if !config.parameters.is_empty() {
-        return Err(CliError::input("[parameters] maps deck quantities; the airframe's names are its catalogue's"));
+        return Err(CliError::input(
+            "[parameters] maps deck quantities; the airframe's names are its catalogue's",
+        ));
     }
     let mut options = AirframeOptions::new(MeshDensity::parse(mesh).map_err(CliError::input)?);
     if let Some(t) = config.model.end_time {
@@ -283,7 +319,9 @@ fn airframe(config: &Config, mesh: &str, base: &Path) -> Result<(Built, String),
         values.set(k, *v).map_err(CliError::input)?;
     }
     let Some(space) = study_space(config, base)? else {
-        return Err(CliError::input("[space]: give `preset = \"table1\"|\"table2\"` or `bounds = \"bounds.csv\"`"));
+        return Err(CliError::input(
+            "[space]: give `preset = \"table1\"|\"table2\"` or `bounds = \"bounds.csv\"`",
+        ));
     };
     let names: Vec<String> = catalogue().into_iter().map(|a| a.name).collect();
     let full = space_of(&names).map_err(CliError::input)?;
@@ -294,8 +332,7 @@ fn airframe(config: &Config, mesh: &str, base: &Path) -> Result<(Built, String),
         .map_err(CliError::input)?;
     let geometry = geometry_of(&airframe);
     let model = AirframeModel::new(airframe, full).map_err(CliError::input)?;
-    let sub = Subspace::new(model, space)?
-        .with_base(base_point)?;
+    let sub = Subspace::new(model, space)?.with_base(base_point)?;
     let description = format!(
         "built-in airframe, {mesh} mesh, {} s, set {:?}",
         options.end_time, config.model.set
@@ -308,7 +345,10 @@ pub fn geometry_of(airframe: &Airframe) -> Geometry {
     let nodes = airframe.node_positions();
     let mut channels = BTreeMap::new();
     for &n in airframe.sensor_nodes() {
-        if let Some(at) = usize::try_from(n).ok().and_then(|i| nodes.get(i.wrapping_sub(1))) {
+        if let Some(at) = usize::try_from(n)
+            .ok()
+            .and_then(|i| nodes.get(i.wrapping_sub(1)))
+        {
             for a in ["x", "y", "z"] {
                 channels.insert(format!("{n}.{a}"), *at);
             }
@@ -323,13 +363,24 @@ pub fn geometry_of(airframe: &Airframe) -> Geometry {
 
 fn deck_model(config: &Config, path: &Path, base: &Path) -> Result<(Built, String), CliError> {
     if !config.model.set.is_empty() || config.model.end_time.is_some() {
-        return Err(CliError::input("[model]: `set` and `end_time` apply to the airframe; edit the deck instead"));
+        return Err(CliError::input(
+            "[model]: `set` and `end_time` apply to the airframe; edit the deck instead",
+        ));
     }
-    let bytes = std::fs::read(path).map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
     let deck = read_deck(path)?;
-    deck.warnings.iter().for_each(|w| eprintln!("impactcal: warning: {w}"));
+    deck.warnings
+        .iter()
+        .for_each(|w| eprintln!("impactcal: warning: {w}"));
     let model = DeckModel::new(deck.model).map_err(CliError::input)?;
-    let fields_of = |name: &str| config.parameters.get(name).cloned().unwrap_or_else(|| name.to_string());
+    let fields_of = |name: &str| {
+        config
+            .parameters
+            .get(name)
+            .cloned()
+            .unwrap_or_else(|| name.to_string())
+    };
     let space = match study_space(config, base)? {
         Some(s) => s,
         None if !config.parameters.is_empty() => {
@@ -349,7 +400,11 @@ fn deck_model(config: &Config, path: &Path, base: &Path) -> Result<(Built, Strin
                 .collect::<Result<Vec<_>, CliError>>()?;
             ParameterSpace::new(params)?
         }
-        None => return Err(CliError::input("[space]: give `bounds = \"bounds.csv\"` or a [parameters] table")),
+        None => {
+            return Err(CliError::input(
+                "[space]: give `bounds = \"bounds.csv\"` or a [parameters] table",
+            ));
+        }
     };
     let fields: Vec<String> = space.names().iter().map(|n| fields_of(n)).collect();
     let sub = Subspace::aliased(model, space, &fields)?;
@@ -385,13 +440,19 @@ impl Progress {
 impl Observer for Progress {
     fn stage(&self, name: &str, total: usize, reused: usize) {
         self.done();
-        let reuse = if reused > 0 { format!(" ({reused} from the journal)") } else { String::new() };
+        let reuse = if reused > 0 {
+            format!(" ({reused} from the journal)")
+        } else {
+            String::new()
+        };
         if !self.terminal {
             eprintln!("impactcal: {name}: {total} runs{reuse}");
             return;
         }
         let bar = ProgressBar::new(total as u64);
-        if let Ok(style) = ProgressStyle::with_template("{msg:>10} [{bar:40}] {pos}/{len} runs {elapsed}") {
+        if let Ok(style) =
+            ProgressStyle::with_template("{msg:>10} [{bar:40}] {pos}/{len} runs {elapsed}")
+        {
             bar.set_style(style.progress_chars("=> "));
         }
         bar.set_message(name.to_string());

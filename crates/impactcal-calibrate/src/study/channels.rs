@@ -59,7 +59,8 @@ pub fn test_on_model(
         labels.push(m.clone());
         channels.push(test.channel_by_label(t)?.iter().map(|v| v / gain).collect());
     }
-    let on_labels = Histories::from_channels(labels, channels, test.dt(), test.start(), test.unit())?;
+    let on_labels =
+        Histories::from_channels(labels, channels, test.dt(), test.start(), test.unit())?;
     let what = "the test against the model's window (the test must cover it)";
     Ok(interpolate_onto(
         &on_labels,
@@ -99,8 +100,9 @@ pub fn indices_of(h: &Histories, labels: &[String]) -> Result<Vec<usize>> {
     labels
         .iter()
         .map(|l| {
-            h.index_of(l)
-                .ok_or_else(|| CalibrateError::study(format!("channel `{l}`"), "not in the histories"))
+            h.index_of(l).ok_or_else(|| {
+                CalibrateError::study(format!("channel `{l}`"), "not in the histories")
+            })
         })
         .collect()
 }
@@ -118,12 +120,20 @@ pub fn relative_error(model: &Histories, test: &Histories, labels: &[String]) ->
             den += y * y;
         }
     }
-    Ok(if den > 0.0 { (num / den).sqrt() } else { f64::NAN })
+    Ok(if den > 0.0 {
+        (num / den).sqrt()
+    } else {
+        f64::NAN
+    })
 }
 
 /// `||a - b|| / ||b||` of two vectors.
 pub fn relative_l2(a: &[f64], b: &[f64]) -> f64 {
     let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
     let den: f64 = b.iter().map(|y| y * y).sum();
-    if den > 0.0 { (num / den).sqrt() } else { f64::NAN }
+    if den > 0.0 {
+        (num / den).sqrt()
+    } else {
+        f64::NAN
+    }
 }

@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 
 use super::result::{Errors, StudyResult};
 use crate::report::{
-    Axis, Block, Envelope, Figure, HeatMap, Lines, Marker, Plot, Report, Section, Series,
-    Stacked, Structure, Table,
+    Axis, Block, Envelope, Figure, HeatMap, Lines, Marker, Plot, Report, Section, Series, Stacked,
+    Structure, Table,
 };
 
 /// Where the channels are, for the sensor figure: every point of the structure and the
@@ -69,9 +69,18 @@ fn pct(v: f64) -> String {
 /// The report of a study. `geometry` (when the model has one) places the sensors on the
 /// structure; without it the sensor figure is left out and the sensors are listed.
 pub fn report(r: &StudyResult, geometry: Option<&Geometry>) -> Report {
-    let mut lead = vec![format!("M1 verdict: {}. {}.", r.m1.verdict.as_str(), r.m1.statement)];
+    let mut lead = vec![format!(
+        "M1 verdict: {}. {}.",
+        r.m1.verdict.as_str(),
+        r.m1.statement
+    )];
     if let Some(e) = &r.errors {
-        lead.push(before_after_sentence(r, e.reduction, &e.baseline, &e.calibrated));
+        lead.push(before_after_sentence(
+            r,
+            e.reduction,
+            &e.baseline,
+            &e.calibrated,
+        ));
     }
     let mut sections = vec![setup(r), m1_section(r)];
     if r.sensors.is_some() {
@@ -131,7 +140,10 @@ fn setup(r: &StudyResult) -> Section {
         .collect();
     let n = &r.noise;
     let noise_rows = vec![
-        vec!["jitter runs (eps)".into(), format!("{} ({})", n.runs, n.eps)],
+        vec![
+            "jitter runs (eps)".into(),
+            format!("{} ({})", n.runs, n.eps),
+        ],
         vec![
             "relative spread over the objective channels".into(),
             pct(n.relative_spread),
@@ -142,7 +154,10 @@ fn setup(r: &StudyResult) -> Section {
         ],
         vec!["relative spread of Q(t)".into(), pct(n.relative_spread_q)],
         vec![
-            format!("median predictability horizon (spread > {} of the signal)", n.fraction),
+            format!(
+                "median predictability horizon (spread > {} of the signal)",
+                n.fraction
+            ),
             n.median_horizon
                 .map_or("beyond the window".into(), |h| format!("{h:.4} s")),
         ],
@@ -187,7 +202,11 @@ fn setup(r: &StudyResult) -> Section {
                 &["parameter", "lower", "upper", "nominal", "calibrated"],
                 rows,
             ),
-            table("The model's own noise (jitter ensemble)", &["quantity", "value"], noise_rows),
+            table(
+                "The model's own noise (jitter ensemble)",
+                &["quantity", "value"],
+                noise_rows,
+            ),
         ],
     }
 }
@@ -264,7 +283,8 @@ fn sensors_section(r: &StudyResult, geometry: Option<&Geometry>) -> Section {
         s.condition_number,
         s.candidates - s.selected.len(),
         s.expansion_rel_error.map_or("-".into(), pct),
-        s.expansion_condition.map_or("-".into(), |c| format!("{c:.2}")),
+        s.expansion_condition
+            .map_or("-".into(), |c| format!("{c:.2}")),
         s.selected.join(", ")
     ))];
     if let Some(geo) = geometry {
@@ -353,7 +373,10 @@ fn surrogate_section(r: &StudyResult) -> Section {
                 vec![
                     k.to_string(),
                     s.q.loo_by_kind.get(*k).map_or("failed".into(), |v| g(*v)),
-                    s.sensors.loo_by_kind.get(*k).map_or("failed".into(), |v| g(*v)),
+                    s.sensors
+                        .loo_by_kind
+                        .get(*k)
+                        .map_or("failed".into(), |v| g(*v)),
                 ]
             })
             .collect();
@@ -365,7 +388,8 @@ fn surrogate_section(r: &StudyResult) -> Section {
             g(s.q.loo_rel_error),
             s.sensors.chosen,
             g(s.sensors.loo_rel_error),
-            s.q.smoothing_lambda.map_or("-".into(), |l| format!("{l:e}"))
+            s.q.smoothing_lambda
+                .map_or("-".into(), |l| format!("{l:e}"))
         )));
         blocks.push(table(
             "Leave-one-out errors by surrogate",
@@ -445,12 +469,37 @@ fn reconcile_section(r: &StudyResult) -> Section {
             "Before and after",
             &["measure", "baseline", "calibrated", "model's own noise"],
             vec![
-                vec!["prediction error (sensors)".into(), pct(b.prediction_error), pct(a.prediction_error), pct(noise)],
-                vec!["Q(t) error".into(), pct(b.q_error), pct(a.q_error), pct(r.noise.relative_spread_q)],
+                vec![
+                    "prediction error (sensors)".into(),
+                    pct(b.prediction_error),
+                    pct(a.prediction_error),
+                    pct(noise),
+                ],
+                vec![
+                    "Q(t) error".into(),
+                    pct(b.q_error),
+                    pct(a.q_error),
+                    pct(r.noise.relative_spread_q),
+                ],
                 vec!["M2 pairs above 0.9".into(), m2(b), m2(a), "-".into()],
-                vec!["mean relative L2 per sensor".into(), g(b.rel_l2), g(a.rel_l2), "-".into()],
-                vec!["mean Sprague-Geers C".into(), g(b.sprague_geers_c), g(a.sprague_geers_c), "-".into()],
-                vec!["mean ISO/TS 18571 R".into(), g(b.iso18571_r), g(a.iso18571_r), "-".into()],
+                vec![
+                    "mean relative L2 per sensor".into(),
+                    g(b.rel_l2),
+                    g(a.rel_l2),
+                    "-".into(),
+                ],
+                vec![
+                    "mean Sprague-Geers C".into(),
+                    g(b.sprague_geers_c),
+                    g(a.sprague_geers_c),
+                    "-".into(),
+                ],
+                vec![
+                    "mean ISO/TS 18571 R".into(),
+                    g(b.iso18571_r),
+                    g(a.iso18571_r),
+                    "-".into(),
+                ],
             ],
         ));
         let rows = b
@@ -471,7 +520,15 @@ fn reconcile_section(r: &StudyResult) -> Section {
             .collect();
         blocks.push(table(
             "Per sensor",
-            &["sensor", "rel. L2 before", "after", "S-G C before", "after", "ISO R before", "after"],
+            &[
+                "sensor",
+                "rel. L2 before",
+                "after",
+                "S-G C before",
+                "after",
+                "ISO R before",
+                "after",
+            ],
             rows,
         ));
         let mut q = vec![
@@ -581,12 +638,23 @@ pub fn reveal_section(items: &[Revealed], threshold: f64) -> Section {
                 changed.join(", "),
                 moved.len(),
                 100.0 * threshold,
-                if moved.is_empty() { "none".to_string() } else { moved.join(", ") },
+                if moved.is_empty() {
+                    "none".to_string()
+                } else {
+                    moved.join(", ")
+                },
                 both
             )),
             table(
                 "Hidden and calibrated values",
-                &["parameter", "nominal", "test (hidden)", "change", "calibrated", "move"],
+                &[
+                    "parameter",
+                    "nominal",
+                    "test (hidden)",
+                    "change",
+                    "calibrated",
+                    "move",
+                ],
                 rows,
             ),
         ],

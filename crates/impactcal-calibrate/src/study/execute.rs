@@ -119,7 +119,9 @@ impl Runs<'_> {
         outcomes
             .into_iter()
             .enumerate()
-            .map(|(i, o)| o.ok_or_else(|| CalibrateError::study(stage, format!("run {i} never finished"))))
+            .map(|(i, o)| {
+                o.ok_or_else(|| CalibrateError::study(stage, format!("run {i} never finished")))
+            })
             .collect()
     }
 }

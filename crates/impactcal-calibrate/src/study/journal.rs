@@ -220,7 +220,9 @@ fn decode(bytes: &[u8], point: &[f64]) -> std::result::Result<RunOutcome, String
         0 => Ok(Err(r.string()?)),
         1 => {
             let channels = r.u32()?;
-            let labels: Vec<String> = (0..channels).map(|_| r.string()).collect::<Result<_, _>>()?;
+            let labels: Vec<String> = (0..channels)
+                .map(|_| r.string())
+                .collect::<Result<_, _>>()?;
             let samples = r.u32()?;
             let dt = r.f64()?;
             let start = r.f64()?;
@@ -269,11 +271,13 @@ mod tests {
         assert_eq!(used, read);
         let used = used.unwrap();
         for (a, b) in used.data().iter().zip(h.data()) {
-            assert_eq!(*a, f64::from(*b as f32));
+            assert_eq!(a.to_bits(), f64::from(*b as f32).to_bits());
         }
         assert!(j.read("ensemble", 4, &[1.0, 2.0]).unwrap().is_none());
         assert!(j.read("ensemble", 3, &[1.0, 2.5]).is_err());
-        let failed = j.write("ensemble", 5, &[0.0, 0.0], &Err("diverged".into())).unwrap();
+        let failed = j
+            .write("ensemble", 5, &[0.0, 0.0], &Err("diverged".into()))
+            .unwrap();
         assert_eq!(failed, Err("diverged".to_string()));
         assert_eq!(j.read("ensemble", 5, &[0.0, 0.0]).unwrap(), Some(failed));
         // Another study's folder is refused.

@@ -26,7 +26,12 @@ pub struct M2Result {
 ///
 /// # Errors
 /// Shape errors (for example a run without signal on these channels).
-pub fn m2(model: &Histories, test: &Histories, channels: &[String], shapes: usize) -> Result<M2Result> {
+pub fn m2(
+    model: &Histories,
+    test: &Histories,
+    channels: &[String],
+    shapes: usize,
+) -> Result<M2Result> {
     let m = model.select(channels)?;
     let t = test.select(channels)?;
     let k = shapes.min(channels.len()).min(t.samples()).max(1);

@@ -212,14 +212,16 @@ pub fn run(
             ),
         ));
     }
-    let noise_idx: Vec<usize> = objective
-        .iter()
-        .filter_map(|l| noise.index_of(l))
-        .collect();
+    let noise_idx: Vec<usize> = objective.iter().filter_map(|l| noise.index_of(l)).collect();
     let q_noise = q_spread(&baseline, &jitter_runs, &objective)?;
 
     // 2. The ensemble.
-    let design = sample(&space, SamplingMethod::ScrambledHalton, options.ensemble, options.seed)?;
+    let design = sample(
+        &space,
+        SamplingMethod::ScrambledHalton,
+        options.ensemble,
+        options.seed,
+    )?;
     let points: Vec<Vec<f64>> = (0..design.points.nrows())
         .map(|i| design.points.row(i).iter().copied().collect())
         .collect();
@@ -243,7 +245,11 @@ pub fn run(
     if ok_runs.is_empty() {
         return Err(CalibrateError::study(
             "ensemble",
-            format!("all {} runs failed (first: {})", points.len(), failed[0].message),
+            format!(
+                "all {} runs failed (first: {})",
+                points.len(),
+                failed[0].message
+            ),
         ));
     }
     let ensemble = EnsembleSummary {
@@ -384,7 +390,8 @@ pub fn run(
     }
     let start: Vec<(Vec<f64>, RunOutcome)> = points.iter().cloned().zip(outcomes).collect();
     observer.stage("reconcile", options.reconcile_runs, 0);
-    let mut run_batch = |first: usize, pts: &[Vec<f64>]| runs.stage_from("reconcile", first, pts, false);
+    let mut run_batch =
+        |first: usize, pts: &[Vec<f64>]| runs.stage_from("reconcile", first, pts, false);
     let best = reconcile::reconcile(
         &space,
         &start,

@@ -77,7 +77,11 @@ impl ParamGuard for StudyOptions {
             ));
         }
         if self.sensors == 0 {
-            return Err(CoreError::invalid_option("study.sensors", 0, "place at least one sensor"));
+            return Err(CoreError::invalid_option(
+                "study.sensors",
+                0,
+                "place at least one sensor",
+            ));
         }
         if self.shapes == 0 || self.shapes > self.sensors {
             return Err(CoreError::invalid_option(
@@ -94,7 +98,11 @@ impl ParamGuard for StudyOptions {
             ));
         }
         if self.reconcile_batch == 0 {
-            return Err(CoreError::invalid_option("study.reconcile_batch", 0, "must be at least 1"));
+            return Err(CoreError::invalid_option(
+                "study.reconcile_batch",
+                0,
+                "must be at least 1",
+            ));
         }
         if self.noise_runs < 2 {
             return Err(CoreError::invalid_option(
@@ -104,7 +112,11 @@ impl ParamGuard for StudyOptions {
             ));
         }
         if !(self.noise_eps > 0.0 && self.noise_eps <= 0.1) {
-            return Err(CoreError::invalid_option("study.noise_eps", self.noise_eps, "must lie in (0, 0.1]"));
+            return Err(CoreError::invalid_option(
+                "study.noise_eps",
+                self.noise_eps,
+                "must lie in (0, 0.1]",
+            ));
         }
         if !(self.noise_fraction > 0.0 && self.noise_fraction.is_finite()) {
             return Err(CoreError::invalid_option(

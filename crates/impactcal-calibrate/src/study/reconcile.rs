@@ -10,6 +10,9 @@ use serde::{Deserialize, Serialize};
 use super::journal::RunOutcome;
 use crate::error::Result;
 
+/// Runs a batch of points as runs `first..first + points.len()` of the reconciliation.
+pub type RunBatch<'a> = dyn FnMut(usize, &[Vec<f64>]) -> Result<Vec<RunOutcome>> + 'a;
+
 /// The outcome of the reconciliation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Reconcile {
@@ -55,7 +58,7 @@ pub fn reconcile(
     budget: usize,
     batch: usize,
     seed: u64,
-    run: &mut dyn FnMut(usize, &[Vec<f64>]) -> Result<Vec<RunOutcome>>,
+    run: &mut RunBatch<'_>,
     error: &dyn Fn(&Histories) -> Result<f64>,
 ) -> Result<Best> {
     let options = CorsOptions {

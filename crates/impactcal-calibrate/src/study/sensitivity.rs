@@ -72,7 +72,8 @@ pub fn sensitivity(
     };
     let s = analyze(&design.layout, y.as_ref(), &options)?;
     let clean = |v: f64| if v.is_finite() { v } else { 0.0 };
-    let series = |m: &Vec<Vec<f64>>, i: usize| -> Vec<f64> { m.iter().map(|row| clean(row[i])).collect() };
+    let series =
+        |m: &Vec<Vec<f64>>, i: usize| -> Vec<f64> { m.iter().map(|row| clean(row[i])).collect() };
     let first_order: BTreeMap<String, Vec<f64>> = names
         .iter()
         .enumerate()
@@ -104,7 +105,9 @@ pub fn sensitivity(
                     0.0
                 }
             };
-            let best = names.iter().max_by(|x, y| weighted(x).total_cmp(&weighted(y)))?;
+            let best = names
+                .iter()
+                .max_by(|x, y| weighted(x).total_cmp(&weighted(y)))?;
             Some(Dominant {
                 start: time[a],
                 end: time[b - 1],

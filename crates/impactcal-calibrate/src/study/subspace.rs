@@ -46,7 +46,10 @@ impl<M: Model> Subspace<M> {
             let Some(i) = full.index_of(field) else {
                 return Err(CalibrateError::study(
                     format!("parameter `{field}`"),
-                    format!("the model has no such quantity; closest: {}", near(field, &full.names())),
+                    format!(
+                        "the model has no such quantity; closest: {}",
+                        near(field, &full.names())
+                    ),
                 ));
             };
             let q = &full.parameters()[i];
@@ -79,7 +82,11 @@ impl<M: Model> Subspace<M> {
         if base.len() != self.base.len() {
             return Err(CalibrateError::study(
                 "base point",
-                format!("has {} values, the model {} parameters", base.len(), self.base.len()),
+                format!(
+                    "has {} values, the model {} parameters",
+                    base.len(),
+                    self.base.len()
+                ),
             ));
         }
         self.base = base;
@@ -151,15 +158,28 @@ mod tests {
             Parameter::new("mass.tail", 0.05, 0.1, 0.07).unwrap(),
         ])
         .unwrap();
-        let sub = ParameterSpace::new(vec![Parameter::new("mass.tail", 0.06, 0.08, 0.07).unwrap()]).unwrap();
+        let sub = ParameterSpace::new(vec![Parameter::new("mass.tail", 0.06, 0.08, 0.07).unwrap()])
+            .unwrap();
         let m = Subspace::new(Sum(full.clone()), sub).unwrap();
-        assert_eq!(m.simulate(&[0.075]).unwrap().channel(0), &[0.1, 0.03, 0.075]);
+        assert_eq!(
+            m.simulate(&[0.075]).unwrap().channel(0),
+            &[0.1, 0.03, 0.075]
+        );
         let m = m.with_base(vec![0.12, 0.025, 0.0]).unwrap();
-        assert_eq!(m.simulate(&[0.06]).unwrap().channel(0), &[0.12, 0.025, 0.06]);
-        let typo = ParameterSpace::new(vec![Parameter::new("bely_panel.t", 0.05, 0.1, 0.07).unwrap()]).unwrap();
-        let e = Subspace::new(Sum(full.clone()), typo).unwrap_err().to_string();
+        assert_eq!(
+            m.simulate(&[0.06]).unwrap().channel(0),
+            &[0.12, 0.025, 0.06]
+        );
+        let typo = ParameterSpace::new(vec![
+            Parameter::new("bely_panel.t", 0.05, 0.1, 0.07).unwrap(),
+        ])
+        .unwrap();
+        let e = Subspace::new(Sum(full.clone()), typo)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("closest: `belly_panel.t`"), "{e}");
-        let wide = ParameterSpace::new(vec![Parameter::new("roof.t", 0.01, 0.04, 0.03).unwrap()]).unwrap();
+        let wide =
+            ParameterSpace::new(vec![Parameter::new("roof.t", 0.01, 0.04, 0.03).unwrap()]).unwrap();
         let e = Subspace::new(Sum(full), wide).unwrap_err().to_string();
         assert!(e.contains("outside what the model accepts"), "{e}");
     }

@@ -111,7 +111,10 @@ pub fn choose(
         let outcome = (|| {
             let s = ResponseSurrogate::fit(space, kind, points, values, names.clone())?;
             let e = s.loo_errors(LooMethod::Auto)?;
-            Ok((ErrorSummary::new(e.as_ref(), values).relative_rms, Fitted::Response(s)))
+            Ok((
+                ErrorSummary::new(e.as_ref(), values).relative_rms,
+                Fitted::Response(s),
+            ))
         })();
         consider(name(kind), outcome);
     }
@@ -119,8 +122,12 @@ pub fn choose(
     let mut smooth: Option<(f64, f64, RbfInterpolant)> = None;
     let mut last_error = None;
     for lambda in LAMBDAS {
-        let fit = RbfInterpolant::fit(unit.as_ref(), values, RbfOptions::cubic().with_smoothing(lambda))
-            .and_then(|i| i.loo_errors(LooMethod::Closed).map(|e| (i, e)));
+        let fit = RbfInterpolant::fit(
+            unit.as_ref(),
+            values,
+            RbfOptions::cubic().with_smoothing(lambda),
+        )
+        .and_then(|i| i.loo_errors(LooMethod::Closed).map(|e| (i, e)));
         match fit {
             Ok((i, e)) => {
                 let r = ErrorSummary::new(e.as_ref(), values).relative_rms;
@@ -133,10 +140,16 @@ pub fn choose(
     }
     let smoothing_lambda = smooth.as_ref().map(|s| s.1);
     match smooth {
-        Some((r, _, i)) => consider(SMOOTHING.into(), Ok((r, Fitted::Smoothing(space.clone(), i)))),
+        Some((r, _, i)) => consider(
+            SMOOTHING.into(),
+            Ok((r, Fitted::Smoothing(space.clone(), i))),
+        ),
         None => consider(
             SMOOTHING.into(),
-            Err(CalibrateError::study(SMOOTHING, last_error.unwrap_or_default())),
+            Err(CalibrateError::study(
+                SMOOTHING,
+                last_error.unwrap_or_default(),
+            )),
         ),
     }
     let Some((loo_rel_error, chosen, fitted)) = best else {
