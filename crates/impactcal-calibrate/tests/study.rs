@@ -19,7 +19,7 @@ const DT: f64 = 2.5e-4;
 
 /// Velocities of `NODES` nodes (x and z) of a structure hitting the ground: three damped
 /// modes whose frequencies scale with `sqrt(stiffness)`, damping ratios with `damping`, and
-/// the second mode's amplitude with `mass`; a rebound on z. Fails where `stiffness > fail`.
+/// the first mode's amplitude with `mass`; a rebound on z. Fails where `stiffness > fail`.
 struct Drop {
     space: ParameterSpace,
     fail: f64,
@@ -50,7 +50,7 @@ impl Model for Drop {
         }
         let freqs = [38.0, 95.0, 170.0].map(|f: f64| f * p[0].sqrt());
         let zetas = [0.08, 0.05, 0.04].map(|z| z * p[1]);
-        let amps = [120.0, 45.0 * p[2], 18.0];
+        let amps = [120.0 * p[2], 45.0, 18.0];
         let mut labels = Vec::new();
         let mut channels = Vec::new();
         for n in 0..NODES {
@@ -207,9 +207,9 @@ fn reconciliation_recovers_an_interior_point_and_a_resumed_study_is_identical() 
     let truth = [1.17, 1.21, 0.93];
     let test = model.simulate(&truth).unwrap();
     let dir = tempfile::tempdir().unwrap();
-    let r = run(&model, &test, options(16, 24), dir.path()).unwrap();
+    let r = run(&model, &test, options(16, 40), dir.path()).unwrap();
     let c = r.reconcile.as_ref().unwrap();
-    assert_eq!(c.runs, 24);
+    assert_eq!(c.runs, 40);
     let widths = [0.6, 0.9, 0.4];
     for i in 0..3 {
         let off = (c.calibrated_point[i] - truth[i]).abs() / widths[i];
@@ -232,7 +232,7 @@ fn reconciliation_recovers_an_interior_point_and_a_resumed_study_is_identical() 
     assert_eq!(s.ranking.len(), 3);
     assert!(r.surrogate.as_ref().unwrap().loo_rel_error < 0.5);
     // The same study again in the same folder reuses every run and gives the same result.
-    let again = run(&model, &test, options(16, 24), dir.path()).unwrap();
+    let again = run(&model, &test, options(16, 40), dir.path()).unwrap();
     assert_eq!(again, r);
     // An interrupted study (half the ensemble and most reconciliation runs lost) too.
     let journal = dir.path().join("journal");
@@ -245,7 +245,7 @@ fn reconciliation_recovers_an_interior_point_and_a_resumed_study_is_identical() 
             }
         }
     }
-    let resumed = run(&model, &test, options(16, 24), dir.path()).unwrap();
+    let resumed = run(&model, &test, options(16, 40), dir.path()).unwrap();
     assert_eq!(
         serde_json::to_string(&resumed).unwrap(),
         serde_json::to_string(&r).unwrap()

@@ -454,8 +454,8 @@ fn reconcile_section(r: &StudyResult) -> Section {
     if let (Some(e), Some(c)) = (&r.errors, &r.reconcile) {
         blocks.push(Block::Paragraph(format!(
             "CORS-RBF minimised ln(prediction error) over the sensors with {} new model runs \
-             ({} at a time), started from the {} ensemble runs. The best point came from the \
-             {}. {}",
+             ({} at a time), started from the baseline and the ensemble ({} runs). The best point \
+             is the {}. {}",
             c.runs,
             c.batch,
             c.warm_start,

@@ -26,7 +26,7 @@ pub struct Reconcile {
     pub calibrated: BTreeMap<String, f64>,
     /// The same point in the space's order.
     pub calibrated_point: Vec<f64>,
-    /// Where the best point came from: `ensemble` or `reconcile` (new run `k`).
+    /// Where the best point came from: `baseline`, `ensemble run k` or `reconcile run k`.
     pub best_from: String,
     /// Prediction error of the best point.
     pub best_error: f64,
@@ -44,8 +44,8 @@ pub struct Best {
     pub histories: Histories,
 }
 
-/// Runs CORS-RBF: warm start from `start` (points with their histories, failures as
-/// `Err`), then `budget` new runs in batches of `batch` through `run(first_index, points)`,
+/// Runs CORS-RBF: warm start from `start` (the baseline first, then the ensemble: points
+/// with their histories, failures as `Err`), then `budget` new runs in batches of `batch` through `run(first_index, points)`,
 /// each scored by `error` (the relative prediction error, positive); the surrogate fits
 /// `ln(error)`.
 ///
@@ -69,7 +69,7 @@ pub fn reconcile(
     let mut evaluated: Vec<(Vec<f64>, Option<Histories>, f64, String)> = Vec::new();
     let mut warm_points = Vec::new();
     let mut warm_values = Vec::new();
-    for (p, o) in start {
+    for (k, (p, o)) in start.iter().enumerate() {
         let v = match o {
             Ok(h) => error(h)?,
             Err(_) => f64::NAN,
@@ -77,7 +77,12 @@ pub fn reconcile(
         let v = positive(v);
         warm_points.push(p.clone());
         warm_values.push(v);
-        evaluated.push((p.clone(), o.clone().ok(), v, "ensemble".into()));
+        let from = if k == 0 {
+            "baseline".to_string()
+        } else {
+            format!("ensemble run {}", k - 1)
+        };
+        evaluated.push((p.clone(), o.clone().ok(), v, from));
     }
     cors.warm_start_rows(&warm_points, &warm_values)?;
     let mut errors = Vec::new();
