@@ -308,3 +308,123 @@ fn bad_studies_are_refused() {
     .unwrap_err();
     assert!(e.to_string().contains("no channel in common"), "{e}");
 }
+
+/// The report document of a whole study carries the study's numbers in every figure and
+/// table.
+#[test]
+fn the_report_document_holds_the_study_numbers() {
+    use impactcal_calibrate::report::{Block, Plot};
+    use impactcal_calibrate::study::document::{Geometry, report};
+    let model = Drop::new(f64::INFINITY);
+    let test = model.simulate(&[1.1, 0.9, 1.05]).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let r = run(&model, &test, options(12, 6), dir.path()).unwrap();
+    let mut geometry = Geometry {
+        points: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+        unit: "in".into(),
+        ..Geometry::default()
+    };
+    for n in 0..NODES {
+        for a in ["x", "z"] {
+            geometry
+                .channels
+                .insert(format!("{}.{a}", 100 + n), [n as f64, 0.0, 0.0]);
+        }
+    }
+    let doc = report(&r, Some(&geometry));
+    assert!(doc.lead[0].contains(r.m1.verdict.as_str()));
+    let figures: Vec<_> = doc
+        .sections
+        .iter()
+        .flat_map(|s| &s.blocks)
+        .filter_map(|b| match b {
+            Block::Figure(f) => Some(f),
+            _ => None,
+        })
+        .collect();
+    let names: Vec<&str> = figures.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "fig-m1",
+            "fig-sensors",
+            "fig-m2-baseline",
+            "fig-m2-calibrated",
+            "fig-sensitivity",
+            "fig-q",
+            "fig-sensor"
+        ]
+    );
+    let m2 = r.m2.as_ref().unwrap();
+    let s = r.sensitivity.as_ref().unwrap();
+    for f in &figures {
+        match (&f.plot, f.name.as_str()) {
+            (Plot::Envelope(e), _) => {
+                assert_eq!(
+                    (&e.lower, &e.upper, &e.x),
+                    (&r.m1.lower, &r.m1.upper, &r.m1.time)
+                );
+                assert_eq!(e.series[0].values, r.m1.test);
+                let marked: Vec<[f64; 2]> = e.marked.iter().map(|m| [m.0, m.1]).collect();
+                assert_eq!(marked, r.m1.intervals);
+            }
+            (Plot::Structure(st), _) => {
+                let labels: Vec<&str> = st.marked.iter().map(|m| m.label.as_str()).collect();
+                assert_eq!(labels, r.sensors.as_ref().unwrap().selected);
+                for m in &st.marked {
+                    assert_eq!(m.at, geometry.channels[&m.label]);
+                }
+            }
+            (Plot::HeatMap(h), name) => {
+                let m = if name.ends_with("baseline") {
+                    &m2.baseline
+                } else {
+                    m2.calibrated.as_ref().unwrap()
+                };
+                assert_eq!(h.values, m.matrix);
+                let pairs: Vec<(usize, usize)> = m.pairs.iter().map(|p| (p.0, p.1)).collect();
+                assert_eq!(h.marked, pairs);
+                assert!((h.row_weights[0] - 100.0 * m.model_contributions[0]).abs() < 1e-12);
+            }
+            (Plot::Stacked(st), _) => {
+                assert_eq!(st.stacked.len(), 3);
+                for series in &st.stacked {
+                    let truth = &s.first_order[&series.name];
+                    for (a, b) in series.values.iter().zip(truth) {
+                        assert_eq!(*a, b.max(0.0));
+                    }
+                }
+                assert_eq!(st.top.values, r.curves.q_baseline);
+            }
+            (Plot::Lines(l), "fig-q") => {
+                assert_eq!(l.series[0].values, r.curves.q_test);
+                assert_eq!(l.series[1].values, r.curves.q_baseline);
+                assert_eq!(Some(&l.series[2].values), r.curves.q_calibrated.as_ref());
+            }
+            (Plot::Lines(l), _) => {
+                assert_eq!(l.series[0].values, r.curves.sensor_test);
+                assert_eq!(l.series.len(), 3);
+            }
+        }
+    }
+    // The before/after table states the computed errors.
+    let e = r.errors.as_ref().unwrap();
+    let table = doc
+        .sections
+        .iter()
+        .flat_map(|s| &s.blocks)
+        .find_map(|b| match b {
+            Block::Table(t) if t.caption == "Before and after" => Some(t),
+            _ => None,
+        })
+        .unwrap();
+    assert_eq!(
+        table.rows[0][1],
+        format!("{:.2} %", 100.0 * e.baseline.prediction_error)
+    );
+    assert_eq!(
+        table.rows[0][2],
+        format!("{:.2} %", 100.0 * e.calibrated.prediction_error)
+    );
+    assert!(e.calibrated.prediction_error <= e.baseline.prediction_error);
+}
