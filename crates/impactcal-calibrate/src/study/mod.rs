@@ -201,16 +201,8 @@ pub fn run(
             ),
         ));
     }
-    if !options.screen_only && options.sensors > objective.len() {
-        return Err(CalibrateError::study(
-            "study.sensors",
-            format!(
-                "{} sensors asked for, but only {} channels can carry one (the predictable \
-                 channels the test and the model share)",
-                options.sensors,
-                objective.len()
-            ),
-        ));
+    if !options.screen_only {
+        sensors::check_count(options.sensors, objective.len())?;
     }
     let noise_idx: Vec<usize> = objective.iter().filter_map(|l| noise.index_of(l)).collect();
     let q_noise = q_spread(&baseline, &jitter_runs, &objective)?;

@@ -29,6 +29,23 @@ pub struct SensorsResult {
     pub expansion_condition: Option<f64>,
 }
 
+/// Whether `count` sensors fit on `candidates` channels.
+///
+/// # Errors
+/// [`CalibrateError::Study`] for more sensors than candidates.
+pub fn check_count(count: usize, candidates: usize) -> Result<()> {
+    if count > candidates {
+        return Err(CalibrateError::study(
+            "study.sensors",
+            format!(
+                "{count} sensors asked for, but only {candidates} channels can carry one (the \
+                 predictable channels the test and the model share)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Places `count` sensors on the impact shapes (`shapes` of them) of the ensemble `runs`,
 /// restricted to `candidates`, and expands the test at the sensors to the other candidates
 /// through the `baseline` run's shapes.
@@ -43,16 +60,7 @@ pub fn place_sensors(
     baseline: &Histories,
     test: &Histories,
 ) -> Result<SensorsResult> {
-    if count > candidates.len() {
-        return Err(CalibrateError::study(
-            "study.sensors",
-            format!(
-                "{count} sensors asked for, but only {} channels can carry one (the \
-                 predictable channels the test and the model share)",
-                candidates.len()
-            ),
-        ));
-    }
+    check_count(count, candidates.len())?;
     let restricted: Vec<Histories> = runs
         .iter()
         .map(|h| h.select(candidates))
