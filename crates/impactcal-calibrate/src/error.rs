@@ -46,12 +46,66 @@ pub enum CalibrateError {
         /// The plotting library's message.
         message: String,
     },
+    /// From the impact shapes (M2, expansion).
+    #[error(transparent)]
+    Shapes(#[from] impactcal_shapes::ShapesError),
+    /// From sensor placement.
+    #[error(transparent)]
+    Sensors(#[from] impactcal_sensors::SensorsError),
+    /// From the surrogates.
+    #[error(transparent)]
+    Erbf(#[from] impactcal_erbf::ErbfError),
+    /// From the sensitivity analysis.
+    #[error(transparent)]
+    Sobol(#[from] impactcal_sobol::SobolError),
+    /// From the CORS-RBF optimiser.
+    #[error(transparent)]
+    Cors(#[from] impactcal_cors::CorsError),
+    /// A study that the data or options cannot support (no channel in common with the
+    /// model, more sensors than channels, too few successful runs).
+    #[error("{what}: {reason}")]
+    Study {
+        /// What is at fault.
+        what: String,
+        /// Why.
+        reason: String,
+    },
+    /// The output folder holds the journal of another study (other model, space, test or
+    /// options); nothing was written.
+    #[error(
+        "{dir}: holds the run journal of another study (fingerprint {found}, this study \
+         {expected}); choose another output folder or remove it"
+    )]
+    ForeignJournal {
+        /// The output folder.
+        dir: String,
+        /// The fingerprint found in the folder.
+        found: String,
+        /// This study's fingerprint.
+        expected: String,
+    },
+    /// A journal file that cannot be read or written.
+    #[error("{path}: {message}")]
+    Journal {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 /// `Result` with [`CalibrateError`].
 pub type Result<T, E = CalibrateError> = std::result::Result<T, E>;
 
 impl CalibrateError {
+    /// A [`CalibrateError::Study`] error.
+    pub fn study(what: impl Into<String>, reason: impl Into<String>) -> Self {
+        CalibrateError::Study {
+            what: what.into(),
+            reason: reason.into(),
+        }
+    }
+
     /// The same error with its subject rewritten by `f` (for example to name the channel a
     /// metric failed on); errors without a subject are returned unchanged.
     #[must_use]
@@ -78,8 +132,16 @@ impl CalibrateError {
             CalibrateError::Core(e) => e.kind(),
             CalibrateError::Degenerate { .. }
             | CalibrateError::Length { .. }
-            | CalibrateError::Report { .. } => ErrorKind::BadInput,
+            | CalibrateError::Report { .. }
+            | CalibrateError::Study { .. }
+            | CalibrateError::ForeignJournal { .. } => ErrorKind::BadInput,
             CalibrateError::Render { .. } => ErrorKind::Numerical,
+            CalibrateError::Shapes(e) => e.kind(),
+            CalibrateError::Sensors(e) => e.kind(),
+            CalibrateError::Erbf(e) => e.kind(),
+            CalibrateError::Sobol(e) => e.kind(),
+            CalibrateError::Cors(e) => e.kind(),
+            CalibrateError::Journal { .. } => ErrorKind::Io,
         }
     }
 }

@@ -27,5 +27,6 @@
 pub mod error;
 pub mod metrics;
 pub mod report;
+pub mod study;
 
 pub use error::{CalibrateError, Result};

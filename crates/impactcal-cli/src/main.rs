@@ -6,6 +6,7 @@
 mod airframe;
 mod compare;
 mod convert;
+mod demo;
 mod error;
 mod expand;
 mod filter;
@@ -19,6 +20,7 @@ mod samples;
 mod shapes;
 mod simulate;
 mod sobol;
+mod study;
 mod surrogate;
 
 use std::process::ExitCode;
@@ -71,6 +73,12 @@ enum Command {
     /// The built-in parametric helicopter airframe: write it as a keyword deck, list its
     /// adjustable quantities and presets, draw its parts.
     Airframe(airframe::Args),
+    /// The calibration study of a model against a test (M1, sensors, M2, surrogates,
+    /// sensitivity, CORS-RBF reconciliation) from a TOML study file; runs are journaled.
+    Study(study::Args),
+    /// The source paper's study on the coarse airframe against a test with hidden changes:
+    /// Table 1 screened by M1, Table 2 studied and reconciled, the changes revealed.
+    Demo(demo::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -89,6 +97,8 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Convert(a) => convert::run(a),
         Command::Filter(a) => filter::run(a),
         Command::Metrics(a) => metrics::run(a),
+        Command::Study(a) => study::run(a),
+        Command::Demo(a) => demo::run(a),
     }
 }
 

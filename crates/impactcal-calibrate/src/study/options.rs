@@ -1,0 +1,140 @@
+//! The settings of a study, checked once into [`ValidStudyOptions`].
+
+use impactcal_core::{CoreError, ParamGuard};
+use serde::{Deserialize, Serialize};
+
+/// The settings of a calibration study (the `[study]` table of a study file). Defaults are
+/// the source paper's where it gives one: 41 sensors, 1,000 (here 1,024, a power of two for
+/// the Sobol' design) surrogate evaluations per sensitivity sample, 60 reconciliation runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StudyOptions {
+    /// Runs of the Halton ensemble `N` (the paper: 150 for Table 1, 50 for Table 2).
+    pub ensemble: usize,
+    /// Sensors `K` placed by effective independence on the ensemble's impact shapes.
+    pub sensors: usize,
+    /// Impact shapes kept for placement and M2 (at most `sensors`).
+    pub shapes: usize,
+    /// Base rows `n` of the Saltelli design evaluated on the surrogate of Q(t)
+    /// (`n (d + 2)` evaluations).
+    pub sensitivity_samples: usize,
+    /// New true-model runs of the CORS-RBF reconciliation (0: no reconciliation).
+    pub reconcile_runs: usize,
+    /// Points CORS-RBF proposes at a time (runs of a batch go in parallel); part of the
+    /// study's definition, since the sequence of points depends on it.
+    pub reconcile_batch: usize,
+    /// Seed of the ensemble, the jitter ensemble, the Sobol' design and CORS-RBF.
+    pub seed: u64,
+    /// Runs `J` of the jitter ensemble that measures the model's own noise.
+    pub noise_runs: usize,
+    /// Largest relative perturbation of the jitter ensemble.
+    pub noise_eps: f64,
+    /// A channel is predictable while its jitter spread stays within this fraction of its
+    /// RMS signal; channels whose horizon ends inside the window leave the objective.
+    pub noise_fraction: f64,
+    /// Keep unpredictable channels in the objective (flagged in the result).
+    pub keep_unpredictable: bool,
+    /// Stop after M1 (the screening of a first parameter set).
+    pub screen_only: bool,
+}
+
+impl Default for StudyOptions {
+    fn default() -> Self {
+        StudyOptions {
+            ensemble: 50,
+            sensors: 41,
+            shapes: 10,
+            sensitivity_samples: 1024,
+            reconcile_runs: 60,
+            reconcile_batch: 2,
+            seed: 1,
+            noise_runs: 8,
+            noise_eps: 1e-4,
+            noise_fraction: 0.05,
+            keep_unpredictable: false,
+            screen_only: false,
+        }
+    }
+}
+
+impl ParamGuard for StudyOptions {
+    type Checked = ValidStudyOptions;
+
+    /// Checks every option on its own (whether the model and the test can support them is
+    /// checked when the study runs).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] for an ensemble of fewer than 2 runs (a budget of 0
+    /// included), 0 sensors or shapes, more shapes than sensors, fewer than 2 sensitivity
+    /// samples, a reconciliation batch of 0, fewer than 2 jitter runs, `noise_eps` outside
+    /// `(0, 0.1]` or `noise_fraction` not positive.
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        if self.ensemble < 2 {
+            return Err(CoreError::invalid_option(
+                "study.ensemble",
+                self.ensemble,
+                "an ensemble needs at least 2 runs",
+            ));
+        }
+        if self.sensors == 0 {
+            return Err(CoreError::invalid_option(
+                "study.sensors",
+                0,
+                "place at least one sensor",
+            ));
+        }
+        if self.shapes == 0 || self.shapes > self.sensors {
+            return Err(CoreError::invalid_option(
+                "study.shapes",
+                self.shapes,
+                format!("must lie in 1..={} (the sensor count)", self.sensors),
+            ));
+        }
+        if self.sensitivity_samples < 2 {
+            return Err(CoreError::invalid_option(
+                "study.sensitivity_samples",
+                self.sensitivity_samples,
+                "must be at least 2",
+            ));
+        }
+        if self.reconcile_batch == 0 {
+            return Err(CoreError::invalid_option(
+                "study.reconcile_batch",
+                0,
+                "must be at least 1",
+            ));
+        }
+        if self.noise_runs < 2 {
+            return Err(CoreError::invalid_option(
+                "study.noise_runs",
+                self.noise_runs,
+                "a jitter ensemble needs at least 2 runs",
+            ));
+        }
+        if !(self.noise_eps > 0.0 && self.noise_eps <= 0.1) {
+            return Err(CoreError::invalid_option(
+                "study.noise_eps",
+                self.noise_eps,
+                "must lie in (0, 0.1]",
+            ));
+        }
+        if !(self.noise_fraction > 0.0 && self.noise_fraction.is_finite()) {
+            return Err(CoreError::invalid_option(
+                "study.noise_fraction",
+                self.noise_fraction,
+                "must be positive",
+            ));
+        }
+        Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<ValidStudyOptions> {
+        ValidStudyOptions::checked(self)
+    }
+}
+
+impactcal_core::valid_options! {
+    /// [`StudyOptions`] that passed their checks: the only form a study runs with.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct ValidStudyOptions(StudyOptions);
+}

@@ -1,0 +1,146 @@
+//! Reconciliation: CORS-RBF minimises `ln` of the prediction error over the sensors with new
+//! true-model runs, started from the ensemble (warm start).
+
+use std::collections::BTreeMap;
+
+use impactcal_core::{Histories, ParameterSpace};
+use impactcal_cors::{Cors, CorsOptions, Transform};
+use serde::{Deserialize, Serialize};
+
+use super::journal::RunOutcome;
+use crate::error::Result;
+
+/// Runs a batch of points as runs `first..first + points.len()` of the reconciliation.
+pub type RunBatch<'a> = dyn FnMut(usize, &[Vec<f64>]) -> Result<Vec<RunOutcome>> + 'a;
+
+/// The outcome of the reconciliation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Reconcile {
+    /// New true-model runs made.
+    pub runs: usize,
+    /// Points proposed at a time.
+    pub batch: usize,
+    /// Ensemble runs the optimiser started from.
+    pub warm_start: usize,
+    /// The calibrated parameters (the best evaluated point).
+    pub calibrated: BTreeMap<String, f64>,
+    /// The same point in the space's order.
+    pub calibrated_point: Vec<f64>,
+    /// Where the best point came from: `baseline`, `ensemble run k` or `reconcile run k`.
+    pub best_from: String,
+    /// Prediction error of the best point.
+    pub best_error: f64,
+    /// Prediction error of each new run in order (NaN for a failed run).
+    pub errors: Vec<f64>,
+    /// Indices of the new runs that failed, with the reason.
+    pub failed: Vec<(usize, String)>,
+}
+
+/// A run of the reconciliation with its histories (for the before/after comparison).
+pub struct Best {
+    /// The summary.
+    pub summary: Reconcile,
+    /// The histories at the calibrated point.
+    pub histories: Histories,
+}
+
+/// Runs CORS-RBF: warm start from `start` (the baseline first, then the ensemble: points
+/// with their histories, failures as `Err`), then `budget` new runs in batches of `batch` through `run(first_index, points)`,
+/// each scored by `error` (the relative prediction error, positive); the surrogate fits
+/// `ln(error)`.
+///
+/// # Errors
+/// CORS errors; whatever `run` or `error` returns.
+#[allow(clippy::too_many_arguments)]
+pub fn reconcile(
+    space: &ParameterSpace,
+    start: &[(Vec<f64>, RunOutcome)],
+    budget: usize,
+    batch: usize,
+    seed: u64,
+    run: &mut RunBatch<'_>,
+    error: &dyn Fn(&Histories) -> Result<f64>,
+) -> Result<Best> {
+    let options = CorsOptions {
+        transform: Transform::Log,
+        ..CorsOptions::with_seed(seed)
+    };
+    let mut cors = Cors::new(space.clone(), options)?;
+    let mut evaluated: Vec<(Vec<f64>, Option<Histories>, f64, String)> = Vec::new();
+    let mut warm_points = Vec::new();
+    let mut warm_values = Vec::new();
+    for (k, (p, o)) in start.iter().enumerate() {
+        let v = match o {
+            Ok(h) => error(h)?,
+            Err(_) => f64::NAN,
+        };
+        let v = positive(v);
+        warm_points.push(p.clone());
+        warm_values.push(v);
+        let from = if k == 0 {
+            "baseline".to_string()
+        } else {
+            format!("ensemble run {}", k - 1)
+        };
+        evaluated.push((p.clone(), o.clone().ok(), v, from));
+    }
+    cors.warm_start_rows(&warm_points, &warm_values)?;
+    let mut errors = Vec::new();
+    let mut failed = Vec::new();
+    while errors.len() < budget {
+        let q = batch.min(budget - errors.len());
+        let suggestions = cors.suggest(q)?;
+        if suggestions.is_empty() {
+            break;
+        }
+        let points: Vec<Vec<f64>> = suggestions.iter().map(|s| s.x.clone()).collect();
+        let outcomes = run(errors.len(), &points)?;
+        for (s, o) in suggestions.iter().zip(outcomes) {
+            let k = errors.len();
+            let v = match &o {
+                Ok(h) => positive(error(h)?),
+                Err(m) => {
+                    failed.push((k, m.clone()));
+                    f64::NAN
+                }
+            };
+            cors.tell(s.id, v)?;
+            errors.push(v);
+            evaluated.push((s.x.clone(), o.ok(), v, format!("reconcile run {k}")));
+        }
+    }
+    let best = evaluated
+        .iter()
+        .filter(|e| e.1.is_some() && e.2.is_finite())
+        .min_by(|a, b| a.2.total_cmp(&b.2));
+    let Some((point, Some(histories), best_error, from)) = best.cloned() else {
+        return Err(crate::error::CalibrateError::study(
+            "reconciliation",
+            "no run succeeded",
+        ));
+    };
+    Ok(Best {
+        summary: Reconcile {
+            runs: errors.len(),
+            batch,
+            warm_start: start.len(),
+            calibrated: space
+                .names()
+                .iter()
+                .zip(&point)
+                .map(|(n, v)| (n.to_string(), *v))
+                .collect(),
+            calibrated_point: point,
+            best_from: from,
+            best_error,
+            errors,
+            failed,
+        },
+        histories,
+    })
+}
+
+/// `ln` needs a positive value: an exact match (error 0) is floored at 1e-300.
+fn positive(v: f64) -> f64 {
+    if v.is_finite() { v.max(1e-300) } else { v }
+}

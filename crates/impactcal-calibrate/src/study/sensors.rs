@@ -1,0 +1,101 @@
+//! Sensor placement on the ensemble's impact shapes, and the test expanded from the sensors
+//! to every channel through the baseline's shapes (the paper's Eq. 4.8).
+
+use impactcal_core::Histories;
+use impactcal_sensors::{PlacementOptions, place_from_histories};
+use impactcal_shapes::{Expansion, ImpactShapes, ShapeOptions};
+use serde::{Deserialize, Serialize};
+
+use super::channels::relative_error;
+use crate::error::{CalibrateError, Result};
+
+/// The sensors a study uses.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SensorsResult {
+    /// Candidate channels (the objective channels the test has).
+    pub candidates: usize,
+    /// Impact shapes of the concatenated ensemble the placement kept.
+    pub shapes: usize,
+    /// The selected channels, in placement order.
+    pub selected: Vec<String>,
+    /// `det(Q_K) / det(Q_all)` of the Fisher information kept.
+    pub determinant_ratio: f64,
+    /// Condition number of the selected rows of the shapes.
+    pub condition_number: f64,
+    /// Relative L2 error of the test expanded from the sensors to the other objective
+    /// channels through the baseline's shapes (`None` when no channel is left over).
+    pub expansion_rel_error: Option<f64>,
+    /// Condition number of the expansion's fit.
+    pub expansion_condition: Option<f64>,
+}
+
+/// Whether `count` sensors fit on `candidates` channels.
+///
+/// # Errors
+/// [`CalibrateError::Study`] for more sensors than candidates.
+pub fn check_count(count: usize, candidates: usize) -> Result<()> {
+    if count > candidates {
+        return Err(CalibrateError::study(
+            "study.sensors",
+            format!(
+                "{count} sensors asked for, but only {candidates} channels can carry one (the \
+                 predictable channels the test and the model share)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Places `count` sensors on the impact shapes (`shapes` of them) of the ensemble `runs`,
+/// restricted to `candidates`, and expands the test at the sensors to the other candidates
+/// through the `baseline` run's shapes.
+///
+/// # Errors
+/// [`CalibrateError::Study`] for more sensors than candidates; placement and shape errors.
+pub fn place_sensors(
+    runs: &[Histories],
+    candidates: &[String],
+    count: usize,
+    shapes: usize,
+    baseline: &Histories,
+    test: &Histories,
+) -> Result<SensorsResult> {
+    check_count(count, candidates.len())?;
+    let restricted: Vec<Histories> = runs
+        .iter()
+        .map(|h| h.select(candidates))
+        .collect::<impactcal_core::Result<_>>()?;
+    let placed = place_from_histories(
+        &restricted,
+        &ShapeOptions::count(shapes),
+        &PlacementOptions::new(count),
+    )?;
+    let selected = placed.placement.selected.clone();
+    let rest: Vec<String> = candidates
+        .iter()
+        .filter(|c| !selected.contains(c))
+        .cloned()
+        .collect();
+    let (expansion_rel_error, expansion_condition) = if rest.is_empty() {
+        (None, None)
+    } else {
+        let base = ImpactShapes::from_histories(
+            &baseline.select(candidates)?,
+            &ShapeOptions::count(shapes.min(count)),
+        )?;
+        let e = Expansion::compute(&base, &test.select(&selected)?, None)?;
+        (
+            Some(relative_error(e.histories(), test, &rest)?),
+            Some(e.condition()),
+        )
+    };
+    Ok(SensorsResult {
+        candidates: candidates.len(),
+        shapes: placed.shapes.len(),
+        selected,
+        determinant_ratio: placed.placement.determinant_ratio,
+        condition_number: placed.placement.condition_number,
+        expansion_rel_error,
+        expansion_condition,
+    })
+}

@@ -1,0 +1,236 @@
+//! `impactcal demo`: the source paper's study on the coarse airframe. The "test" is the
+//! airframe with undisclosed thickness changes in a few sections; Table 1's parameter set is
+//! screened with M1 on 150 runs, then Table 2's is studied in full (50 runs, sensors, M2,
+//! surrogates, sensitivity, 60 CORS-RBF runs), and the report ends with the reveal.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args as ClapArgs;
+use impactcal::calibrate::report::{Block, Plot, Report};
+use impactcal::calibrate::study::document::{Revealed, report, reveal_section};
+use impactcal::calibrate::study::{StudyOptions, StudyResult, Subspace};
+use impactcal::core::{Cfc, Model, ParamGuard};
+use impactcal::shell::airframe::{
+    Airframe, AirframeModel, AirframeOptions, MeshDensity, Preset, catalogue, space_of,
+};
+use serde::Serialize;
+
+use crate::error::CliError;
+use crate::output::write_text;
+use crate::simulate::thread_pool;
+use crate::study::{Built, Setup, execute, finish, geometry_of};
+
+/// The demo's window (s): the airframe is predictable over it (docs/airframe.md,
+/// "Predictability"); later, its own noise grows by e every 4 ms.
+pub const END_TIME: f64 = 0.025;
+
+/// The hidden changes of the test: factor on the nominal value of each section thickness.
+pub const HIDDEN: [(&str, f64); 3] = [
+    ("belly_panel.t", 1.2),
+    ("keel_beam_stiffener.t", 1.2),
+    ("back_panel.t", 0.8),
+];
+
+/// Arguments of `impactcal demo`.
+#[derive(ClapArgs, Debug)]
+pub struct Args {
+    /// Output folder: `test.csv`, `table1/` and `table2/` (each with its run journal and
+    /// `study.json`), `demo.json`.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Number of threads.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Runs of the Table 1 ensemble (the paper: 150).
+    #[arg(long, default_value_t = 150)]
+    pub table1_runs: usize,
+    /// Runs of the Table 2 ensemble (the paper: 50).
+    #[arg(long, default_value_t = 50)]
+    pub table2_runs: usize,
+    /// New runs of the CORS-RBF reconciliation (the paper: 60).
+    #[arg(long, default_value_t = 60)]
+    pub reconcile_runs: usize,
+    /// Sensors (the paper: 41).
+    #[arg(long, default_value_t = 41)]
+    pub sensors: usize,
+    /// Base rows of the Sobol' design on the surrogate (n (d + 2) evaluations).
+    #[arg(long, default_value_t = 1024)]
+    pub sensitivity_samples: usize,
+}
+
+#[derive(Serialize)]
+struct Summary<'a> {
+    wall_time_s: f64,
+    end_time: f64,
+    table1_verdict: &'a str,
+    table1_exceedance_fraction: f64,
+    table1_intervals: &'a [[f64; 2]],
+    table2_verdict: &'a str,
+    table2_exceedance_fraction: f64,
+    prediction_error_before: Option<f64>,
+    prediction_error_after: Option<f64>,
+    reduction: Option<f64>,
+    m2_above_0_9_before: Option<usize>,
+    m2_above_0_9_after: Option<usize>,
+    reveal: &'a [Revealed],
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let started = Instant::now();
+    let pool = thread_pool(args.threads)?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| CliError::io(format!("{}: {e}", args.out.display())))?;
+    let mut options = AirframeOptions::new(MeshDensity::Coarse);
+    options.end_time = END_TIME;
+    let airframe = Airframe::new(options)?;
+    let names: Vec<String> = catalogue().into_iter().map(|a| a.name).collect();
+    let full = space_of(&names)?;
+    let model = AirframeModel::new(airframe.clone(), full.clone())?;
+    let mut hidden_point = full.nominal();
+    for (name, factor) in HIDDEN {
+        if let Some(i) = full.index_of(name) {
+            hidden_point[i] *= factor;
+        }
+    }
+    eprintln!("impactcal: the test (the airframe with hidden changes)");
+    let test = pool.install(|| model.simulate(&hidden_point))?;
+    test.write_csv(args.out.join("test.csv"))?;
+    let cfc = Some(Cfc::from_class(60)?);
+    let geometry = geometry_of(&airframe);
+    let setup = |preset: Preset| -> Result<Setup, CliError> {
+        let sub = Subspace::new(model.clone(), preset.space()?)?;
+        Ok(Setup {
+            model: Built::Airframe(Box::new(sub), geometry.clone()),
+            description: format!("built-in airframe, coarse mesh, {END_TIME} s, {preset:?}"),
+            test: test.clone(),
+            map: None,
+            cfc,
+        })
+    };
+    let table1 = StudyOptions {
+        ensemble: args.table1_runs,
+        screen_only: true,
+        ..StudyOptions::default()
+    }
+    .check()?;
+    let table2 = StudyOptions {
+        ensemble: args.table2_runs,
+        sensors: args.sensors,
+        shapes: 10.min(args.sensors),
+        sensitivity_samples: args.sensitivity_samples,
+        reconcile_runs: args.reconcile_runs,
+        ..StudyOptions::default()
+    }
+    .check()?;
+    let (s1, s2) = (setup(Preset::Table1)?, setup(Preset::Table2)?);
+    eprintln!(
+        "impactcal: Table 1 ({} runs): does M1 let this parameter set explain the test?",
+        table1.ensemble
+    );
+    let dir1 = args.out.join("table1");
+    let r1 = pool.install(|| execute(&s1, &table1, &dir1))?;
+    finish(&r1, &s1, &dir1)?;
+    eprintln!(
+        "impactcal: Table 2 ({} runs), sensitivity, reconciliation",
+        table2.ensemble
+    );
+    let dir2 = args.out.join("table2");
+    let r2 = pool.install(|| execute(&s2, &table2, &dir2))?;
+    finish(&r2, &s2, &dir2)?;
+    let reveal: Vec<Revealed> = r2
+        .space
+        .parameters()
+        .iter()
+        .enumerate()
+        .map(|(i, p)| Revealed {
+            name: p.name.clone(),
+            nominal: p.nominal,
+            hidden: full
+                .index_of(&p.name)
+                .map_or(p.nominal, |k| hidden_point[k]),
+            calibrated: r2
+                .reconcile
+                .as_ref()
+                .map_or(p.nominal, |c| c.calibrated_point[i]),
+        })
+        .collect();
+    let doc = demo_report(&r1, &r2, &reveal, &s2);
+    let e = r2.errors.as_ref();
+    let m2 = r2.m2.as_ref();
+    let summary = Summary {
+        wall_time_s: started.elapsed().as_secs_f64(),
+        end_time: END_TIME,
+        table1_verdict: r1.m1.verdict.as_str(),
+        table1_exceedance_fraction: r1.m1.exceedance_fraction,
+        table1_intervals: &r1.m1.intervals,
+        table2_verdict: r2.m1.verdict.as_str(),
+        table2_exceedance_fraction: r2.m1.exceedance_fraction,
+        prediction_error_before: e.map(|e| e.baseline.prediction_error),
+        prediction_error_after: e.map(|e| e.calibrated.prediction_error),
+        reduction: e.map(|e| e.reduction),
+        m2_above_0_9_before: m2.map(|m| m.baseline.matched_above_0_9),
+        m2_above_0_9_after: m2
+            .and_then(|m| m.calibrated.as_ref())
+            .map(|c| c.matched_above_0_9),
+        reveal: &reveal,
+    };
+    let json = serde_json::to_string_pretty(&summary)
+        .map_err(|e| CliError::failure(format!("cannot encode the summary: {e}")))?;
+    write_text(&(json + "\n"), Some(&args.out.join("demo.json")))?;
+    for line in &doc.lead {
+        eprintln!("{line}");
+    }
+    eprintln!(
+        "impactcal: demo finished in {:.0} s; wrote {}",
+        summary.wall_time_s,
+        args.out.join("demo.json").display()
+    );
+    Ok(())
+}
+
+/// The demo's report: Table 1's M1 screening, Table 2's whole study, the reveal.
+pub fn demo_report(
+    t1: &StudyResult,
+    t2: &StudyResult,
+    reveal: &[Revealed],
+    setup: &Setup,
+) -> Report {
+    let geometry = match &setup.model {
+        Built::Airframe(_, g) => Some(g),
+        Built::Deck(_) => None,
+    };
+    let first = report(t1, None);
+    let second = report(t2, geometry);
+    let mut screening: Vec<_> = first
+        .sections
+        .into_iter()
+        .filter(|s| s.heading.starts_with("M1"))
+        .collect();
+    for s in &mut screening {
+        s.heading = format!("Table 1 screening. {}", s.heading);
+        for b in &mut s.blocks {
+            if let Block::Figure(f) = b {
+                f.name = format!("{}-table1", f.name);
+                if let Plot::Envelope(e) = &mut f.plot {
+                    e.series.truncate(1);
+                }
+            }
+        }
+    }
+    let mut lead = vec![format!(
+        "Table 1 (moduli): {}. Table 2 (thicknesses): {}.",
+        t1.m1.verdict.as_str(),
+        t2.m1.verdict.as_str()
+    )];
+    lead.extend(second.lead.iter().skip(1).cloned());
+    let mut sections = screening;
+    sections.extend(second.sections);
+    sections.push(reveal_section(reveal, 0.05));
+    Report {
+        title: "The source paper's calibration study on the coarse airframe".into(),
+        lead,
+        sections,
+    }
+}

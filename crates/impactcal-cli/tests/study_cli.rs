@@ -1,0 +1,247 @@
+//! `impactcal study` end to end: a keyword deck studied and killed mid-ensemble (the resumed
+//! study equals an uninterrupted one), the coarse airframe with a small budget, and every
+//! bad input a user would produce (exit 2, one line, nothing overwritten).
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::{example_file, impactcal};
+
+/// Writes a study file and the strip deck's nominal histories (the test) into `dir`.
+fn strip_study(dir: &Path, study: &str) -> PathBuf {
+    let deck = example_file("decks", "strip_drop.k");
+    let test = dir.join("test.csv");
+    if !test.exists() {
+        let out = impactcal(&[
+            "simulate",
+            "--deck",
+            deck.to_str().unwrap(),
+            "--out",
+            test.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let config = dir.join("study.toml");
+    std::fs::write(
+        &config,
+        format!(
+            "[model]\ndeck = {deck:?}\n\n[parameters]\nthickness = \"section.1.t\"\n\
+             yield = \"material.1.sigy\"\n\n[test]\ndata = \"test.csv\"\n\n[study]\n{study}\n"
+        ),
+    )
+    .unwrap();
+    config
+}
+
+fn study(config: &Path, out: &Path) -> std::process::Output {
+    impactcal(&[
+        "study",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
+const STRIP: &str = "ensemble = 160\nsensors = 3\nshapes = 2\nsensitivity_samples = 64\n\
+                     reconcile_runs = 6\nnoise_runs = 3";
+
+#[test]
+fn a_killed_study_resumes_to_the_uninterrupted_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = strip_study(dir.path(), STRIP);
+    let whole = dir.path().join("whole");
+    let out = study(&config, &whole);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let killed = dir.path().join("killed");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impactcal"))
+        .args([
+            "study",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            killed.to_str().unwrap(),
+        ])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let ensemble = killed.join("journal/ensemble");
+    let count = || {
+        std::fs::read_dir(&ensemble).map_or(0, |d| {
+            d.filter_map(Result::ok)
+                .filter(|e| e.path().extension().is_some_and(|x| x == "run"))
+                .count()
+        })
+    };
+    let start = Instant::now();
+    while count() < 10 && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    let done = count();
+    assert!(
+        (10..160).contains(&done),
+        "killed after {done} of 160 ensemble runs"
+    );
+    assert!(!killed.join("study.json").exists());
+
+    let out = study(&config, &killed);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let a = std::fs::read_to_string(whole.join("study.json")).unwrap();
+    let b = std::fs::read_to_string(killed.join("study.json")).unwrap();
+    assert_eq!(a, b);
+    let r: serde_json::Value = serde_json::from_str(&a).unwrap();
+    for key in [
+        "n_runs",
+        "exceedance_fraction",
+        "intervals",
+        "verdict",
+        "probability_bound",
+    ] {
+        assert!(r["m1"].get(key).is_some(), "m1.{key}");
+    }
+    assert_eq!(r["m1"]["n_runs"], 160);
+    assert_eq!(r["sensors"]["selected"].as_array().unwrap().len(), 3);
+    assert_eq!(r["reconcile"]["runs"], 6);
+    assert!(r["reconcile"]["calibrated"]["thickness"].is_f64());
+    assert!(r["sensitivity"]["first_order"]["yield"].is_array());
+    for side in ["baseline", "calibrated"] {
+        assert!(r["m2"][side]["matched_above_0_9"].is_u64());
+        for key in ["rel_l2", "iso18571_r", "sprague_geers_c"] {
+            assert!(r["errors"][side].get(key).is_some(), "errors.{side}.{key}");
+        }
+    }
+    assert!(r["surrogate"]["loo_rel_error"].is_f64());
+}
+
+#[test]
+fn the_coarse_airframe_end_to_end_with_a_small_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let test = dir.path().join("test.csv");
+    let out = impactcal(&[
+        "simulate",
+        "--model",
+        "airframe",
+        "--end-time",
+        "0.01",
+        "--set",
+        "belly_panel.t=0.108",
+        "--out",
+        test.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let config = dir.path().join("study.toml");
+    std::fs::write(
+        &config,
+        "[model]\nairframe = \"coarse\"\nend_time = 0.01\n\n[space]\npreset = \"table2\"\n\n\
+         [test]\ndata = \"test.csv\"\ncfc = 60\n\n[study]\nensemble = 8\nsensors = 8\nshapes = 3\n\
+         sensitivity_samples = 32\nreconcile_runs = 2\nnoise_runs = 2\n",
+    )
+    .unwrap();
+    let out = study(&config, &dir.path().join("out"));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("out/study.json")).unwrap()).unwrap();
+    assert_eq!(r["channels"]["model"], 1215);
+    assert_eq!(r["m1"]["n_runs"], 8);
+    assert_eq!(r["reconcile"]["runs"], 2);
+    let before = r["errors"]["baseline"]["prediction_error"]
+        .as_f64()
+        .unwrap();
+    let after = r["errors"]["calibrated"]["prediction_error"]
+        .as_f64()
+        .unwrap();
+    assert!(after <= before, "{after} > {before}");
+    assert_eq!(r["sensitivity"]["ranking"].as_array().unwrap().len(), 6);
+}
+
+/// Runs `impactcal study` expecting bad input: exit 2, one line on stderr containing `what`.
+fn refused(config: &Path, out: &Path, what: &str) {
+    let o = study(config, out);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let last = err.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("impactcal: error:") && last.contains(what),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_input_exits_with_code_two_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let config = strip_study(
+        d,
+        "ensemble = 4\nsensors = 2\nshapes = 1\nreconcile_runs = 0\nnoise_runs = 2",
+    );
+    let text = std::fs::read_to_string(&config).unwrap();
+    let variant = |name: &str, from: &str, to: &str| -> PathBuf {
+        let p = d.join(name);
+        assert!(text.contains(from));
+        std::fs::write(&p, text.replacen(from, to, 1)).unwrap();
+        p
+    };
+    // An unknown model quantity: the near names are listed.
+    let c = variant("typo.toml", "\"section.1.t\"", "\"section.1.tt\"");
+    refused(&c, &d.join("o1"), "closest: `section.1.t`");
+    // Bounds outside what the model accepts (the deck's +-20 %).
+    std::fs::write(
+        d.join("bounds.csv"),
+        "name,lower,upper,nominal\nsection.1.t,0.001,0.003,0.002\n",
+    )
+    .unwrap();
+    let c = variant(
+        "bounds.toml",
+        "[test]",
+        "[space]\nbounds = \"bounds.csv\"\n\n[test]",
+    );
+    refused(&c, &d.join("o2"), "outside what the model accepts");
+    // A test with no channel in common with the model.
+    std::fs::write(d.join("other.csv"), "time,9.q\n0,1\n0.001,2\n0.002,3\n").unwrap();
+    let c = variant("other.toml", "\"test.csv\"", "\"other.csv\"");
+    refused(&c, &d.join("o3"), "no channel in common");
+    // A budget of 0.
+    let c = variant("zero.toml", "ensemble = 4", "ensemble = 0");
+    refused(&c, &d.join("o4"), "study.ensemble");
+    // More sensors than channels (6).
+    let c = variant("many.toml", "sensors = 2", "sensors = 7");
+    refused(&c, &d.join("o5"), "7 sensors");
+    // A malformed study file names its line.
+    let c = variant("syntax.toml", "ensemble = 4", "ensemble = four");
+    refused(&c, &d.join("o6"), "line");
+    // A folder holding another study's journal: nothing is overwritten.
+    let out = d.join("o7");
+    assert!(study(&config, &out).status.success());
+    let before = std::fs::read(out.join("study.json")).unwrap();
+    let c = variant("seed.toml", "ensemble = 4", "ensemble = 4\nseed = 9");
+    refused(&c, &out, "another study");
+    assert_eq!(std::fs::read(out.join("study.json")).unwrap(), before);
+}
