@@ -4,6 +4,7 @@
 //! function; this file only registers them. Numerical work happens in the library.
 
 mod airframe;
+mod batch;
 mod compare;
 mod convert;
 mod error;
@@ -71,6 +72,9 @@ enum Command {
     /// The built-in parametric helicopter airframe: write it as a keyword deck, list its
     /// adjustable quantities and presets, draw its parts.
     Airframe(airframe::Args),
+    /// Run a batch of parameter points through a solver (in process, a local process pool
+    /// or Slurm) from a TOML configuration; journaled, and resumed by running it again.
+    Batch(batch::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -89,6 +93,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Convert(a) => convert::run(a),
         Command::Filter(a) => filter::run(a),
         Command::Metrics(a) => metrics::run(a),
+        Command::Batch(a) => batch::run(a),
     }
 }
 
