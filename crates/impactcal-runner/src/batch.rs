@@ -303,8 +303,8 @@ impl<'a> Driver<'a> {
         };
         let mut pending = Vec::new();
         let mut slurm = BTreeMap::new();
-        for i in 0..n {
-            if let Some(file) = &done[i] {
+        for (i, finished) in done.iter().enumerate() {
+            if let Some(file) = finished {
                 if let Ok(h) = Histories::read_csv(batch.root.join(file)) {
                     let mut s = driver.lock_state();
                     s.results[i] = Some(Ok(h));

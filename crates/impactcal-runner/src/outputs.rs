@@ -265,6 +265,10 @@ fn fortran_number(s: &str) -> Option<f64> {
     format!("{mantissa}e{exponent}").parse().ok()
 }
 
+/// One output time of a `nodout` file: its header line, its time, and (node, x/y/z) in file
+/// order.
+type Step = (usize, f64, Vec<(u64, [f64; 3])>);
+
 /// Parses a `nodout` file into the chosen quantity of the chosen nodes. Errors carry the
 /// 1-based line.
 fn parse_nodout(
@@ -284,7 +288,7 @@ fn parse_nodout(
         NodalQuantity::Acceleration => 6,
     };
     // Per output time: its line, its time, and (node, xyz) in file order.
-    let mut steps: Vec<(usize, f64, Vec<(u64, [f64; 3])>)> = Vec::new();
+    let mut steps: Vec<Step> = Vec::new();
     let mut block = Block::None;
     let mut legend = false;
     for (i, line) in text.lines().enumerate() {
@@ -307,7 +311,7 @@ fn parse_nodout(
                     "a time-step header without a readable `at time`".to_string(),
                 ))?;
             // The rotation block repeats the header of the same time step.
-            if steps.last().is_none_or(|s| s.1 != time) {
+            if steps.last().is_none_or(|s| s.1.to_bits() != time.to_bits()) {
                 steps.push((n, time, Vec::new()));
             }
             block = Block::None;

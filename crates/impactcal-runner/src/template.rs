@@ -440,7 +440,10 @@ mod tests {
             .unwrap();
         let field = &text.lines().nth(1).unwrap()[..10];
         assert_eq!(field.len(), 10);
-        assert_eq!(field.trim().parse::<f64>().unwrap(), written[1]);
+        assert_eq!(
+            field.trim().parse::<f64>().unwrap().to_bits(),
+            written[1].to_bits()
+        );
         assert_eq!(field, "1.60997e-4");
     }
 
