@@ -58,6 +58,18 @@ impl ProcessOptions {
     }
 }
 
+/// The solver command of an executor that runs processes (the built-in solver runs in
+/// process only).
+fn argv<'d>(driver: &'d Driver<'_>) -> Result<&'d [String]> {
+    match &driver.batch.solver().command {
+        crate::solver::SolverCommand::Argv(argv) => Ok(argv),
+        crate::solver::SolverCommand::BuiltIn { .. } => Err(config(
+            "the processes and slurm executors run a solver command; the built-in solver runs \
+             in process only (executor kind = \"local\")",
+        )),
+    }
+}
+
 fn config(message: impl Into<String>) -> RunnerError {
     RunnerError::Config {
         file: "configuration".into(),

@@ -12,7 +12,6 @@ use std::time::{Duration, Instant};
 use crate::batch::{Driver, cancelled, start_ticks};
 use crate::error::{Result, RunnerError, run_io};
 use crate::journal::Entry;
-use crate::solver::SolverCommand;
 use crate::workdir::{STDERR, STDOUT};
 
 /// Runs `pending` on `jobs` worker threads, each starting one solver process at a time.
@@ -22,12 +21,7 @@ pub(crate) fn run(
     jobs: usize,
     timeout: Option<Duration>,
 ) -> Result<()> {
-    let SolverCommand::Argv(argv) = &driver.batch.solver().command else {
-        return Err(RunnerError::Config {
-            file: "configuration".into(),
-            message: "the processes and slurm executors run a solver command; the built-in solver runs in process only (executor kind = \"local\")".into(),
-        });
-    };
+    let argv = super::argv(driver)?;
     let queue = Mutex::new(pending.iter().copied().collect::<VecDeque<usize>>());
     let next = || {
         queue

@@ -24,7 +24,6 @@ use serde::{Deserialize, Serialize};
 use crate::batch::{Driver, InFlight, cancelled};
 use crate::error::{Result, RunnerError, io};
 use crate::journal::Entry;
-use crate::solver::SolverCommand;
 use crate::workdir::{self, read_exit_status, write_atomic};
 
 /// Options of the Slurm executor (the `[executor]` table with `kind = "slurm"`).
@@ -205,12 +204,7 @@ pub(crate) fn run(
     options: &SlurmOptions,
 ) -> Result<()> {
     options.check()?;
-    let SolverCommand::Argv(argv) = &driver.batch.solver().command else {
-        return Err(RunnerError::Config {
-            file: "configuration".into(),
-            message: "the slurm executor runs a solver command; the built-in solver runs in process only (executor kind = \"local\")".into(),
-        });
-    };
+    let argv = super::argv(driver)?;
     let mut watch: Vec<Task> = Vec::new();
     let mut todo: Vec<usize> = pending;
     // Re-attach: find the array job of each earlier submission (by id, or by job name when
