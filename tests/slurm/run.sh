@@ -147,8 +147,8 @@ def secs(s):
     m = re.match(r"(\d+)m([\d.]+)s", s); return int(m.group(1)) * 60 + float(m.group(2))
 # `times`: the shell's own user/sys, then its children's (the driver and what it ran).
 user, sys_ = (secs(x) for x in text[1].split())
-print(f"{n} tasks in {wall:.1f} s wall; driver CPU (user+sys, with its sbatch/squeue/cp "
-      f"children) {user + sys_:.2f} s = {1000 * (user + sys_) / n:.1f} ms per task")
+print(f"{n} tasks in {wall:.1f} s wall; driver CPU (user+sys, with the sbatch/squeue it ran) "
+      f"{user + sys_:.2f} s = {1000 * (user + sys_) / n:.1f} ms per task")
 PY
 fi
 echo "== slurm test passed"

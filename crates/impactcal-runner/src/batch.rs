@@ -114,6 +114,22 @@ impl Batch {
         })
     }
 
+    /// A batch over the parameters of `space` (points in its order and units), as a study
+    /// submits its ensemble: [`Batch::new`] with the space's names.
+    ///
+    /// # Errors
+    /// As [`Batch::new`].
+    pub fn for_space<'p>(
+        out: &Path,
+        study: &str,
+        solver: Solver,
+        space: &impactcal_core::ParameterSpace,
+        points: impl Into<PointRows<'p>>,
+    ) -> Result<Batch> {
+        let names = space.names().iter().map(|s| s.to_string()).collect();
+        Batch::new(out, study, solver, names, points)
+    }
+
     /// The same batch with at most `retries` further attempts per run.
     #[must_use]
     pub fn with_retries(mut self, retries: u32) -> Self {

@@ -10,7 +10,8 @@
 //! alone. Each run has its own directory `<out>/runs/<study>/<index>/`; the [`journal`]
 //! records every run before it starts and every result after it is read, so a batch
 //! interrupted at any moment (Ctrl-C, SIGKILL of the driver, a lost node) is resumed by
-//! running it again, with the same results.
+//! running it again, with the same results. [`SolverModel`] makes a solver an
+//! [`impactcal_core::Model`] for code written against that trait.
 //!
 //! ```
 //! use impactcal_runner::{Batch, Cancel, Executor, OutputSpec, Solver, SolverCommand, Template, run_batch};
@@ -40,6 +41,7 @@ pub mod config;
 pub mod error;
 pub mod executor;
 pub mod journal;
+pub mod model;
 pub mod outputs;
 pub mod solver;
 pub mod template;
@@ -49,6 +51,7 @@ pub use batch::{Batch, BatchReport, Cancel};
 pub use config::BatchConfig;
 pub use error::{Result, RunnerError};
 pub use executor::{Executor, ProcessOptions, SlurmOptions, run_batch};
+pub use model::SolverModel;
 pub use outputs::{NodalQuantity, OutputFormat, OutputSpec};
 pub use solver::{Solver, SolverCommand};
 pub use template::Template;
