@@ -13,6 +13,7 @@
 //! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) | core, erbf |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe | core |
 //! | [`calibrate`] | `impactcal-calibrate` | curve metrics (Sprague-Geers, Russell, ISO/TS 18571) of a model against a test | core |
+//! | [`runner`] | `impactcal-runner` | where runs happen: in process, a local process pool, a Slurm cluster; external solvers through deck templates; work directories and a run journal | core, shell |
 //!
 //! The calibration path runs through them in this order: histories of an ensemble
 //! ([`core`], [`shell`]) give impact shapes ([`shapes`]), which place sensors ([`sensors`]);
@@ -38,6 +39,7 @@ pub use impactcal_calibrate as calibrate;
 pub use impactcal_core as core;
 pub use impactcal_cors as cors;
 pub use impactcal_erbf as erbf;
+pub use impactcal_runner as runner;
 pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
 pub use impactcal_shell as shell;
@@ -49,6 +51,7 @@ use impactcal_calibrate::CalibrateError;
 use impactcal_core::CoreError;
 use impactcal_cors::CorsError;
 use impactcal_erbf::ErbfError;
+use impactcal_runner::RunnerError;
 use impactcal_sensors::SensorsError;
 use impactcal_shapes::ShapesError;
 use impactcal_shell::ShellError;
@@ -84,6 +87,9 @@ pub enum Error {
     /// From `impactcal-calibrate`.
     #[error(transparent)]
     Calibrate(#[from] CalibrateError),
+    /// From `impactcal-runner`: solver runs, executors, the run journal.
+    #[error(transparent)]
+    Runner(#[from] RunnerError),
 }
 
 impl Error {
@@ -100,6 +106,7 @@ impl Error {
             Error::Cors(e) => e.kind(),
             Error::Shell(e) => shell_kind(e),
             Error::Calibrate(e) => e.kind(),
+            Error::Runner(e) => e.kind(),
         }
     }
 }

@@ -179,13 +179,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let json = serde_json::to_string_pretty(&summary)
         .map_err(|e| CliError::failure(format!("cannot encode the summary: {e}")))?;
     write_text(&(json + "\n"), Some(&args.out.join("demo.json")))?;
+    let files = crate::study::write_report(&doc, &args.out)?;
     for line in &doc.lead {
         eprintln!("{line}");
     }
     eprintln!(
-        "impactcal: demo finished in {:.0} s; wrote {}",
+        "impactcal: demo finished in {:.0} s; wrote {} and {}",
         summary.wall_time_s,
-        args.out.join("demo.json").display()
+        args.out.join("demo.json").display(),
+        files.html.display()
     );
     Ok(())
 }

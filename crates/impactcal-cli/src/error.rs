@@ -102,7 +102,8 @@ from_library_error!(
     impactcal::sobol::SobolError,
     impactcal::cors::CorsError,
     impactcal::shell::ShellError,
-    impactcal::calibrate::CalibrateError
+    impactcal::calibrate::CalibrateError,
+    impactcal::runner::RunnerError
 );
 
 #[cfg(test)]

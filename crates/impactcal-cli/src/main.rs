@@ -4,6 +4,7 @@
 //! function; this file only registers them. Numerical work happens in the library.
 
 mod airframe;
+mod batch;
 mod compare;
 mod convert;
 mod demo;
@@ -79,6 +80,9 @@ enum Command {
     /// The source paper's study on the coarse airframe against a test with hidden changes:
     /// Table 1 screened by M1, Table 2 studied and reconciled, the changes revealed.
     Demo(demo::Args),
+    /// Run a batch of parameter points through a solver (in process, a local process pool
+    /// or Slurm) from a TOML configuration; journaled, and resumed by running it again.
+    Batch(batch::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -99,6 +103,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Metrics(a) => metrics::run(a),
         Command::Study(a) => study::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::Batch(a) => batch::run(a),
     }
 }
 

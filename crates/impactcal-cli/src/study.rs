@@ -31,7 +31,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use clap::Args as ClapArgs;
-use impactcal::calibrate::report::Report;
+use impactcal::calibrate::report::{Report, ReportFiles};
 use impactcal::calibrate::study::document::{Geometry, report};
 use impactcal::calibrate::study::journal::fingerprint;
 use impactcal::calibrate::study::{
@@ -165,17 +165,28 @@ pub fn run(args: Args) -> Result<(), CliError> {
     finish(&result, &setup, &args.out)
 }
 
-/// Writes `study.json` and prints the verdicts.
+/// Writes `study.json`, the report (`report.html`, `report.md` and its SVG figures) and
+/// prints the verdicts.
 pub fn finish(result: &StudyResult, setup: &Setup, out: &Path) -> Result<(), CliError> {
     let json = serde_json::to_string_pretty(result)
         .map_err(|e| CliError::failure(format!("cannot encode the study: {e}")))?;
     write_text(&(json + "\n"), Some(&out.join("study.json")))?;
     let doc = study_report(result, setup);
+    let files = write_report(&doc, out)?;
     for line in &doc.lead {
         eprintln!("{line}");
     }
-    eprintln!("wrote {}", out.join("study.json").display());
+    eprintln!(
+        "wrote {} and {}",
+        out.join("study.json").display(),
+        files.html.display()
+    );
     Ok(())
+}
+
+/// Renders `doc` into `out` (`report.html`, `report.md`, one SVG file per figure).
+pub fn write_report(doc: &Report, out: &Path) -> Result<ReportFiles, CliError> {
+    Ok(impactcal::calibrate::report::write(doc, out)?)
 }
 
 /// The report document of a study (rendered to `report.html` and `report.md`).

@@ -180,6 +180,22 @@ fn the_coarse_airframe_end_to_end_with_a_small_budget() {
         .unwrap();
     assert!(after <= before, "{after} > {before}");
     assert_eq!(r["sensitivity"]["ranking"].as_array().unwrap().len(), 6);
+    // The report: one self-contained HTML file with every figure inline, and Markdown
+    // linking one SVG file per figure.
+    let out = dir.path().join("out");
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let markdown = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let svgs: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".svg"))
+        .collect();
+    assert!(svgs.len() >= 6, "{svgs:?}");
+    assert_eq!(html.matches("<svg").count(), svgs.len());
+    for svg in &svgs {
+        assert!(markdown.contains(svg.as_str()), "{svg} not linked");
+    }
+    assert!(!html.contains("<script"));
 }
 
 /// Runs `impactcal study` expecting bad input: exit 2, one line on stderr containing `what`.

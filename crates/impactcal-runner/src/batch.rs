@@ -1,0 +1,636 @@
+//! A batch of runs: its points, work directories, journal, and the driver that every
+//! executor shares (prepare a run, record it, read its result, decide on a retry, resume).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use impactcal_core::{Histories, PointRows};
+
+use crate::error::{Result, RunnerError, io, run_io};
+use crate::journal::{Entry, Journal};
+use crate::solver::Solver;
+use crate::template::{Template, check_names};
+use crate::workdir::{self, RunRecord, now, read_exit_status, run_dir, write_atomic};
+
+/// A request to stop, shared between a signal handler and the driver: the executors stop
+/// starting runs, kill their local processes or `scancel` their Slurm jobs, and return
+/// [`RunnerError::Cancelled`]. The journal keeps everything done so far.
+#[derive(Debug, Clone, Default)]
+pub struct Cancel(Arc<AtomicBool>);
+
+impl Cancel {
+    /// A token not cancelled yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// Asks the batch to stop (callable from a signal handler: it only sets a flag).
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::SeqCst);
+    }
+    /// Whether a stop was asked for.
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::SeqCst)
+    }
+}
+
+/// A batch of solver runs: one per point, in `<out>/runs/<study>/<index>/`, with the
+/// journal `<out>/runs/<study>/journal.jsonl`.
+#[derive(Debug, Clone)]
+pub struct Batch {
+    study: String,
+    root: PathBuf,
+    solver: Solver,
+    names: Vec<String>,
+    points: Vec<Vec<f64>>,
+    retries: u32,
+}
+
+impl Batch {
+    /// A batch of `points` (one per row; coordinates in the order of `names`) run by
+    /// `solver` under `out`. `study` names the batch's directory (letters, digits, `_`, `-`,
+    /// `.`). Retries default to 2 (three attempts in all for a run that fails in a way that
+    /// another attempt may cure: a solver failure, a timeout, bad output, a lost task).
+    ///
+    /// # Errors
+    /// [`RunnerError::Config`] for a bad study name or solver; [`RunnerError::Names`] when
+    /// a name is not a plain identifier or names and templates do not match;
+    /// [`impactcal_core::CoreError`] for no points, a point of the wrong length or a
+    /// non-finite coordinate (naming the point).
+    pub fn new<'p>(
+        out: &Path,
+        study: &str,
+        solver: Solver,
+        names: Vec<String>,
+        points: impl Into<PointRows<'p>>,
+    ) -> Result<Batch> {
+        let study_ok = !study.is_empty()
+            && study != "."
+            && study != ".."
+            && study
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'));
+        if !study_ok {
+            return Err(RunnerError::Config {
+                file: "configuration".into(),
+                message: format!(
+                    "study name `{study}` must be letters, digits, `_`, `-` or `.` only"
+                ),
+            });
+        }
+        solver.check("configuration")?;
+        let templates: Vec<&Template> = solver.inputs.iter().map(|(t, _)| t).collect();
+        check_names(&templates, &names)?;
+        let points = points.into();
+        if points.is_empty() {
+            return Err(impactcal_core::CoreError::Empty {
+                what: "batch (no points)".into(),
+            }
+            .into());
+        }
+        let mut rows = Vec::with_capacity(points.len());
+        for i in 0..points.len() {
+            let p = points.point(i).into_owned();
+            if p.len() != names.len() {
+                return Err(impactcal_core::CoreError::DimensionMismatch {
+                    what: format!("coordinates of point {i}"),
+                    expected: names.len(),
+                    found: p.len(),
+                }
+                .into());
+            }
+            impactcal_core::check_finite(&format!("point {i}"), &p)?;
+            rows.push(p);
+        }
+        Ok(Batch {
+            study: study.to_string(),
+            root: out.join("runs").join(study),
+            solver,
+            names,
+            points: rows,
+            retries: 2,
+        })
+    }
+
+    /// A batch over the parameters of `space` (points in its order and units), as a study
+    /// submits its ensemble: [`Batch::new`] with the space's names.
+    ///
+    /// # Errors
+    /// As [`Batch::new`].
+    pub fn for_space<'p>(
+        out: &Path,
+        study: &str,
+        solver: Solver,
+        space: &impactcal_core::ParameterSpace,
+        points: impl Into<PointRows<'p>>,
+    ) -> Result<Batch> {
+        let names = space.names().iter().map(|s| s.to_string()).collect();
+        Batch::new(out, study, solver, names, points)
+    }
+
+    /// The same batch with at most `retries` further attempts per run.
+    #[must_use]
+    pub fn with_retries(mut self, retries: u32) -> Self {
+        self.retries = retries;
+        self
+    }
+
+    /// `<out>/runs/<study>`: the runs' directories and the journal.
+    pub fn root(&self) -> &Path {
+        &self.root
+    }
+
+    /// The journal's path.
+    pub fn journal_path(&self) -> PathBuf {
+        self.root.join("journal.jsonl")
+    }
+
+    /// Number of runs.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Whether the batch has no run (never: [`Batch::new`] refuses that).
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// The solver.
+    pub fn solver(&self) -> &Solver {
+        &self.solver
+    }
+
+    /// The study name.
+    pub fn study(&self) -> &str {
+        &self.study
+    }
+}
+
+/// The outcome of a batch: one entry per point, in input order.
+#[derive(Debug)]
+pub struct BatchReport {
+    /// `runs[i]`: the histories of run `i`, or why it failed (naming the run and the file).
+    pub runs: Vec<Result<Histories, RunnerError>>,
+    /// `reused[i]`: the result was found finished in the journal (a resumed batch).
+    pub reused: Vec<bool>,
+    /// `attempts[i]`: the number of the attempt that gave the outcome (1-based, counted
+    /// over every session of the batch).
+    pub attempts: Vec<u32>,
+}
+
+impl BatchReport {
+    /// The failed runs.
+    pub fn failures(&self) -> impl Iterator<Item = (usize, &RunnerError)> {
+        self.runs
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| r.as_ref().err().map(|e| (i, e)))
+    }
+}
+
+/// What the journal says of one run when a batch is opened.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct InFlight {
+    /// The attempt in flight.
+    pub attempt: u32,
+    /// A local process: pid and start ticks.
+    pub process: Option<(u32, u64)>,
+    /// A Slurm array: its token (job name), job id once known, and the task.
+    pub slurm: Option<(String, Option<String>, usize)>,
+}
+
+#[derive(Debug)]
+struct State {
+    results: Vec<Option<Result<Histories, RunnerError>>>,
+    reused: Vec<bool>,
+    last_attempt: Vec<u32>,
+    session_attempts: Vec<u32>,
+}
+
+/// The part of running a batch that every executor shares.
+pub(crate) struct Driver<'a> {
+    pub batch: &'a Batch,
+    pub cancel: &'a Cancel,
+    pub executor: &'static str,
+    journal: Mutex<Journal>,
+    state: Mutex<State>,
+}
+
+impl<'a> Driver<'a> {
+    /// Opens the batch's journal, checks it belongs to this batch (writing the batch line
+    /// when new), reuses finished runs, stops orphaned local solver processes, collects runs
+    /// that ended while no driver watched, and returns the runs still to do and the Slurm
+    /// tasks that may still be queued or running.
+    pub fn open(
+        batch: &'a Batch,
+        cancel: &'a Cancel,
+        executor: &'static str,
+    ) -> Result<(Driver<'a>, Vec<usize>, BTreeMap<usize, InFlight>)> {
+        std::fs::create_dir_all(&batch.root).map_err(io(&batch.root))?;
+        let path = batch.journal_path();
+        let (mut journal, entries) = Journal::open(&path)?;
+        let header = Entry::Batch {
+            study: batch.study.clone(),
+            names: batch.names.clone(),
+            points: batch.points.clone(),
+            solver: batch.solver.fingerprint(),
+        };
+        match entries.first() {
+            None => journal.append(&header)?,
+            Some(first) if *first == header => {}
+            Some(_) => {
+                return Err(RunnerError::Journal {
+                    path,
+                    line: 1,
+                    message:
+                        "the journal belongs to a different batch (other points, names or solver); \
+                              use another output directory or study name"
+                            .into(),
+                });
+            }
+        }
+        let n = batch.len();
+        let mut done: Vec<Option<String>> = vec![None; n];
+        let mut last_attempt = vec![0u32; n];
+        let mut flight: BTreeMap<usize, InFlight> = BTreeMap::new();
+        let mut tokens: BTreeMap<String, Option<String>> = BTreeMap::new();
+        for e in &entries {
+            match e {
+                Entry::Submit { index, attempt, .. } if *index < n => {
+                    last_attempt[*index] = last_attempt[*index].max(*attempt);
+                    done[*index] = None;
+                    flight.insert(
+                        *index,
+                        InFlight {
+                            attempt: *attempt,
+                            ..InFlight::default()
+                        },
+                    );
+                }
+                Entry::Started {
+                    index,
+                    attempt,
+                    pid,
+                    start_ticks,
+                } => {
+                    if let Some(f) = flight.get_mut(index).filter(|f| f.attempt == *attempt) {
+                        f.process = Some((*pid, *start_ticks));
+                    }
+                }
+                Entry::SlurmSubmit { token, indices } => {
+                    tokens.insert(token.clone(), None);
+                    for (k, i) in indices.iter().enumerate() {
+                        if let Some(f) = flight.get_mut(i) {
+                            f.slurm = Some((token.clone(), None, k));
+                        }
+                    }
+                }
+                Entry::SlurmJob { token, job_id } => {
+                    tokens.insert(token.clone(), Some(job_id.clone()));
+                }
+                Entry::Result { index, file, .. } if *index < n => {
+                    flight.remove(index);
+                    done[*index] = Some(file.clone());
+                }
+                Entry::Failure { index, .. } => {
+                    flight.remove(index);
+                }
+                _ => {}
+            }
+        }
+        for f in flight.values_mut() {
+            if let Some((token, job, _)) = &mut f.slurm {
+                *job = tokens.get(token).cloned().flatten();
+            }
+        }
+        let driver = Driver {
+            batch,
+            cancel,
+            executor,
+            journal: Mutex::new(journal),
+            state: Mutex::new(State {
+                results: (0..n).map(|_| None).collect(),
+                reused: vec![false; n],
+                last_attempt,
+                session_attempts: vec![0; n],
+            }),
+        };
+        let mut pending = Vec::new();
+        let mut slurm = BTreeMap::new();
+        for (i, finished) in done.iter().enumerate() {
+            if let Some(file) = finished {
+                if let Ok(h) = Histories::read_csv(batch.root.join(file)) {
+                    let mut s = driver.lock_state();
+                    s.results[i] = Some(Ok(h));
+                    s.reused[i] = true;
+                    continue;
+                }
+            }
+            match flight.remove(&i) {
+                Some(f) if f.slurm.is_some() => {
+                    slurm.insert(i, f);
+                }
+                Some(f) => {
+                    if let Some((pid, ticks)) = f.process {
+                        stop_orphan(pid, ticks);
+                    }
+                    // Ended while no driver watched: its exit status is on disk.
+                    if read_exit_status(&run_dir(&batch.root, i)).is_some() {
+                        let outcome = driver.collect(i, f.attempt);
+                        if !driver.settle(i, f.attempt, outcome)? {
+                            let mut s = driver.lock_state();
+                            s.reused[i] = true;
+                            continue;
+                        }
+                    }
+                    pending.push(i);
+                }
+                None => pending.push(i),
+            }
+        }
+        Ok((driver, pending, slurm))
+    }
+
+    fn lock_state(&self) -> std::sync::MutexGuard<'_, State> {
+        self.state
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// Appends to the journal.
+    pub fn record(&self, entry: &Entry) -> Result<()> {
+        self.journal
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .append(entry)
+    }
+
+    /// The directory of run `index`.
+    pub fn dir(&self, index: usize) -> PathBuf {
+        run_dir(&self.batch.root, index)
+    }
+
+    /// Takes the next attempt number of run `index`, writes its inputs into a clean work
+    /// directory with `params.json`, and returns the attempt. A per-run failure (a directory
+    /// that cannot be created, a value that does not fit) is returned as `Ok(Err(..))`.
+    pub fn prepare(&self, index: usize) -> Result<(u32, Result<PathBuf>)> {
+        let attempt = {
+            let mut s = self.lock_state();
+            s.last_attempt[index] += 1;
+            s.session_attempts[index] += 1;
+            s.last_attempt[index]
+        };
+        Ok((attempt, self.write_inputs(index, attempt)))
+    }
+
+    fn write_inputs(&self, index: usize, attempt: u32) -> Result<PathBuf> {
+        let dir = self.dir(index);
+        std::fs::create_dir_all(&dir).map_err(run_io(index, &dir))?;
+        let output = self.batch.solver.output.file.clone();
+        for stale in [
+            workdir::EXIT_STATUS,
+            workdir::RESULT,
+            workdir::STDOUT,
+            workdir::STDERR,
+            output.as_str(),
+        ] {
+            let p = dir.join(stale);
+            match std::fs::remove_file(&p) {
+                Ok(()) => {}
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) => return Err(run_io(index, p)(e)),
+            }
+        }
+        let values = &self.batch.points[index];
+        let mut written = values.clone();
+        for (template, name) in &self.batch.solver.inputs {
+            let (text, w) = template.render(index, &self.batch.names, values)?;
+            for (k, v) in w.iter().enumerate() {
+                if v.to_bits() != values[k].to_bits() {
+                    written[k] = *v;
+                }
+            }
+            let p = dir.join(name);
+            write_atomic(&p, text.as_bytes()).map_err(run_io(index, p))?;
+        }
+        let record = RunRecord {
+            index,
+            attempt,
+            names: self.batch.names.clone(),
+            values: values.clone(),
+            written,
+            prepared_at: now(),
+            finished_at: None,
+            seconds: None,
+            exit_status: None,
+        };
+        self.write_record(index, &record)?;
+        Ok(dir)
+    }
+
+    fn write_record(&self, index: usize, record: &RunRecord) -> Result<()> {
+        let p = self.dir(index).join(workdir::PARAMS);
+        let text = serde_json::to_string_pretty(record).map_err(|e| RunnerError::RunIo {
+            run: index,
+            path: p.clone(),
+            source: std::io::Error::other(e),
+        })?;
+        write_atomic(&p, text.as_bytes()).map_err(run_io(index, p))
+    }
+
+    /// Reads the result of run `index` from its directory: the exit status, then the
+    /// output; writes `result.csv` atomically and completes `params.json`.
+    pub fn collect(&self, index: usize, attempt: u32) -> Result<Histories> {
+        let dir = self.dir(index);
+        let Some(status) = read_exit_status(&dir) else {
+            return Err(RunnerError::Output {
+                run: index,
+                path: dir.join(workdir::EXIT_STATUS),
+                message: "no exit status: the solver did not finish".into(),
+            });
+        };
+        let p = dir.join(workdir::PARAMS);
+        let record: Option<RunRecord> = std::fs::read_to_string(&p)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok());
+        let outcome = if status == 0 {
+            self.batch.solver.output.read(index, &dir)
+        } else {
+            Err(RunnerError::SolverExit {
+                run: index,
+                status: describe_status(status),
+                stderr: dir.join(workdir::STDERR),
+            })
+        };
+        if let Ok(h) = &outcome {
+            let mut text = Vec::new();
+            h.write_csv_to(&mut text, workdir::RESULT)?;
+            let r = dir.join(workdir::RESULT);
+            write_atomic(&r, &text).map_err(run_io(index, r))?;
+        }
+        if let Some(mut record) = record.filter(|r| r.attempt == attempt) {
+            let t = now();
+            record.finished_at = Some(t);
+            record.seconds = Some(t - record.prepared_at);
+            record.exit_status = Some(status);
+            self.write_record(index, &record)?;
+        }
+        outcome
+    }
+
+    /// Records the outcome of an attempt and says whether to try again: a result is
+    /// journaled and kept; a failure is retried when another attempt may help and the
+    /// run's attempts in this session are within the limit, and kept otherwise. Journal
+    /// failures are returned as errors (the batch cannot go on without its record).
+    pub fn settle(&self, index: usize, attempt: u32, outcome: Result<Histories>) -> Result<bool> {
+        match outcome {
+            Ok(h) => {
+                self.record(&Entry::Result {
+                    index,
+                    attempt,
+                    file: format!("{index}/{}", workdir::RESULT),
+                })?;
+                self.lock_state().results[index] = Some(Ok(h));
+                Ok(false)
+            }
+            Err(e) => {
+                let retry = e.retryable()
+                    && self.lock_state().session_attempts[index] <= self.batch.retries;
+                self.record(&Entry::Failure {
+                    index,
+                    attempt,
+                    error: e.to_string(),
+                    retry,
+                })?;
+                if !retry {
+                    self.lock_state().results[index] = Some(Err(e));
+                }
+                Ok(retry)
+            }
+        }
+    }
+
+    /// Runs `index` to its outcome with `execute` (which starts the solver in the prepared
+    /// directory and returns its exit status), retrying as [`settle`](Self::settle) says.
+    pub fn drive(
+        &self,
+        index: usize,
+        execute: impl Fn(&Self, usize, u32, &Path) -> Result<i32>,
+    ) -> Result<()> {
+        loop {
+            if self.cancel.is_cancelled() {
+                return Err(cancelled("no new run started"));
+            }
+            let (attempt, dir) = self.prepare(index)?;
+            let outcome = match dir {
+                Err(e) => Err(e),
+                Ok(dir) => {
+                    self.record(&Entry::Submit {
+                        index,
+                        attempt,
+                        executor: self.executor.into(),
+                    })?;
+                    match execute(self, index, attempt, &dir) {
+                        Err(e @ RunnerError::Cancelled { .. }) => return Err(e),
+                        Err(e) => Err(e),
+                        Ok(status) => {
+                            let p = dir.join(workdir::EXIT_STATUS);
+                            write_atomic(&p, format!("{status}\n").as_bytes())
+                                .map_err(run_io(index, p))?;
+                            self.collect(index, attempt)
+                        }
+                    }
+                }
+            };
+            if !self.settle(index, attempt, outcome)? {
+                return Ok(());
+            }
+        }
+    }
+
+    /// The report, in input order.
+    pub fn finish(self) -> BatchReport {
+        let s = self
+            .state
+            .into_inner()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let runs = s
+            .results
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| {
+                r.unwrap_or_else(|| {
+                    Err(RunnerError::Output {
+                        run: i,
+                        path: run_dir(&self.batch.root, i),
+                        message: "the run did not finish".into(),
+                    })
+                })
+            })
+            .collect();
+        BatchReport {
+            runs,
+            reused: s.reused,
+            attempts: s.last_attempt,
+        }
+    }
+}
+
+/// A [`RunnerError::Cancelled`].
+pub(crate) fn cancelled(message: &str) -> RunnerError {
+    RunnerError::Cancelled {
+        message: format!("{message}; run the same command again to resume"),
+    }
+}
+
+/// `exit 3`, or `signal 9` for statuses above 128 (the shell's convention).
+pub(crate) fn describe_status(status: i32) -> String {
+    if status > 128 && status < 160 {
+        format!("signal {} (status {status})", status - 128)
+    } else {
+        format!("status {status}")
+    }
+}
+
+/// Stops a solver process left running by a driver that was killed: only if the pid
+/// still belongs to the process that was started (same start time), so a reused pid is
+/// never touched. Waits until it has exited (or is a zombie).
+fn stop_orphan(pid: u32, start_ticks: u64) {
+    let alive = |pid: u32| -> Option<(char, u64)> {
+        let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+        let rest = &stat[stat.rfind(')')? + 1..];
+        let fields: Vec<&str> = rest.split_whitespace().collect();
+        let state = fields.first()?.chars().next()?;
+        let ticks = fields.get(19)?.parse().ok()?;
+        Some((state, ticks))
+    };
+    match alive(pid) {
+        Some((state, ticks)) if ticks == start_ticks && state != 'Z' => {}
+        _ => return,
+    }
+    let _ = std::process::Command::new("kill")
+        .args(["-KILL", &pid.to_string()])
+        .status();
+    for _ in 0..200 {
+        match alive(pid) {
+            Some((state, ticks)) if ticks == start_ticks && state != 'Z' => {
+                std::thread::sleep(std::time::Duration::from_millis(10));
+            }
+            _ => return,
+        }
+    }
+}
+
+/// The start time of process `pid` in clock ticks since boot (field 22 of
+/// `/proc/<pid>/stat`), or 0 when unknown.
+pub(crate) fn start_ticks(pid: u32) -> u64 {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .ok()
+        .and_then(|stat| {
+            let rest = &stat[stat.rfind(')')? + 1..];
+            rest.split_whitespace().nth(19)?.parse().ok()
+        })
+        .unwrap_or(0)
+}

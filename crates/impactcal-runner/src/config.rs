@@ -1,0 +1,276 @@
+//! The batch configuration file (TOML): the solver, the executor and the batch's name.
+//!
+//! ```toml
+//! [batch]
+//! study = "strip"          # runs go to <out>/runs/strip/<index>/
+//! retries = 2              # further attempts of a run that fails (default 2)
+//!
+//! [solver]
+//! template = "strip.k"     # the deck template, relative to this file
+//! deck = "deck.k"          # its name in each run's directory (default: the template's)
+//! inputs = []              # further templated text inputs, written under their own names
+//! # The solver command, run without a shell in the run's directory. Absent: the built-in
+//! # solver (in process for kind = "local", else `impactcal simulate --deck <deck> --out
+//! # <output>`).
+//! command = ["impactcal", "simulate", "--deck", "deck.k", "--out", "out.csv"]
+//! quantity = "velocity"    # built-in solver: the nodal quantity written
+//!
+//! [solver.output]
+//! format = "csv"           # "csv" | "nodout" | "user-csv"
+//! file = "out.csv"
+//!
+//! [executor]
+//! kind = "processes"       # "local" | "processes" | "slurm"
+//! jobs = 4
+//! timeout = 600
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use impactcal_shell::Quantity;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, RunnerError, io};
+use crate::executor::{Executor, ProcessOptions, SlurmOptions};
+use crate::outputs::{NodalQuantity, OutputSpec};
+use crate::solver::{Solver, SolverCommand};
+use crate::template::Template;
+
+/// The `[batch]` table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BatchSection {
+    /// The study name (the runs' directory under `<out>/runs/`).
+    #[serde(default = "default_study")]
+    pub study: String,
+    /// Further attempts per failing run.
+    #[serde(default = "default_retries")]
+    pub retries: u32,
+}
+
+fn default_study() -> String {
+    "batch".into()
+}
+
+fn default_retries() -> u32 {
+    2
+}
+
+impl Default for BatchSection {
+    fn default() -> Self {
+        BatchSection {
+            study: default_study(),
+            retries: default_retries(),
+        }
+    }
+}
+
+/// The `[solver]` table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSection {
+    /// The deck template, relative to the configuration file.
+    pub template: PathBuf,
+    /// The deck's name in a run's directory (default: the template's file name).
+    #[serde(default)]
+    pub deck: Option<String>,
+    /// Further templated inputs, relative to the configuration file.
+    #[serde(default)]
+    pub inputs: Vec<PathBuf>,
+    /// The command (argv); absent for the built-in solver.
+    #[serde(default)]
+    pub command: Option<Vec<String>>,
+    /// The built-in solver's nodal quantity.
+    #[serde(default)]
+    pub quantity: NodalQuantity,
+    /// The output.
+    #[serde(default = "default_output")]
+    pub output: OutputSpec,
+}
+
+fn default_output() -> OutputSpec {
+    OutputSpec::csv("out.csv")
+}
+
+/// The `[executor]` table, by `kind`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum ExecutorSection {
+    /// In process.
+    Local,
+    /// A local process pool.
+    Processes(ProcessOptions),
+    /// Slurm.
+    Slurm(SlurmOptions),
+}
+
+/// A batch configuration file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BatchConfig {
+    /// `[batch]`.
+    #[serde(default)]
+    pub batch: BatchSection,
+    /// `[solver]`.
+    pub solver: SolverSection,
+    /// `[executor]`.
+    pub executor: ExecutorSection,
+    /// The file it was read from (paths are relative to its directory).
+    #[serde(skip)]
+    pub source: PathBuf,
+}
+
+impl BatchConfig {
+    /// Reads a configuration file.
+    ///
+    /// # Errors
+    /// [`RunnerError::Io`] when it cannot be read; [`RunnerError::Config`] naming the file,
+    /// line and column of a TOML or schema fault (an unknown key, a wrong type).
+    pub fn read(path: &Path) -> Result<BatchConfig> {
+        let text = std::fs::read_to_string(path).map_err(io(path))?;
+        let mut c = BatchConfig::parse(&text, &path.display().to_string())?;
+        c.source = path.to_path_buf();
+        Ok(c)
+    }
+
+    /// Parses configuration text; `name` names it in messages.
+    ///
+    /// # Errors
+    /// As [`BatchConfig::read`].
+    pub fn parse(text: &str, name: &str) -> Result<BatchConfig> {
+        toml::from_str(text).map_err(|e| {
+            let place = e
+                .span()
+                .map(|s| {
+                    let line = text[..s.start].matches('\n').count() + 1;
+                    let col = s.start - text[..s.start].rfind('\n').map_or(0, |p| p + 1) + 1;
+                    format!("line {line}, column {col}: ")
+                })
+                .unwrap_or_default();
+            RunnerError::Config {
+                file: name.to_string(),
+                message: format!("{place}{}", e.message()),
+            }
+        })
+    }
+
+    fn base(&self) -> PathBuf {
+        self.source
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default()
+    }
+
+    /// The executor.
+    pub fn executor(&self) -> Executor {
+        match &self.executor {
+            ExecutorSection::Local => Executor::Local,
+            ExecutorSection::Processes(p) => Executor::Processes(p.clone()),
+            ExecutorSection::Slurm(s) => Executor::Slurm(s.clone()),
+        }
+    }
+
+    /// The solver: the templates read, the command resolved. Without a `command`, the
+    /// local executor runs the built-in solver in process and the others run
+    /// `<impactcal> simulate --deck <deck> --out <output> --quantity <q>`, `impactcal` being
+    /// the program given (the running `impactcal` binary).
+    ///
+    /// # Errors
+    /// [`RunnerError::Io`] / [`RunnerError::Template`] for a template that cannot be read
+    /// or parsed; [`RunnerError::Config`] when the built-in solver is asked of another
+    /// executor and no program is given.
+    pub fn solver(&self, impactcal: Option<&Path>) -> Result<Solver> {
+        let s = &self.solver;
+        let base = self.base();
+        let template_path = base.join(&s.template);
+        let deck = match &s.deck {
+            Some(d) => d.clone(),
+            None => s
+                .template
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "deck.k".into()),
+        };
+        let mut inputs = vec![(Template::read(&template_path)?, deck.clone())];
+        for p in &s.inputs {
+            let name = p
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            inputs.push((Template::read(&base.join(p))?, name));
+        }
+        let quantity = match s.quantity {
+            NodalQuantity::Displacement => Quantity::Displacement,
+            NodalQuantity::Velocity => Quantity::Velocity,
+            NodalQuantity::Acceleration => Quantity::Acceleration,
+        };
+        let command = match (&s.command, &self.executor) {
+            (Some(argv), _) => SolverCommand::Argv(argv.clone()),
+            (None, ExecutorSection::Local) => SolverCommand::BuiltIn { quantity },
+            (None, _) => {
+                let Some(exe) = impactcal else {
+                    return Err(RunnerError::Config {
+                        file: self.source.display().to_string(),
+                        message: "solver.command is required for this executor".into(),
+                    });
+                };
+                let q = match s.quantity {
+                    NodalQuantity::Displacement => "displacement",
+                    NodalQuantity::Velocity => "velocity",
+                    NodalQuantity::Acceleration => "acceleration",
+                };
+                SolverCommand::Argv(vec![
+                    exe.display().to_string(),
+                    "simulate".into(),
+                    "--deck".into(),
+                    deck,
+                    "--out".into(),
+                    s.output.file.clone(),
+                    "--quantity".into(),
+                    q.into(),
+                ])
+            }
+        };
+        let solver = Solver {
+            inputs,
+            command,
+            output: s.output.clone(),
+        };
+        solver.check(&self.source.display().to_string())?;
+        Ok(solver)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn config_parses_and_names_faults() {
+        let c = BatchConfig::parse(
+            "[solver]\ntemplate = \"d.k\"\n[executor]\nkind = \"slurm\"\npartition = \"debug\"\nmax_running = 4\n",
+            "b.toml",
+        )
+        .unwrap();
+        assert_eq!(c.batch, BatchSection::default());
+        let ExecutorSection::Slurm(s) = &c.executor else {
+            panic!("{:?}", c.executor)
+        };
+        assert_eq!(s.partition.as_deref(), Some("debug"));
+        assert_eq!(s.max_running, Some(4));
+        assert_eq!(s.max_array, 1000);
+        let e = BatchConfig::parse(
+            "[solver]\ntemplate = \"d.k\"\n[executor]\nkind = \"processes\"\njobs = 2\ntimeuot = 3\n",
+            "b.toml",
+        )
+        .unwrap_err();
+        assert!(e.to_string().starts_with("b.toml: line "), "{e}");
+        assert!(e.to_string().contains("timeuot"), "{e}");
+        let e = BatchConfig::parse(
+            "[solver]\ntemplate = \"d.k\"\n[executor]\nkind = \"cloud\"\n",
+            "b.toml",
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("cloud"), "{e}");
+    }
+}

@@ -1,0 +1,133 @@
+//! Executors: where the runs of a batch happen.
+//!
+//! - [`Executor::Local`]: in this process, runs in parallel on rayon's thread pool (the
+//!   built-in solver in process; an external command as a child process per run);
+//! - [`Executor::Processes`]: a pool of at most `jobs` concurrent solver processes, each
+//!   with a time limit after which it is killed;
+//! - [`Executor::Slurm`]: one Slurm job array per batch, each task in its own work
+//!   directory, polled with `squeue`.
+//!
+//! All three share the journal, the work directories and the retry rule of [`Batch`]: a run
+//! is recorded before it starts and its result after it is read, so [`run_batch`] on a
+//! batch whose driver was killed reuses finished runs, re-attaches to Slurm tasks still
+//! queued or running and runs the rest again, ending with the same results.
+
+mod local;
+mod processes;
+pub mod slurm;
+
+use std::time::Duration;
+
+use serde::{Deserialize, Serialize};
+
+use crate::batch::{Batch, BatchReport, Cancel, Driver};
+use crate::error::{Result, RunnerError};
+pub use slurm::SlurmOptions;
+
+/// Options of the local process pool.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProcessOptions {
+    /// Concurrent solver processes (at least 1).
+    pub jobs: usize,
+    /// Time limit per run in seconds; a run still going is killed and counts as failed
+    /// (and is retried within the batch's limit). None: no limit.
+    #[serde(default)]
+    pub timeout: Option<f64>,
+}
+
+impl ProcessOptions {
+    /// Checks `jobs >= 1` and a finite positive timeout.
+    ///
+    /// # Errors
+    /// [`RunnerError::Config`].
+    pub fn check(&self) -> Result<()> {
+        if self.jobs == 0 {
+            return Err(config("executor.jobs must be at least 1"));
+        }
+        if let Some(t) = self.timeout {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(config(format!("executor.timeout {t} must be positive")));
+            }
+        }
+        Ok(())
+    }
+
+    fn timeout(&self) -> Option<Duration> {
+        self.timeout.map(Duration::from_secs_f64)
+    }
+}
+
+/// The solver command of an executor that runs processes (the built-in solver runs in
+/// process only).
+fn argv<'d>(driver: &'d Driver<'_>) -> Result<&'d [String]> {
+    match &driver.batch.solver().command {
+        crate::solver::SolverCommand::Argv(argv) => Ok(argv),
+        crate::solver::SolverCommand::BuiltIn { .. } => Err(config(
+            "the processes and slurm executors run a solver command; the built-in solver runs \
+             in process only (executor kind = \"local\")",
+        )),
+    }
+}
+
+fn config(message: impl Into<String>) -> RunnerError {
+    RunnerError::Config {
+        file: "configuration".into(),
+        message: message.into(),
+    }
+}
+
+/// Where the runs of a batch happen.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum Executor {
+    /// In this process, in parallel on rayon's pool.
+    Local,
+    /// A local pool of solver processes.
+    Processes(ProcessOptions),
+    /// A Slurm cluster.
+    Slurm(SlurmOptions),
+}
+
+impl Executor {
+    /// The executor's name in the journal and the configuration.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Executor::Local => "local",
+            Executor::Processes(_) => "processes",
+            Executor::Slurm(_) => "slurm",
+        }
+    }
+}
+
+/// Runs every point of `batch` that the journal does not hold a result for, on
+/// `executor`, and returns every run's outcome in input order.
+///
+/// A failed run is reported in its slot and does not stop the others. A rerun after an
+/// interruption (Ctrl-C, or the driver killed at any moment) resumes: see the module docs.
+///
+/// # Errors
+/// Faults of the batch as a whole: the journal cannot be written or belongs to another
+/// batch; the built-in solver asked of an executor that runs processes; a scheduler that
+/// cannot be queried; [`RunnerError::Cancelled`] when `cancel` was set (runs in flight are
+/// killed or cancelled; the journal holds the rest).
+pub fn run_batch(batch: &Batch, executor: &Executor, cancel: &Cancel) -> Result<BatchReport> {
+    let (driver, pending, in_flight) = Driver::open(batch, cancel, executor.name())?;
+    match executor {
+        Executor::Local => {
+            let mut pending = pending;
+            pending.extend(in_flight.keys());
+            pending.sort_unstable();
+            local::run(&driver, &pending)?;
+        }
+        Executor::Processes(options) => {
+            options.check()?;
+            let mut pending = pending;
+            pending.extend(in_flight.keys());
+            pending.sort_unstable();
+            processes::run(&driver, &pending, options.jobs, options.timeout())?;
+        }
+        Executor::Slurm(options) => slurm::run(&driver, pending, in_flight, options)?,
+    }
+    Ok(driver.finish())
+}

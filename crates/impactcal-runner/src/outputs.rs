@@ -1,0 +1,557 @@
+//! Reading a run's output back as [`Histories`]: our wide CSV, LS-DYNA's ASCII `nodout`, or
+//! a CSV whose time and channel columns the user names.
+//!
+//! Time bases: our CSV must be uniform (as everywhere in the workspace). LS-DYNA writes a
+//! `nodout` block at the first cycle past each output interval, so its time stamps stray by
+//! up to one solver step; a `nodout` or user CSV whose steps are not uniform is put on the
+//! uniform base of its median step by linear interpolation
+//! ([`impactcal_core::signal::resample_uniform`]).
+//!
+//! The `nodout` layout read here is the one LS-DYNA documents and its `l2a` translator
+//! writes: a block per output time headed `n o d a l   p r i n t   o u t   f o r   t i m e
+//! s t e p <cycle> ( at time <t> )`, then a column line `nodal point  x-disp ... z-coor`,
+//! then one line per node: the node id (10 columns) and twelve numbers (12 columns each):
+//! displacement, velocity, acceleration and coordinates in x, y, z. A second block per time
+//! with rotations (`nodal point  x-rot ...`) is skipped. An optional `{BEGIN LEGEND}` ...
+//! `{END LEGEND}` section is skipped. Fortran numbers without an `E` (`1.2345-100`) are read.
+
+use std::path::{Path, PathBuf};
+
+use impactcal_core::signal::resample_uniform;
+use impactcal_core::{CoreError, Histories, Table, TableOptions};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Result, RunnerError};
+
+/// The format of a solver's output file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum OutputFormat {
+    /// Our wide CSV (`time,<label>,...`), as `impactcal simulate --out` writes it.
+    #[default]
+    Csv,
+    /// LS-DYNA's ASCII `nodout`.
+    Nodout,
+    /// A CSV with a header, its time column and channel columns named in the configuration.
+    UserCsv,
+}
+
+/// The nodal quantity taken from a `nodout` file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum NodalQuantity {
+    /// Displacement (columns 1-3).
+    Displacement,
+    /// Velocity (columns 4-6).
+    #[default]
+    Velocity,
+    /// Acceleration (columns 7-9).
+    Acceleration,
+}
+
+/// Where a run's output is and how to read it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// The format.
+    #[serde(default)]
+    pub format: OutputFormat,
+    /// The file, relative to the run's work directory.
+    pub file: String,
+    /// `nodout`: the quantity (velocity by default).
+    #[serde(default)]
+    pub quantity: NodalQuantity,
+    /// `nodout`: the nodes to keep (all by default), in this order.
+    #[serde(default)]
+    pub nodes: Option<Vec<u64>>,
+    /// `user-csv`: the time column (`time` by default).
+    #[serde(default)]
+    pub time_column: Option<String>,
+    /// `user-csv`: the channel columns to keep (all others by default), in this order.
+    #[serde(default)]
+    pub columns: Option<Vec<String>>,
+    /// The time the output must reach; an output that ends earlier (by more than half a
+    /// step) is reported as truncated.
+    #[serde(default)]
+    pub end_time: Option<f64>,
+}
+
+impl OutputSpec {
+    /// Our wide CSV in `file`.
+    pub fn csv(file: impl Into<String>) -> Self {
+        OutputSpec {
+            format: OutputFormat::Csv,
+            file: file.into(),
+            quantity: NodalQuantity::default(),
+            nodes: None,
+            time_column: None,
+            columns: None,
+            end_time: None,
+        }
+    }
+
+    /// Checks the specification: a relative file inside the work directory, a positive end
+    /// time.
+    ///
+    /// # Errors
+    /// [`RunnerError::Config`] naming the field.
+    pub fn check(&self, file: &str) -> Result<()> {
+        let p = Path::new(&self.file);
+        let inside = !self.file.is_empty()
+            && p.is_relative()
+            && p.components()
+                .all(|c| matches!(c, std::path::Component::Normal(_)));
+        if !inside {
+            return Err(RunnerError::Config {
+                file: file.into(),
+                message: format!(
+                    "output file `{}` must be a relative path inside the run's directory",
+                    self.file
+                ),
+            });
+        }
+        if let Some(t) = self.end_time {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(RunnerError::Config {
+                    file: file.into(),
+                    message: format!("output end_time {t} must be finite and positive"),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads the output of run `run` from its work directory `dir`.
+    ///
+    /// # Errors
+    /// [`RunnerError::Output`] naming the run and the file: missing, empty, malformed (with
+    /// the line), truncated (a `nodout` time step with fewer nodes than the first, a last
+    /// record cut short, an end before `end_time`), or nodes/columns that are not there.
+    pub fn read(&self, run: usize, dir: &Path) -> Result<Histories> {
+        let path = dir.join(&self.file);
+        let fail = |message: String| RunnerError::Output {
+            run,
+            path: path.clone(),
+            message,
+        };
+        let text = match std::fs::read(&path) {
+            Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(fail("the solver wrote no output file".into()));
+            }
+            Err(e) => return Err(fail(format!("cannot read: {e}"))),
+        };
+        if text.trim().is_empty() {
+            return Err(fail("the output file is empty".into()));
+        }
+        let name = path.display().to_string();
+        let h = match self.format {
+            OutputFormat::Csv => Histories::parse_csv(&text, &name).map_err(|e| fail(position(e))),
+            OutputFormat::Nodout => parse_nodout(&text, self.quantity, self.nodes.as_deref())
+                .map_err(|(line, m)| fail(format!("line {line}: {m}"))),
+            OutputFormat::UserCsv => self.parse_user_csv(&text, &name).map_err(fail),
+        }?;
+        if let Some(end) = self.end_time {
+            let last = h.start() + (h.samples() - 1) as f64 * h.dt();
+            if last < end - 0.5 * h.dt() {
+                return Err(fail(format!(
+                    "truncated: the output ends at t = {last:e}, before the expected end time {end:e}"
+                )));
+            }
+        }
+        Ok(h)
+    }
+
+    fn parse_user_csv(&self, text: &str, name: &str) -> std::result::Result<Histories, String> {
+        let table = Table::parse(text, name, TableOptions::default()).map_err(position)?;
+        let time = self.time_column.as_deref().unwrap_or("time");
+        let header = table.header();
+        let channel_names: Vec<&str> = match &self.columns {
+            Some(c) => c.iter().map(String::as_str).collect(),
+            None => header
+                .iter()
+                .map(String::as_str)
+                .filter(|h| *h != time)
+                .collect(),
+        };
+        let mut wanted = vec![time];
+        wanted.extend(&channel_names);
+        let missing: Vec<&str> = wanted
+            .iter()
+            .copied()
+            .filter(|w| table.column_index(w).is_none())
+            .collect();
+        if !missing.is_empty() {
+            return Err(format!(
+                "no column{} `{}` (the header has: {})",
+                if missing.len() > 1 { "s" } else { "" },
+                missing.join("`, `"),
+                header.join(", ")
+            ));
+        }
+        let col = |n: &str| table.column_index(n).unwrap_or(0);
+        let times: Vec<f64> = table.rows().iter().map(|r| r[col(time)]).collect();
+        let channels: Vec<Vec<f64>> = channel_names
+            .iter()
+            .map(|n| table.rows().iter().map(|r| r[col(n)]).collect())
+            .collect();
+        let labels = channel_names.iter().map(|s| s.to_string()).collect();
+        uniform(labels, &times, channels, table.lines()).map_err(|(l, m)| format!("row {l}: {m}"))
+    }
+}
+
+/// A CSV error as `row r, column c: message` (the path is said once, by the caller).
+fn position(e: CoreError) -> String {
+    match e {
+        CoreError::Csv {
+            row,
+            column,
+            message,
+            ..
+        } => format!("row {row}, column {column}: {message}"),
+        CoreError::File { message, .. } => message,
+        other => other.to_string(),
+    }
+}
+
+/// Histories from channels at `times`, resampled when the steps are not uniform. `lines`
+/// gives the source line of each time for messages.
+fn uniform(
+    labels: Vec<String>,
+    times: &[f64],
+    channels: Vec<Vec<f64>>,
+    lines: &[usize],
+) -> std::result::Result<Histories, (usize, String)> {
+    let first = lines.first().copied().unwrap_or(1);
+    if times.len() < 2 {
+        return Err((first, "need at least two output times".into()));
+    }
+    for k in 1..times.len() {
+        if times[k] <= times[k - 1] {
+            return Err((
+                lines[k],
+                format!(
+                    "time {} does not increase (previous {})",
+                    times[k],
+                    times[k - 1]
+                ),
+            ));
+        }
+    }
+    let n = times.len();
+    let mean = (times[n - 1] - times[0]) / (n - 1) as f64;
+    let is_uniform = times
+        .windows(2)
+        .all(|w| ((w[1] - w[0]) - mean).abs() <= 1e-6 * mean);
+    let (channels, dt) = if is_uniform {
+        (channels, mean)
+    } else {
+        let (c, r) = resample_uniform(times, &channels).map_err(|e| (first, e.to_string()))?;
+        (c, r.dt)
+    };
+    Histories::from_channels(labels, channels, dt, times[0], "").map_err(|e| (first, e.to_string()))
+}
+
+/// A number as LS-DYNA's Fortran output writes it: `1.2345E-03`, or `1.2345-100` when the
+/// exponent takes three digits.
+fn fortran_number(s: &str) -> Option<f64> {
+    if let Ok(v) = s.parse::<f64>() {
+        return Some(v);
+    }
+    let body = s.strip_prefix(['-', '+']).unwrap_or(s);
+    let split = body.rfind(['-', '+']).filter(|&p| p > 0)?;
+    let offset = s.len() - body.len();
+    let (mantissa, exponent) = s.split_at(offset + split);
+    format!("{mantissa}e{exponent}").parse().ok()
+}
+
+/// One output time of a `nodout` file: its header line, its time, and (node, x/y/z) in file
+/// order.
+type Step = (usize, f64, Vec<(u64, [f64; 3])>);
+
+/// Parses a `nodout` file into the chosen quantity of the chosen nodes. Errors carry the
+/// 1-based line.
+fn parse_nodout(
+    text: &str,
+    quantity: NodalQuantity,
+    nodes: Option<&[u64]>,
+) -> std::result::Result<Histories, (usize, String)> {
+    #[derive(PartialEq)]
+    enum Block {
+        None,
+        Translation,
+        Other,
+    }
+    let offset = match quantity {
+        NodalQuantity::Displacement => 0,
+        NodalQuantity::Velocity => 3,
+        NodalQuantity::Acceleration => 6,
+    };
+    // Per output time: its line, its time, and (node, xyz) in file order.
+    let mut steps: Vec<Step> = Vec::new();
+    let mut block = Block::None;
+    let mut legend = false;
+    for (i, line) in text.lines().enumerate() {
+        let n = i + 1;
+        let trimmed = line.trim();
+        if trimmed.starts_with("{BEGIN LEGEND}") {
+            legend = true;
+            continue;
+        }
+        if legend {
+            legend = !trimmed.starts_with("{END LEGEND}");
+            continue;
+        }
+        if trimmed.starts_with("n o d a l   p r i n t   o u t") {
+            let time = trimmed
+                .split_once("at time")
+                .and_then(|(_, rest)| fortran_number(rest.trim().trim_end_matches(')').trim()))
+                .ok_or((
+                    n,
+                    "a time-step header without a readable `at time`".to_string(),
+                ))?;
+            // The rotation block repeats the header of the same time step.
+            if steps.last().is_none_or(|s| s.1.to_bits() != time.to_bits()) {
+                steps.push((n, time, Vec::new()));
+            }
+            block = Block::None;
+            continue;
+        }
+        if trimmed.starts_with("nodal point") {
+            block = if trimmed.contains("x-disp") {
+                Block::Translation
+            } else {
+                Block::Other
+            };
+            continue;
+        }
+        if trimmed.is_empty() {
+            block = Block::None;
+            continue;
+        }
+        if block != Block::Translation {
+            continue;
+        }
+        let fields: Vec<&str> = trimmed.split_whitespace().collect();
+        if fields.len() < 13 {
+            return Err((
+                n,
+                format!(
+                    "a node record with {} of 13 fields (truncated?)",
+                    fields.len()
+                ),
+            ));
+        }
+        let node: u64 = fields[0]
+            .parse()
+            .map_err(|_| (n, format!("node id `{}` is not a whole number", fields[0])))?;
+        let mut xyz = [0.0; 3];
+        for (c, v) in xyz.iter_mut().enumerate() {
+            let f = fields[1 + offset + c];
+            *v = fortran_number(f)
+                .filter(|v| v.is_finite())
+                .ok_or((n, format!("`{f}` is not a finite number")))?;
+        }
+        if let Some(step) = steps.last_mut() {
+            step.2.push((node, xyz));
+        }
+    }
+    let Some(first) = steps.first() else {
+        return Err((1, "no time step (not a nodout file?)".into()));
+    };
+    let all: Vec<u64> = first.2.iter().map(|(id, _)| *id).collect();
+    if all.is_empty() {
+        return Err((first.0, "the first time step lists no node".into()));
+    }
+    for (line, _, rows) in &steps {
+        let ids: Vec<u64> = rows.iter().map(|(id, _)| *id).collect();
+        if ids != all {
+            return Err((
+                *line,
+                format!(
+                    "this time step lists {} nodes where the first lists {} (truncated or mixed output)",
+                    ids.len(),
+                    all.len()
+                ),
+            ));
+        }
+    }
+    let chosen: Vec<usize> = match nodes {
+        None => (0..all.len()).collect(),
+        Some(want) => {
+            let mut idx = Vec::new();
+            for w in want {
+                let Some(k) = all.iter().position(|a| a == w) else {
+                    let list: Vec<String> = all.iter().map(u64::to_string).collect();
+                    return Err((
+                        first.0,
+                        format!("node {w} is not in the file (nodes: {})", list.join(", ")),
+                    ));
+                };
+                idx.push(k);
+            }
+            idx
+        }
+    };
+    let mut labels = Vec::new();
+    let mut channels = Vec::new();
+    for &k in &chosen {
+        for (c, axis) in ["x", "y", "z"].iter().enumerate() {
+            labels.push(format!("{}.{axis}", all[k]));
+            channels.push(steps.iter().map(|s| s.2[k].1[c]).collect());
+        }
+    }
+    let times: Vec<f64> = steps.iter().map(|s| s.1).collect();
+    let lines: Vec<usize> = steps.iter().map(|s| s.0).collect();
+    uniform(labels, &times, channels, &lines)
+}
+
+/// The path of the output of a run in `dir`.
+pub fn output_path(spec: &OutputSpec, dir: &Path) -> PathBuf {
+    dir.join(&spec.file)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A `nodout` in LS-DYNA's documented layout (the `l2a` translator's formats: node id in
+    /// 9 columns, the first number in 13, the others in 12, scientific with 4 decimals).
+    /// `value` as C's `%w.dE` writes it: `d.ddddE+XX`, right-aligned in `w` columns.
+    fn e(value: f64, w: usize, d: usize) -> String {
+        let s = format!("{value:.d$E}");
+        let (m, x) = s.split_once('E').unwrap();
+        let x: i32 = x.parse().unwrap();
+        let sign = if x < 0 { '-' } else { '+' };
+        format!("{:>w$}", format!("{m}E{sign}{:02}", x.abs()))
+    }
+
+    fn nodout(times: &[f64], nodes: &[u64], value: impl Fn(f64, u64, usize) -> f64) -> String {
+        let mut s = String::from(
+            " ls-dyna R13.1.1     date 11/24/2026\n\n{BEGIN LEGEND}\n Entity #        Title\n       21     tip\n{END LEGEND}\n",
+        );
+        for (k, &t) in times.iter().enumerate() {
+            let header = format!(
+                "\n\n\n n o d a l   p r i n t   o u t   f o r   t i m e  s t e p{:8}                              ( at time{} )\n",
+                10 * k + 1,
+                e(t, 14, 7)
+            );
+            s += &header;
+            s += "\n nodal point  x-disp     y-disp      z-disp      x-vel       y-vel       z-vel      x-accl      y-accl      z-accl      x-coor      y-coor      z-coor\n";
+            for &n in nodes {
+                s += &format!("{n:9}{}", e(value(t, n, 0), 13, 4));
+                for c in 1..12 {
+                    s += &e(value(t, n, c), 12, 4);
+                }
+                s += "\n";
+            }
+            s += &header;
+            s += "\n nodal point  x-rot      y-rot       z-rot      x-rot vel   y-rot vel   z-rot vel   x-rot acc   y-rot acc   z-rot acc\n";
+            for &n in nodes {
+                s += &format!("{n:9}{}", e(9.0, 13, 4));
+                for _ in 1..9 {
+                    s += &e(9.0, 12, 4);
+                }
+                s += "\n";
+            }
+        }
+        s
+    }
+
+    fn v(t: f64, n: u64, c: usize) -> f64 {
+        // Column c of node n: displacement = 100 t^2, velocity = 200 t, accel = 200.
+        let base = match c / 3 {
+            0 => 100.0 * t * t,
+            1 => 200.0 * t,
+            2 => 200.0,
+            _ => 0.5,
+        };
+        base * (1.0 + c as f64 % 3.0) + n as f64 * 1e-3
+    }
+
+    #[test]
+    fn nodout_reads_the_documented_layout() {
+        let times: Vec<f64> = (0..6).map(|k| k as f64 * 1e-4).collect();
+        let text = nodout(&times, &[21, 42], v);
+        let h = parse_nodout(&text, NodalQuantity::Velocity, None).unwrap();
+        assert_eq!(h.labels(), ["21.x", "21.y", "21.z", "42.x", "42.y", "42.z"]);
+        assert_eq!(h.samples(), 6);
+        assert!((h.dt() - 1e-4).abs() < 1e-12);
+        // 42.y at t = 3e-4: 200 t * 2 + 0.042 written with 5 significant digits.
+        let want = 200.0 * 3e-4 * 2.0 + 0.042;
+        assert!(
+            (h.value(4, 3) - want).abs() < 1e-4 * want,
+            "{}",
+            h.value(4, 3)
+        );
+        let d = parse_nodout(&text, NodalQuantity::Displacement, Some(&[42])).unwrap();
+        assert_eq!(d.labels(), ["42.x", "42.y", "42.z"]);
+        let e = parse_nodout(&text, NodalQuantity::Velocity, Some(&[7])).unwrap_err();
+        assert!(e.1.contains("node 7 is not in the file"), "{e:?}");
+    }
+
+    #[test]
+    fn nodout_truncation_and_jitter() {
+        let times: Vec<f64> = (0..5).map(|k| k as f64 * 1e-4).collect();
+        let text = nodout(&times, &[1, 2, 3], v);
+        // Cut inside the last step's node lines: that step lists fewer nodes.
+        let rotation = text.rfind(" n o d a l").unwrap();
+        let translation = text[..rotation].rfind(" n o d a l").unwrap();
+        let cut = translation + text[translation..].find("        2 ").unwrap();
+        let e = parse_nodout(&text[..cut + 40], NodalQuantity::Velocity, None).unwrap_err();
+        assert!(e.1.contains("fields (truncated?)"), "{e:?}");
+        let e = parse_nodout(&text[..cut], NodalQuantity::Velocity, None).unwrap_err();
+        assert!(
+            e.1.contains("lists 1 nodes where the first lists 3"),
+            "{e:?}"
+        );
+        // Output times a solver step late: resampled onto the median step.
+        let late = [0.0, 1.02e-4, 2.01e-4, 3.03e-4, 4.0e-4];
+        let h = parse_nodout(&nodout(&late, &[1], v), NodalQuantity::Velocity, None).unwrap();
+        assert!((h.dt() - 1e-4).abs() < 3e-6, "{}", h.dt());
+        // Velocity is linear in t, so the interpolated samples stay on the line.
+        for k in 0..h.samples() {
+            let t = k as f64 * h.dt();
+            assert!((h.value(0, k) - (200.0 * t + 1e-3)).abs() < 1e-3, "{k}");
+        }
+        assert_eq!(fortran_number("1.2345-100"), Some(1.2345e-100));
+        assert_eq!(fortran_number("-2.00000-3"), Some(-2e-3));
+    }
+
+    #[test]
+    fn user_csv_by_named_columns() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("o.csv"),
+            "step,t,acc,vel\n0,0,1,2\n1,0.5,3,4\n2,1.0,5,6\n",
+        )
+        .unwrap();
+        let mut spec = OutputSpec::csv("o.csv");
+        spec.format = OutputFormat::UserCsv;
+        spec.time_column = Some("t".into());
+        spec.columns = Some(vec!["vel".into()]);
+        let h = spec.read(4, dir.path()).unwrap();
+        assert_eq!(h.labels(), ["vel"]);
+        assert_eq!(h.channel(0), [2.0, 4.0, 6.0]);
+        spec.columns = Some(vec!["vel".into(), "force".into()]);
+        let e = spec.read(4, dir.path()).unwrap_err();
+        assert!(e.to_string().starts_with("run 4: "), "{e}");
+        assert!(e.to_string().contains("no column `force`"), "{e}");
+        // Missing, empty, truncated (a ragged last row) and too short are all named.
+        let e = OutputSpec::csv("none.csv").read(1, dir.path()).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("none.csv: the solver wrote no output file"),
+            "{e}"
+        );
+        std::fs::write(dir.path().join("cut.csv"), "time,a\n0,1\n1,2\n2,").unwrap();
+        let e = OutputSpec::csv("cut.csv").read(1, dir.path()).unwrap_err();
+        assert!(e.to_string().contains("row 4"), "{e}");
+        std::fs::write(dir.path().join("short.csv"), "time,a\n0,1\n1,2\n").unwrap();
+        let mut spec = OutputSpec::csv("short.csv");
+        spec.end_time = Some(2.0);
+        let e = spec.read(1, dir.path()).unwrap_err();
+        assert!(e.to_string().contains("truncated"), "{e}");
+        assert_eq!(e.kind(), impactcal_core::ErrorKind::Numerical);
+    }
+}

@@ -1,0 +1,154 @@
+#!/usr/bin/env bash
+# End-to-end test of the Slurm executor on a real one-node cluster on 127.0.0.1.
+#
+#   tests/slurm/run.sh               the test (installs Slurm with apt-get when missing)
+#   tests/slurm/run.sh --overhead N  also measure the driver's own CPU time for N trivial tasks
+#
+# It runs `impactcal batch` through the Slurm executor with examples/batch/slurm.toml:
+#   1. a batch with a run whose solver fails: reported with its exit status and resubmitted
+#      once, the others read back;
+#   2. a cancel: SIGINT to the driver scancels its array (checked with squeue);
+#   3. SIGKILL of the driver mid-array, then a rerun that re-attaches to the tasks still
+#      queued or running and ends with the same histories as step 1.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+REPO=$(pwd)
+OVERHEAD=0
+if [ "${1:-}" = "--overhead" ]; then OVERHEAD=${2:?--overhead N}; fi
+
+if ! command -v slurmctld >/dev/null || ! command -v munged >/dev/null; then
+  echo "== installing slurm"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq slurmctld slurmd slurm-client munge >/dev/null
+fi
+
+ROOT=$(mktemp -d /tmp/impactcal-slurm.XXXXXX)
+cleanup() {
+  if [ -n "${SLURM_CONF:-}" ]; then scancel --user="$(id -un)" 2>/dev/null || true; fi
+  "$REPO/tests/slurm/stop.sh" "$ROOT"
+  rm -rf "$ROOT"
+}
+trap cleanup EXIT
+echo "== starting slurm in $ROOT"
+"$REPO/tests/slurm/start.sh" "$ROOT"
+export SLURM_CONF="$ROOT/slurm.conf"
+
+echo "== building impactcal"
+cargo build --quiet --profile test -p impactcal-cli --bin impactcal
+IMPACTCAL="$REPO/target/debug/impactcal"
+W="$ROOT/work"
+mkdir -p "$W"
+cp examples/batch/strip.k "$W/"
+fail() { echo "FAILED: $*" >&2; exit 1; }
+
+# The shipped configuration, with a faster poll for the test.
+sed 's/^poll = .*/poll = 0.5/' examples/batch/slurm.toml > "$W/slurm.toml"
+# A slow solver for the cancel and kill steps: a pause, then the built-in solver.
+slow_config() {
+  sed "s|^\[solver\]$|[solver]\ncommand = [\"sh\", \"-c\", \"sleep $1; exec \\\\\"\$0\\\\\" simulate --deck strip.k --out out.csv\", \"$IMPACTCAL\"]|" \
+    "$W/slurm.toml" > "$W/slow.toml"
+}
+GOOD="t,vz
+0.002,-5
+0.0025,-4
+0.0015,-6
+0.0022,-4.5
+0.0018,-5.5
+0.0021,-5.2"
+printf '%s\n' "$GOOD" > "$W/good.csv"
+printf '%s\n%s\n' "$GOOD" "-0.001,-5" > "$W/with_bad.csv"
+
+echo "== 1. a batch with a failing run"
+set +e
+"$IMPACTCAL" batch --config "$W/slurm.toml" --points "$W/with_bad.csv" --out "$W/one" 2> "$W/one.err"
+code=$?
+set -e
+cat "$W/one.err"
+[ $code = 1 ] || fail "exit code $code, expected 1"
+grep -q 'run 6: the solver exited with status 2' "$W/one.err" || fail "the failed run is not named"
+python3 - "$W/one/summary.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["succeeded"] == 6 and s["failed"] == 1, s
+assert s["results"][6]["attempts"] == 2, s["results"][6]
+assert all(r["attempts"] == 1 for r in s["results"][:6]), s
+PY
+subs=$(grep -c '"event":"slurm_job"' "$W/one/runs/strip/journal.jsonl")
+[ "$subs" = 2 ] || fail "expected 2 arrays (the batch, the resubmission), found $subs"
+grep -q 'thickness: must be finite and positive' "$W/one/runs/strip/6/stderr.txt" || fail "stderr of run 6"
+
+echo "== 2. cancel: SIGINT scancels the array"
+slow_config 30
+"$IMPACTCAL" batch --config "$W/slow.toml" --points "$W/good.csv" --out "$W/two" 2> "$W/two.err" &
+DRIVER=$!
+for _ in $(seq 1 100); do
+  [ -n "$(squeue -h -o %i)" ] && break
+  sleep 0.2
+done
+[ -n "$(squeue -h -o %i)" ] || fail "nothing was queued"
+kill -INT $DRIVER
+set +e; wait $DRIVER; code=$?; set -e
+cat "$W/two.err"
+[ $code = 1 ] || fail "exit code $code after SIGINT, expected 1"
+grep -q 'interrupted; scancel' "$W/two.err" || fail "no scancel reported"
+for _ in $(seq 1 50); do
+  [ -z "$(squeue -h -o %i)" ] && break
+  sleep 0.2
+done
+[ -z "$(squeue -h -o %i)" ] || { squeue; fail "tasks still queued after the cancel"; }
+
+echo "== 3. SIGKILL of the driver mid-array, then resume"
+slow_config 2
+"$IMPACTCAL" batch --config "$W/slow.toml" --points "$W/good.csv" --out "$W/three" 2> /dev/null &
+DRIVER=$!
+J="$W/three/runs/strip/journal.jsonl"
+for _ in $(seq 1 300); do
+  n=$(grep -c '"event":"result"' "$J" 2>/dev/null || true)
+  [ "${n:-0}" -ge 2 ] && break
+  sleep 0.1
+done
+kill -KILL $DRIVER
+wait $DRIVER 2>/dev/null || true
+left=$(squeue -h -r -o %i | wc -l)
+echo "driver killed with $(grep -c '"event":"result"' "$J") results in the journal and $left tasks in the queue"
+[ "$left" -gt 0 ] || fail "the array finished before the kill"
+"$IMPACTCAL" batch --config "$W/slow.toml" --points "$W/good.csv" --out "$W/three"
+grep -c '"event":"slurm_job"' "$J" | grep -qx 1 || fail "tasks were resubmitted instead of re-attached"
+for i in 0 1 2 3 4 5; do
+  cmp "$W/one/runs/strip/$i/result.csv" "$W/three/runs/strip/$i/result.csv" || fail "run $i differs"
+done
+
+if [ "$OVERHEAD" -gt 0 ]; then
+  echo "== overhead: $OVERHEAD trivial tasks"
+  printf 'time,y\n0,0\n1,<<a>>\n' > "$W/trivial.csv"
+  cat > "$W/trivial.toml" <<TOML
+[batch]
+study = "trivial"
+[solver]
+template = "trivial.csv"
+command = ["cp", "trivial.csv", "out.csv"]
+[executor]
+kind = "slurm"
+poll = 2.0
+max_array = 1000
+TOML
+  python3 -c "
+print('a')
+for i in range($OVERHEAD): print(i)" > "$W/trivial_points.csv"
+  start=$(date +%s.%N)
+  bash -c "'$IMPACTCAL' batch --config '$W/trivial.toml' --points '$W/trivial_points.csv' --out '$W/trivial' && times" > "$W/times.txt"
+  end=$(date +%s.%N)
+  python3 - "$W/times.txt" "$OVERHEAD" "$start" "$end" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read().split("\n")
+n = int(sys.argv[2]); wall = float(sys.argv[4]) - float(sys.argv[3])
+def secs(s):
+    m = re.match(r"(\d+)m([\d.]+)s", s); return int(m.group(1)) * 60 + float(m.group(2))
+# `times`: the shell's own user/sys, then its children's (the driver and what it ran).
+user, sys_ = (secs(x) for x in text[1].split())
+print(f"{n} tasks in {wall:.1f} s wall; driver CPU (user+sys, with the sbatch/squeue it ran) "
+      f"{user + sys_:.2f} s = {1000 * (user + sys_) / n:.1f} ms per task")
+PY
+fi
+echo "== slurm test passed"
