@@ -36,7 +36,7 @@ export SLURM_CONF="$ROOT/slurm.conf"
 
 echo "== building impactcal"
 cargo build --quiet --profile test -p impactcal-cli --bin impactcal
-IMPACTCAL="$REPO/target/debug/impactcal"
+IMPACTCAL="${CARGO_TARGET_DIR:-$REPO/target}/debug/impactcal"
 W="$ROOT/work"
 mkdir -p "$W"
 cp examples/batch/strip.k "$W/"
