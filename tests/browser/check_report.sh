@@ -44,5 +44,6 @@ else
     trap 'rm -rf "$OUT"' EXIT
 fi
 
-cargo run --quiet --example report_gallery -- "$OUT/report" >/dev/null
+# The test profile: its dependencies are already built by `cargo test` in CI.
+cargo run --quiet --profile test --example report_gallery -- "$OUT/report" >/dev/null
 python3 tests/browser/check_report.py --chromium "$CHROMIUM" --report "$OUT/report" --negative-controls
