@@ -36,6 +36,7 @@
 //! # Ok::<(), impactcal_core::CoreError>(())
 //! ```
 
+pub mod enrich;
 pub mod error;
 pub mod histories;
 pub mod model;
@@ -49,6 +50,7 @@ pub mod table;
 pub mod test_functions;
 pub mod testdata;
 
+pub use enrich::{Candidate, Enrichable};
 pub use error::{CoreError, ErrorKind, ParamGuard, Result, check_finite, check_finite_mat};
 pub use histories::Histories;
 pub use model::{BatchResults, Model, RunFailure};

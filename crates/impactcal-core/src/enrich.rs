@@ -1,0 +1,180 @@
+//! Models that can grow: the quantities a model holds fixed today and could free, so that a
+//! calibration that leaves a residual can look for the effect the model lacks.
+//!
+//! A [`Model`] declares a [`ParameterSpace`]; everything else it needs (a damping
+//! coefficient, a friction coefficient, a concentrated mass, the impact velocity) it holds at
+//! one value. An [`Enrichable`] model lists those held quantities as [`Candidate`]s, builds
+//! itself with some of them freed ([`Enrichable::enrich`]), and builds itself at another test
+//! condition ([`Enrichable::at_condition`], for a holdout test).
+//!
+//! ```
+//! use impactcal_core::enrich::{Candidate, Enrichable};
+//! use impactcal_core::{CoreError, Histories, Model, Parameter, ParameterSpace, Result};
+//!
+//! /// A mass on a spring released at speed `v0`: x(t) = v0/w sin(w t) e^{-c t}; `w` is
+//! /// declared, the damping `c` and the speed `v0` are held.
+//! struct Oscillator {
+//!     space: ParameterSpace,
+//!     c: f64,
+//!     v0: f64,
+//! }
+//!
+//! impl Model for Oscillator {
+//!     fn space(&self) -> &ParameterSpace {
+//!         &self.space
+//!     }
+//!     fn simulate(&self, p: &[f64]) -> Result<Histories> {
+//!         let w = p[0];
+//!         let c = self.space.index_of("c").map_or(self.c, |i| p[i]);
+//!         let x: Vec<f64> = (0..100)
+//!             .map(|k| {
+//!                 let t = k as f64 * 0.01;
+//!                 self.v0 / w * (w * t).sin() * (-c * t).exp()
+//!             })
+//!             .collect();
+//!         Histories::new(vec!["x".into()], 100, 0.01, 0.0, "m", x)
+//!     }
+//! }
+//!
+//! impl Enrichable for Oscillator {
+//!     fn candidates(&self) -> Vec<Candidate> {
+//!         let mut c = vec![];
+//!         if self.space.index_of("c").is_none() {
+//!             let p = Parameter::new("c", 0.0, 5.0, self.c).expect("valid");
+//!             c.push(Candidate::new(p, "damping", "viscous damping rate (1/s)"));
+//!         }
+//!         c
+//!     }
+//!     fn enrich(&self, added: &[Parameter]) -> Result<Self> {
+//!         let mut params = self.space.parameters().to_vec();
+//!         for p in added {
+//!             self.check_candidate(p)?;
+//!             params.push(p.clone());
+//!         }
+//!         Ok(Oscillator { space: ParameterSpace::new(params)?, ..*self })
+//!     }
+//!     fn at_condition(&self, set: &[(String, f64)]) -> Result<Self> {
+//!         let mut v0 = self.v0;
+//!         for (name, value) in set {
+//!             match name.as_str() {
+//!                 "v0" => v0 = *value,
+//!                 _ => {
+//!                     return Err(CoreError::invalid_option("condition", name, "not held"))
+//!                 }
+//!             }
+//!         }
+//!         Ok(Oscillator { space: self.space.clone(), v0, ..*self })
+//!     }
+//! }
+//!
+//! let model = Oscillator {
+//!     space: ParameterSpace::new(vec![Parameter::new("w", 5.0, 15.0, 10.0)?])?,
+//!     c: 0.0,
+//!     v0: 1.0,
+//! };
+//! let c = &model.candidates()[0];
+//! let enriched = model.enrich(&[c.parameter.clone()])?;
+//! assert_eq!(enriched.space().names(), ["w", "c"]);
+//! // Freed at its held value, the candidate changes nothing.
+//! let before = model.simulate(&[10.0])?;
+//! let after = enriched.simulate(&[10.0, 0.0])?;
+//! assert_eq!(before.data(), after.data());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{CoreError, Result};
+use crate::model::Model;
+use crate::space::Parameter;
+
+/// A quantity a model holds fixed and could free: an effect it does not declare.
+///
+/// `parameter.nominal` is the value the model holds it at today (freeing it there changes no
+/// run); `parameter.lower..=upper` is the range of physically admissible values (a damping
+/// coefficient or a friction coefficient is never negative), which a fitted amplitude must
+/// respect to be attributed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Candidate {
+    /// The parameter it would add: name, admissible range, held value as nominal, unit.
+    pub parameter: Parameter,
+    /// Its kind, for grouping in reports: `damping`, `friction`, `material`, `thickness`,
+    /// `mass`, `condition`, ...
+    pub group: String,
+    /// What it is, in a few words.
+    pub description: String,
+}
+
+impl Candidate {
+    /// A candidate from its parameter, group and description.
+    pub fn new(
+        parameter: Parameter,
+        group: impl Into<String>,
+        description: impl Into<String>,
+    ) -> Self {
+        Self {
+            parameter,
+            group: group.into(),
+            description: description.into(),
+        }
+    }
+
+    /// The candidate's name (its parameter's).
+    pub fn name(&self) -> &str {
+        &self.parameter.name
+    }
+}
+
+/// A [`Model`] that lists the quantities it holds fixed and can free them.
+///
+/// Contract, which the closed loop relies on:
+/// - [`candidates`](Enrichable::candidates) lists only quantities not in `space()`, with
+///   distinct names; each candidate's nominal is the value the model holds it at.
+/// - `enrich(added)` returns the model whose space is `space()` followed by `added` in that
+///   order; a point of it is a point of `self` followed by the added values, and at the
+///   added parameters' held values it gives the same histories as `self` (bit for bit where
+///   the model is deterministic). Each added parameter names a candidate; its bounds and
+///   nominal are the caller's (they may narrow the admissible range).
+/// - `at_condition(set)` returns the model with held quantities set to other values (a
+///   test at another impact velocity or attitude) and the same space.
+pub trait Enrichable: Model + Sized {
+    /// The held quantities that could be freed, in a fixed order.
+    fn candidates(&self) -> Vec<Candidate>;
+
+    /// The model with `added` appended to its space.
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] when an added name is not a candidate or is repeated;
+    /// [`CoreError::Parameter`] for invalid bounds.
+    fn enrich(&self, added: &[Parameter]) -> Result<Self>;
+
+    /// The model at another test condition: each `(name, value)` sets a held quantity.
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] when a name is not a held quantity of the model (or is a
+    /// declared parameter, which a point sets instead) or the value is not admissible.
+    fn at_condition(&self, set: &[(String, f64)]) -> Result<Self>;
+
+    /// Checks that `p` names one of [`candidates`](Enrichable::candidates) (a helper for
+    /// implementations of [`enrich`](Enrichable::enrich)).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] naming the parameter when it is not a candidate.
+    fn check_candidate(&self, p: &Parameter) -> Result<()> {
+        if self.candidates().iter().any(|c| c.name() == p.name) {
+            Ok(())
+        } else if self.space().index_of(&p.name).is_some() {
+            Err(CoreError::invalid_option(
+                "enrich",
+                &p.name,
+                "already a parameter of the model",
+            ))
+        } else {
+            Err(CoreError::invalid_option(
+                "enrich",
+                &p.name,
+                "not a candidate of the model (held quantities only)",
+            ))
+        }
+    }
+}
