@@ -52,6 +52,15 @@ fn study(config: &Path, out: &Path) -> std::process::Output {
     ])
 }
 
+/// The results a runner journal records (complete lines only).
+fn results_in(journal: &Path) -> usize {
+    std::fs::read_to_string(journal).map_or(0, |t| {
+        t.lines()
+            .filter(|l| l.starts_with("{\"event\":\"result\""))
+            .count()
+    })
+}
+
 const STRIP: &str = "ensemble = 160\nsensors = 3\nshapes = 2\nsensitivity_samples = 64\n\
                      reconcile_runs = 6\nnoise_runs = 3";
 
@@ -79,14 +88,8 @@ fn a_killed_study_resumes_to_the_uninterrupted_result() {
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    let ensemble = killed.join("journal/ensemble");
-    let count = || {
-        std::fs::read_dir(&ensemble).map_or(0, |d| {
-            d.filter_map(Result::ok)
-                .filter(|e| e.path().extension().is_some_and(|x| x == "run"))
-                .count()
-        })
-    };
+    let ensemble = killed.join("runs/ensemble/journal.jsonl");
+    let count = || results_in(&ensemble);
     let start = Instant::now();
     while count() < 10 && start.elapsed() < Duration::from_secs(60) {
         std::thread::sleep(Duration::from_millis(5));
