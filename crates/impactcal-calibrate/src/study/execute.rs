@@ -73,7 +73,8 @@ impl<M: Model> Executor for InProcess<'_, M> {
             command: SolverCommand::InProcess {
                 description: "in-process model".into(),
             },
-            output: OutputSpec::csv("out.csv"),
+            // The model's histories go straight to the run's result file: no second copy.
+            output: OutputSpec::csv(impactcal_runner::workdir::RESULT),
         }
     }
 
