@@ -47,6 +47,16 @@ W="$ROOT/work"
 mkdir -p "$W"
 cp examples/batch/strip.k "$W/"
 fail() { echo "FAILED: $*" >&2; exit 1; }
+# kill_after_results JOURNAL N PID: SIGKILL of PID once JOURNAL records N results (or 60 s).
+kill_after_results() {
+  for _ in $(seq 1 600); do
+    n=$(grep -c '"event":"result"' "$1" 2>/dev/null || true)
+    [ "${n:-0}" -ge "$2" ] && break
+    sleep 0.1
+  done
+  kill -KILL "$3"
+  wait "$3" 2>/dev/null || true
+}
 
 # The shipped configuration, with a faster poll for the test.
 sed 's/^poll = .*/poll = 0.5/' examples/batch/slurm.toml > "$W/slurm.toml"
@@ -109,13 +119,7 @@ slow_config 2
 "$IMPACTCAL" batch --config "$W/slow.toml" --points "$W/good.csv" --out "$W/three" 2> /dev/null &
 DRIVER=$!
 J="$W/three/runs/strip/journal.jsonl"
-for _ in $(seq 1 300); do
-  n=$(grep -c '"event":"result"' "$J" 2>/dev/null || true)
-  [ "${n:-0}" -ge 2 ] && break
-  sleep 0.1
-done
-kill -KILL $DRIVER
-wait $DRIVER 2>/dev/null || true
+kill_after_results "$J" 2 $DRIVER
 left=$(squeue -h -r -o %i | wc -l)
 echo "driver killed with $(grep -c '"event":"result"' "$J") results in the journal and $left tasks in the queue"
 [ "$left" -gt 0 ] || fail "the array finished before the kill"
@@ -141,13 +145,7 @@ printf '[executor]\nkind = "processes"\njobs = 2\n' >> "$S/local.toml"
 "$IMPACTCAL" study --config "$S/slurm.toml" --out "$S/slurm" 2> /dev/null &
 DRIVER=$!
 J="$S/slurm/runs/ensemble/journal.jsonl"
-for _ in $(seq 1 600); do
-  n=$(grep -c '"event":"result"' "$J" 2>/dev/null || true)
-  [ "${n:-0}" -ge 2 ] && break
-  sleep 0.1
-done
-kill -KILL $DRIVER
-wait $DRIVER 2>/dev/null || true
+kill_after_results "$J" 2 $DRIVER
 left=$(squeue -h -r -o %i | wc -l)
 echo "study killed with $(grep -c '"event":"result"' "$J") of 12 ensemble results in the journal and $left tasks in the queue"
 [ "$left" -gt 0 ] || fail "the ensemble finished before the kill"

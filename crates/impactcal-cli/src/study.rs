@@ -174,11 +174,7 @@ pub struct Setup {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let text = std::fs::read_to_string(&args.config)
-        .map_err(|e| CliError::io(format!("{}: {e}", args.config.display())))?;
-    let name = args.config.display().to_string();
-    let config: Config = toml::from_str(&text)
-        .map_err(|e| CliError::input(format!("{name}: {}", one_line(&e.to_string()))))?;
+    let (config, name) = read_config(&args.config)?;
     let base = args.config.parent().unwrap_or(Path::new("."));
     let options = config
         .study
@@ -196,6 +192,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let pool = thread_pool(args.threads)?;
     let result = pool.install(|| execute(&setup, &options, &args.out))?;
     finish(&result, &setup, &args.out)
+}
+
+/// Reads a study file; returns it with its name for messages.
+fn read_config(path: &Path) -> Result<(Config, String), CliError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
+    let name = path.display().to_string();
+    let config: Config = toml::from_str(&text)
+        .map_err(|e| CliError::input(format!("{name}: {}", one_line(&e.to_string()))))?;
+    Ok((config, name))
 }
 
 /// Writes `study.json`, the report (`report.html`, `report.md` and its SVG figures) and
@@ -345,11 +351,7 @@ pub struct PointArgs {
 /// Runs the built-in model of a study file at the point of a run's `params.json` and
 /// writes its histories: what a process-pool or Slurm executor runs for each point.
 pub fn run_point(args: PointArgs) -> Result<(), CliError> {
-    let text = std::fs::read_to_string(&args.config)
-        .map_err(|e| CliError::io(format!("{}: {e}", args.config.display())))?;
-    let name = args.config.display().to_string();
-    let config: Config = toml::from_str(&text)
-        .map_err(|e| CliError::input(format!("{name}: {}", one_line(&e.to_string()))))?;
+    let (config, name) = read_config(&args.config)?;
     let base = args.config.parent().unwrap_or(Path::new("."));
     let (model, _) = build_model(&config, base).map_err(|e| e.context(&name))?;
     let record: RunRecord = serde_json::from_str(
@@ -357,8 +359,8 @@ pub fn run_point(args: PointArgs) -> Result<(), CliError> {
             .map_err(|e| CliError::io(format!("{}: {e}", args.params.display())))?,
     )
     .map_err(|e| CliError::input(format!("{}: {e}", args.params.display())))?;
-    let simulate = |m: &dyn ModelRef| -> Result<Histories, CliError> {
-        let names = m.space_ref().names();
+    let simulate = |m: &dyn Model| -> Result<Histories, CliError> {
+        let names = m.space().names();
         if names != record.names {
             return Err(CliError::input(format!(
                 "{}: parameters {:?}, but the study's model takes {:?}",
@@ -367,7 +369,8 @@ pub fn run_point(args: PointArgs) -> Result<(), CliError> {
                 names
             )));
         }
-        Ok(m.run(&record.values)?)
+        m.space().to_unit(&record.values)?;
+        Ok(m.simulate(&record.values)?)
     };
     let pool = thread_pool(args.threads)?;
     let h = pool.install(|| match &model {
@@ -379,34 +382,6 @@ pub fn run_point(args: PointArgs) -> Result<(), CliError> {
     })?;
     h.write_csv(&args.out)?;
     Ok(())
-}
-
-/// A built-in model seen through `dyn` (`Model` has a generic method).
-trait ModelRef {
-    fn space_ref(&self) -> &ParameterSpace;
-    fn run(&self, x: &[f64]) -> impactcal::core::Result<Histories>;
-}
-
-impl<M: Model> ModelRef for M {
-    fn space_ref(&self) -> &ParameterSpace {
-        self.space()
-    }
-    fn run(&self, x: &[f64]) -> impactcal::core::Result<Histories> {
-        self.space().to_unit(x)?;
-        self.simulate(x)
-    }
-}
-
-fn one_line(s: &str) -> String {
-    s.split_whitespace().collect::<Vec<_>>().join(" ")
-}
-
-fn resolve(base: &Path, p: &Path) -> PathBuf {
-    if p.is_absolute() {
-        p.to_path_buf()
-    } else {
-        base.join(p)
-    }
 }
 
 /// Builds the model, reads the test, the map and the CFC class of a study file whose

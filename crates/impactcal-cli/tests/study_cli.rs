@@ -77,26 +77,12 @@ fn a_killed_study_resumes_to_the_uninterrupted_result() {
     );
 
     let killed = dir.path().join("killed");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_impactcal"))
-        .args([
-            "study",
-            "--config",
-            config.to_str().unwrap(),
-            "--out",
-            killed.to_str().unwrap(),
-        ])
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let ensemble = killed.join("runs/ensemble/journal.jsonl");
-    let count = || results_in(&ensemble);
-    let start = Instant::now();
-    while count() < 10 && start.elapsed() < Duration::from_secs(60) {
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    child.kill().unwrap(); // SIGKILL
-    child.wait().unwrap();
-    let done = count();
+    let done = kill_study_after(
+        &config,
+        &killed,
+        &killed.join("runs/ensemble/journal.jsonl"),
+        10,
+    );
     assert!(
         (10..160).contains(&done),
         "killed after {done} of 160 ensemble runs"
