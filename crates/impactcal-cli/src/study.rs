@@ -384,6 +384,18 @@ pub fn run_point(args: PointArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn resolve(base: &Path, p: &Path) -> PathBuf {
+    if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        base.join(p)
+    }
+}
+
 /// Builds the model, reads the test, the map and the CFC class of a study file whose
 /// relative paths start at `base`.
 ///
