@@ -26,13 +26,7 @@ impl Model for Wave {
         let y: Vec<f64> = (0..50)
             .map(|k| p[0] * (p[1] * k as f64 * 1e-3).sin() / 3.0)
             .collect();
-        Ok(Histories::from_channels(
-            vec!["1.z".into()],
-            vec![y],
-            1e-3 / 3.0,
-            0.0,
-            "in/s",
-        )?)
+        Histories::from_channels(vec!["1.z".into()], vec![y], 1e-3 / 3.0, 0.0, "in/s")
     }
 }
 
@@ -56,9 +50,10 @@ fn in_process() -> Solver {
     }
 }
 
-type Seen = Mutex<Vec<(usize, Result<Histories, String>)>>;
+type Outcomes = Vec<(usize, Result<Histories, String>)>;
+type Seen = Mutex<Outcomes>;
 
-fn run(batch: &Batch, model: &Wave) -> (usize, Vec<(usize, Result<Histories, String>)>) {
+fn run(batch: &Batch, model: &Wave) -> (usize, Outcomes) {
     let seen: Seen = Mutex::new(Vec::new());
     let opened = Mutex::new(usize::MAX);
     let finished = |i: usize, o: Result<Histories, &impactcal_runner::RunnerError>| {
