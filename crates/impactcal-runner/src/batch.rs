@@ -273,7 +273,7 @@ pub type OnFinished<'a> = dyn Fn(usize, std::result::Result<Histories, &RunnerEr
 /// What a caller hooks into [`run_batch_with`](crate::run_batch_with).
 #[derive(Clone, Copy, Default)]
 pub struct Hooks<'a> {
-    /// The model that [`SolverCommand::InProcess`](crate::SolverCommand::InProcess) runs.
+    /// The model that [`SolverCommand::InProcess`] runs.
     pub model: Option<&'a dyn impactcal_core::Model>,
     /// Called once the journal is read, before any run: the number of runs the journal
     /// holds as finished (they are reused unless their result file no longer reads).

@@ -1,6 +1,6 @@
 //! How the study's true-model runs are executed: one small seam ([`Executor`]) between the
-//! study and whatever runs the model, and [`Runs`], which runs each stage of a study as a
-//! batch of [`impactcal_runner`] with its journal.
+//! study and whatever runs the model, and `Runs` (crate-internal), which runs each stage of
+//! a study as a batch of [`impactcal_runner`] with its journal.
 //!
 //! Layout of a study's output folder `<dir>`: `<dir>/runs/fingerprint` holds the study's
 //! fingerprint; each stage of runs is a batch `<dir>/runs/<stage>/` with the runner's
