@@ -44,6 +44,9 @@ else
     trap 'rm -rf "$OUT"' EXIT
 fi
 
-# The test profile: its dependencies are already built by `cargo test` in CI.
-cargo run --quiet --profile test --example report_gallery -- "$OUT/report" >/dev/null
+# The example as `cargo test --workspace` builds it (examples too): after it, as in CI, this
+# is a no-op, where `cargo run --example` would unify features differently and build the
+# workspace's crates again.
+cargo test --workspace --no-run --quiet
+"${CARGO_TARGET_DIR:-target}/debug/examples/report_gallery" "$OUT/report" >/dev/null
 python3 tests/browser/check_report.py --chromium "$CHROMIUM" --report "$OUT/report" --negative-controls

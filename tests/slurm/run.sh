@@ -9,7 +9,10 @@
 #      once, the others read back;
 #   2. a cancel: SIGINT to the driver scancels its array (checked with squeue);
 #   3. SIGKILL of the driver mid-array, then a rerun that re-attaches to the tasks still
-#      queued or running and ends with the same histories as step 1.
+#      queued or running and ends with the same histories as step 1;
+#   4. a small study (examples/study/slurm.toml) killed with SIGKILL mid-ensemble and
+#      resumed: it re-attaches to the ensemble's array and ends with the same study.json as
+#      the same study run uninterrupted on the local process pool.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 REPO=$(pwd)
@@ -35,12 +38,25 @@ echo "== starting slurm in $ROOT"
 export SLURM_CONF="$ROOT/slurm.conf"
 
 echo "== building impactcal"
-cargo build --quiet --profile test -p impactcal-cli --bin impactcal
+# The binary `cargo test --workspace` builds for the integration tests: after it (as in CI)
+# this is a no-op; `cargo build -p impactcal-cli` would unify features differently and
+# build the workspace again.
+cargo test --workspace --no-run --quiet
 IMPACTCAL="${CARGO_TARGET_DIR:-$REPO/target}/debug/impactcal"
 W="$ROOT/work"
 mkdir -p "$W"
 cp examples/batch/strip.k "$W/"
 fail() { echo "FAILED: $*" >&2; exit 1; }
+# kill_after_results JOURNAL N PID: SIGKILL of PID once JOURNAL records N results (or 60 s).
+kill_after_results() {
+  for _ in $(seq 1 600); do
+    n=$(grep -c '"event":"result"' "$1" 2>/dev/null || true)
+    [ "${n:-0}" -ge "$2" ] && break
+    sleep 0.1
+  done
+  kill -KILL "$3"
+  wait "$3" 2>/dev/null || true
+}
 
 # The shipped configuration, with a faster poll for the test.
 sed 's/^poll = .*/poll = 0.5/' examples/batch/slurm.toml > "$W/slurm.toml"
@@ -103,13 +119,7 @@ slow_config 2
 "$IMPACTCAL" batch --config "$W/slow.toml" --points "$W/good.csv" --out "$W/three" 2> /dev/null &
 DRIVER=$!
 J="$W/three/runs/strip/journal.jsonl"
-for _ in $(seq 1 300); do
-  n=$(grep -c '"event":"result"' "$J" 2>/dev/null || true)
-  [ "${n:-0}" -ge 2 ] && break
-  sleep 0.1
-done
-kill -KILL $DRIVER
-wait $DRIVER 2>/dev/null || true
+kill_after_results "$J" 2 $DRIVER
 left=$(squeue -h -r -o %i | wc -l)
 echo "driver killed with $(grep -c '"event":"result"' "$J") results in the journal and $left tasks in the queue"
 [ "$left" -gt 0 ] || fail "the array finished before the kill"
@@ -118,6 +128,33 @@ grep -c '"event":"slurm_job"' "$J" | grep -qx 1 || fail "tasks were resubmitted 
 for i in 0 1 2 3 4 5; do
   cmp "$W/one/runs/strip/$i/result.csv" "$W/three/runs/strip/$i/result.csv" || fail "run $i differs"
 done
+
+echo "== 4. a study on Slurm: SIGKILL mid-ensemble, resume, the same study.json"
+S="$W/study"
+mkdir -p "$S"
+cp examples/study/bounds.csv examples/study/test.csv "$S/"
+# Our solver after a pause of 1 s, so that the kill finds tasks queued or running.
+SLOW="command = [\"sh\", \"-c\", 'sleep 1; exec \"\$0\" simulate --deck strip.k --out out.csv', \"$IMPACTCAL\"]"
+sed -e 's/^poll = .*/poll = 0.5/' -e "s|^template = .*|template = \"$W/strip.k\"\n$SLOW|" \
+  examples/study/slurm.toml > "$S/slurm.toml"
+# The same study on the local process pool: the reference.
+sed -e '/^\[executor\]/,$d' "$S/slurm.toml" > "$S/local.toml"
+printf '[executor]\nkind = "processes"\njobs = 2\n' >> "$S/local.toml"
+"$IMPACTCAL" study --config "$S/local.toml" --out "$S/reference" 2> "$S/reference.err" \
+  || { cat "$S/reference.err"; fail "the reference study"; }
+"$IMPACTCAL" study --config "$S/slurm.toml" --out "$S/slurm" 2> /dev/null &
+DRIVER=$!
+J="$S/slurm/runs/ensemble/journal.jsonl"
+kill_after_results "$J" 2 $DRIVER
+left=$(squeue -h -r -o %i | wc -l)
+echo "study killed with $(grep -c '"event":"result"' "$J") of 12 ensemble results in the journal and $left tasks in the queue"
+[ "$left" -gt 0 ] || fail "the ensemble finished before the kill"
+[ ! -e "$S/slurm/study.json" ] || fail "the study finished before the kill"
+"$IMPACTCAL" study --config "$S/slurm.toml" --out "$S/slurm" 2> "$S/resume.err" \
+  || { cat "$S/resume.err"; fail "the resumed study"; }
+grep 'ensemble: 12 runs' "$S/resume.err"
+grep -c '"event":"slurm_job"' "$J" | grep -qx 1 || fail "the ensemble was resubmitted instead of re-attached"
+cmp "$S/reference/study.json" "$S/slurm/study.json" || fail "the resumed study differs from the reference"
 
 if [ "$OVERHEAD" -gt 0 ]; then
   echo "== overhead: $OVERHEAD trivial tasks"

@@ -92,6 +92,9 @@ pub enum CalibrateError {
         /// What went wrong.
         message: String,
     },
+    /// From the runner that executes a study's runs (its journal, its executor).
+    #[error(transparent)]
+    Runner(#[from] impactcal_runner::RunnerError),
 }
 
 /// `Result` with [`CalibrateError`].
@@ -142,6 +145,7 @@ impl CalibrateError {
             CalibrateError::Sobol(e) => e.kind(),
             CalibrateError::Cors(e) => e.kind(),
             CalibrateError::Journal { .. } => ErrorKind::Io,
+            CalibrateError::Runner(e) => e.kind(),
         }
     }
 }

@@ -107,6 +107,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             test: test.clone(),
             map: None,
             cfc,
+            runner: None,
         })
     };
     let table1 = StudyOptions {
@@ -201,7 +202,7 @@ pub fn demo_report(
 ) -> Report {
     let geometry = match &setup.model {
         Built::Airframe(_, g) => Some(g),
-        Built::Deck(_) => None,
+        Built::Deck(_) | Built::Solver => None,
     };
     let first = report(t1, None);
     let second = report(t2, geometry);

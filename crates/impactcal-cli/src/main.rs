@@ -77,6 +77,9 @@ enum Command {
     /// The calibration study of a model against a test (M1, sensors, M2, surrogates,
     /// sensitivity, CORS-RBF reconciliation) from a TOML study file; runs are journaled.
     Study(study::Args),
+    /// Runs the built-in model of a study file at the point of a run's `params.json` and
+    /// writes its histories (what the processes and slurm executors run for each point).
+    StudyPoint(study::PointArgs),
     /// The source paper's study on the coarse airframe against a test with hidden changes:
     /// Table 1 screened by M1, Table 2 studied and reconciled, the changes revealed.
     Demo(demo::Args),
@@ -102,6 +105,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Filter(a) => filter::run(a),
         Command::Metrics(a) => metrics::run(a),
         Command::Study(a) => study::run(a),
+        Command::StudyPoint(a) => study::run_point(a),
         Command::Demo(a) => demo::run(a),
         Command::Batch(a) => batch::run(a),
     }

@@ -23,7 +23,19 @@
 //! sensitivity_samples = 1024
 //! reconcile_runs = 60
 //! seed = 1
+//!
+//! [executor]                     # optional; the tables `impactcal batch` reads
+//! kind = "processes"             # "local" (default) | "processes" | "slurm"
+//! jobs = 2
+//!
+//! [batch]                        # optional
+//! retries = 2                    # further attempts of a failing run
 //! ```
+//!
+//! Instead of `[model]`, a `[solver]` table (as in a batch configuration: a deck template
+//! and a command) runs an external solver; `[space] bounds` then names its parameters.
+//! With `kind = "processes"` or `"slurm"`, a built-in model runs as `impactcal study-point
+//! --config <this file>` in each run's directory.
 
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
@@ -33,13 +45,16 @@ use std::sync::Mutex;
 use clap::Args as ClapArgs;
 use impactcal::calibrate::report::{Report, ReportFiles};
 use impactcal::calibrate::study::document::{Geometry, report};
-use impactcal::calibrate::study::journal::fingerprint;
 use impactcal::calibrate::study::{
-    Observer, StudyOptions, StudyResult, Subspace, TestData, ValidStudyOptions, run_model,
+    Executor, InProcess, Observer, Runner, StudyOptions, StudyResult, Subspace, TestData,
+    ValidStudyOptions,
 };
 use impactcal::core::{
     Cfc, ChannelMap, Histories, IsoMme, Model, ParamGuard, Parameter, ParameterSpace, TestRecord,
 };
+use impactcal::runner::config::{BatchSection, ExecutorSection, SolverSection};
+use impactcal::runner::workdir::RunRecord;
+use impactcal::runner::{Cancel, OutputSpec, Solver, SolverCommand, fingerprint};
 use impactcal::shell::DeckModel;
 use impactcal::shell::airframe::{
     Airframe, AirframeModel, AirframeOptions, AirframeValues, MeshDensity, Preset, catalogue,
@@ -72,8 +87,14 @@ pub struct Args {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Config {
-    /// The model.
-    pub model: ModelConfig,
+    /// The built-in model (or `solver`).
+    pub model: Option<ModelConfig>,
+    /// An external solver (or `model`), as in a batch configuration.
+    pub solver: Option<SolverSection>,
+    /// Where the runs happen (default: in this process).
+    pub executor: Option<ExecutorSection>,
+    /// Retries (the `[batch]` table of a batch configuration; its `study` does not apply).
+    pub batch: Option<BatchSection>,
     /// Deck quantities under study names.
     #[serde(default)]
     pub parameters: BTreeMap<String, String>,
@@ -130,6 +151,8 @@ pub enum Built {
     Airframe(Box<Subspace<AirframeModel>>, Geometry),
     /// A deck restricted to the study's quantities.
     Deck(Box<Subspace<DeckModel>>),
+    /// An external solver (no model in this process).
+    Solver,
 }
 
 /// Everything a study needs besides its options.
@@ -144,25 +167,41 @@ pub struct Setup {
     pub map: Option<ChannelMap>,
     /// The CFC class.
     pub cfc: Option<Cfc>,
+    /// Runs through a solver command on an executor (an external solver, or a built-in
+    /// model on a process pool or Slurm); `None`: the built-in model in this process.
+    pub runner: Option<Runner>,
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let text = std::fs::read_to_string(&args.config)
-        .map_err(|e| CliError::io(format!("{}: {e}", args.config.display())))?;
-    let name = args.config.display().to_string();
-    let config: Config = toml::from_str(&text)
-        .map_err(|e| CliError::input(format!("{name}: {}", one_line(&e.to_string()))))?;
+    let (config, name) = read_config(&args.config)?;
     let base = args.config.parent().unwrap_or(Path::new("."));
     let options = config
         .study
         .clone()
         .check()
         .map_err(|e| CliError::from(e).context(&name))?;
-    let setup = setup(&config, base).map_err(|e| e.context(&name))?;
+    let mut setup = setup(&config, base).map_err(|e| e.context(&name))?;
+    setup.runner = runner(&config, &args.config, base, &setup).map_err(|e| e.context(&name))?;
+    if let Some(r) = &setup.runner {
+        let handler = r.cancel.clone();
+        // A second handler cannot be installed (tests call `run` more than once): Ctrl-C
+        // then keeps its default action, which loses nothing either.
+        let _ = ctrlc::set_handler(move || handler.cancel());
+    }
     let pool = thread_pool(args.threads)?;
     let result = pool.install(|| execute(&setup, &options, &args.out))?;
     finish(&result, &setup, &args.out)
+}
+
+/// Reads a study file; returns it with its name for messages.
+fn read_config(path: &Path) -> Result<(Config, String), CliError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
+    let name = path.display().to_string();
+    let config: Config = toml::from_str(&text)
+        .map_err(|e| CliError::input(format!("{name}: {}", one_line(&e.to_string()))))?;
+    Ok((config, name))
 }
 
 /// Writes `study.json`, the report (`report.html`, `report.md` and its SVG figures) and
@@ -193,7 +232,7 @@ pub fn write_report(doc: &Report, out: &Path) -> Result<ReportFiles, CliError> {
 pub fn study_report(result: &StudyResult, setup: &Setup) -> Report {
     let geometry = match &setup.model {
         Built::Airframe(_, g) => Some(g),
-        Built::Deck(_) => None,
+        Built::Deck(_) | Built::Solver => None,
     };
     report(result, geometry)
 }
@@ -211,26 +250,138 @@ pub fn execute(
         cfc: setup.cfc,
     };
     let progress = Progress::new();
-    let result = match &setup.model {
-        Built::Airframe(m, _) => run_model(
-            m.as_ref(),
+    let run = |executor: &dyn Executor| {
+        impactcal::calibrate::study::run(
+            executor,
             &setup.description,
             test,
             options,
             out,
             &progress,
-        ),
-        Built::Deck(m) => run_model(
-            m.as_ref(),
-            &setup.description,
-            test,
-            options,
-            out,
-            &progress,
-        ),
+        )
+    };
+    let result = match (&setup.runner, &setup.model) {
+        (Some(r), _) => run(r),
+        (None, Built::Airframe(m, _)) => run(&InProcess(m.as_ref())),
+        (None, Built::Deck(m)) => run(&InProcess(m.as_ref())),
+        (None, Built::Solver) => Err(impactcal::calibrate::CalibrateError::study(
+            "[solver]",
+            "an external solver needs an executor",
+        )),
     };
     progress.done();
     Ok(result?)
+}
+
+/// The runner of a study file whose runs go through a solver command: an external
+/// `[solver]` on any executor, or the built-in model on a process pool or Slurm (each run
+/// `impactcal study-point --config <file>` in its directory). `None` for the built-in model
+/// in this process.
+fn runner(
+    config: &Config,
+    path: &Path,
+    base: &Path,
+    setup: &Setup,
+) -> Result<Option<Runner>, CliError> {
+    let section = config.executor.clone().unwrap_or(ExecutorSection::Local);
+    let retries = match &config.batch {
+        Some(b) if b.study != BatchSection::default().study => {
+            return Err(CliError::input(
+                "[batch] study does not apply to a study file: its runs go to <out>/runs/<stage>/",
+            ));
+        }
+        Some(b) => b.retries,
+        None => BatchSection::default().retries,
+    };
+    let exe = std::env::current_exe()
+        .map_err(|e| CliError::failure(format!("cannot find the impactcal program: {e}")))?;
+    let solver = match (&config.solver, &section) {
+        (Some(s), _) => s.solver(base, path, &section, Some(&exe))?,
+        (None, ExecutorSection::Local) => return Ok(None),
+        (None, _) => {
+            let config = std::fs::canonicalize(path)
+                .map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
+            let mut output = OutputSpec::csv("out.csv");
+            output.unit = Some("velocity".into());
+            Solver {
+                inputs: Vec::new(),
+                command: SolverCommand::Argv(vec![
+                    exe.display().to_string(),
+                    "study-point".into(),
+                    "--config".into(),
+                    config.display().to_string(),
+                ]),
+                output,
+            }
+        }
+    };
+    let space = match &setup.model {
+        Built::Airframe(m, _) => m.space().clone(),
+        Built::Deck(m) => m.space().clone(),
+        Built::Solver => study_space(config, base)?.ok_or_else(|| {
+            CliError::input("[space]: an external solver needs `bounds = \"bounds.csv\"`")
+        })?,
+    };
+    Ok(Some(Runner {
+        space,
+        solver,
+        executor: section.executor(),
+        retries,
+        cancel: Cancel::new(),
+    }))
+}
+
+/// Arguments of `impactcal study-point`.
+#[derive(ClapArgs, Debug)]
+pub struct PointArgs {
+    /// The study file whose built-in model is run.
+    #[arg(long)]
+    pub config: PathBuf,
+    /// The run's parameters: the `params.json` the runner writes in each run's directory.
+    #[arg(long, default_value = "params.json")]
+    pub params: PathBuf,
+    /// Where the histories go (our wide CSV).
+    #[arg(long, default_value = "out.csv")]
+    pub out: PathBuf,
+    /// Number of threads of the solver.
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+/// Runs the built-in model of a study file at the point of a run's `params.json` and
+/// writes its histories: what a process-pool or Slurm executor runs for each point.
+pub fn run_point(args: PointArgs) -> Result<(), CliError> {
+    let (config, name) = read_config(&args.config)?;
+    let base = args.config.parent().unwrap_or(Path::new("."));
+    let (model, _) = build_model(&config, base).map_err(|e| e.context(&name))?;
+    let record: RunRecord = serde_json::from_str(
+        &std::fs::read_to_string(&args.params)
+            .map_err(|e| CliError::io(format!("{}: {e}", args.params.display())))?,
+    )
+    .map_err(|e| CliError::input(format!("{}: {e}", args.params.display())))?;
+    let simulate = |m: &dyn Model| -> Result<Histories, CliError> {
+        let names = m.space().names();
+        if names != record.names {
+            return Err(CliError::input(format!(
+                "{}: parameters {:?}, but the study's model takes {:?}",
+                args.params.display(),
+                record.names,
+                names
+            )));
+        }
+        m.space().to_unit(&record.values)?;
+        Ok(m.simulate(&record.values)?)
+    };
+    let pool = thread_pool(args.threads)?;
+    let h = pool.install(|| match &model {
+        Built::Airframe(m, _) => simulate(m.as_ref()),
+        Built::Deck(m) => simulate(m.as_ref()),
+        Built::Solver => Err(CliError::input(
+            "study-point runs the built-in model of a study file; this one names a [solver]",
+        )),
+    })?;
+    h.write_csv(&args.out)?;
+    Ok(())
 }
 
 fn one_line(s: &str) -> String {
@@ -251,15 +402,7 @@ fn resolve(base: &Path, p: &Path) -> PathBuf {
 /// # Errors
 /// Bad input naming what is wrong.
 pub fn setup(config: &Config, base: &Path) -> Result<Setup, CliError> {
-    let (model, description) = match (&config.model.airframe, &config.model.deck) {
-        (Some(mesh), None) => airframe(config, mesh, base)?,
-        (None, Some(deck)) => deck_model(config, &resolve(base, deck), base)?,
-        _ => {
-            return Err(CliError::input(
-                "[model]: give either `airframe = \"coarse\"` or `deck = \"model.k\"`",
-            ));
-        }
-    };
+    let (model, description) = build_model(config, base)?;
     let data = resolve(base, &config.test.data);
     let test = read_test(&data)?;
     let map = config
@@ -275,7 +418,54 @@ pub fn setup(config: &Config, base: &Path) -> Result<Setup, CliError> {
         test,
         map,
         cfc,
+        runner: None,
     })
+}
+
+/// The model of a study file and its description (which enters the study's fingerprint).
+fn build_model(config: &Config, base: &Path) -> Result<(Built, String), CliError> {
+    let none = ModelConfig {
+        airframe: None,
+        deck: None,
+        end_time: None,
+        set: BTreeMap::new(),
+    };
+    let model = config.model.as_ref().unwrap_or(&none);
+    match (&model.airframe, &model.deck, &config.solver) {
+        (Some(mesh), None, None) => airframe(config, model, mesh, base),
+        (None, Some(deck), None) => deck_model(config, model, &resolve(base, deck), base),
+        (None, None, Some(solver)) if config.model.is_none() => external(config, solver, base),
+        _ => Err(CliError::input(
+            "[model]: give either `airframe = \"coarse\"` or `deck = \"model.k\"`, or a \
+             [solver] table instead of [model]",
+        )),
+    }
+}
+
+/// An external solver: its description fingerprints the `[solver]` table and the text of
+/// its templates, so that a changed deck or command is another study.
+fn external(
+    config: &Config,
+    solver: &SolverSection,
+    base: &Path,
+) -> Result<(Built, String), CliError> {
+    if !config.parameters.is_empty() {
+        return Err(CliError::input(
+            "[parameters] maps deck quantities of a built-in deck model; an external solver's \
+             parameters are its template's",
+        ));
+    }
+    let mut bytes = serde_json::to_vec(solver).unwrap_or_default();
+    for p in std::iter::once(&solver.template).chain(&solver.inputs) {
+        let p = resolve(base, p);
+        bytes.extend(std::fs::read(&p).map_err(|e| CliError::io(format!("{}: {e}", p.display())))?);
+    }
+    let description = format!(
+        "solver {} ({})",
+        solver.template.display(),
+        fingerprint(&bytes)
+    );
+    Ok((Built::Solver, description))
 }
 
 /// A test file: an ISO-MME data set (a folder, an `.mme` file or a zip) or wide CSV.
@@ -313,20 +503,25 @@ fn study_space(config: &Config, base: &Path) -> Result<Option<ParameterSpace>, C
     }
 }
 
-fn airframe(config: &Config, mesh: &str, base: &Path) -> Result<(Built, String), CliError> {
+fn airframe(
+    config: &Config,
+    model: &ModelConfig,
+    mesh: &str,
+    base: &Path,
+) -> Result<(Built, String), CliError> {
     if !config.parameters.is_empty() {
         return Err(CliError::input(
             "[parameters] maps deck quantities; the airframe's names are its catalogue's",
         ));
     }
     let mut options = AirframeOptions::new(MeshDensity::parse(mesh).map_err(CliError::input)?);
-    if let Some(t) = config.model.end_time {
+    if let Some(t) = model.end_time {
         options.end_time = t;
         options.output_interval = options.output_interval.min(t);
     }
     let airframe = Airframe::new(options).map_err(CliError::input)?;
     let mut values = AirframeValues::nominal();
-    for (k, v) in &config.model.set {
+    for (k, v) in &model.set {
         values.set(k, *v).map_err(CliError::input)?;
     }
     let Some(space) = study_space(config, base)? else {
@@ -342,11 +537,11 @@ fn airframe(config: &Config, mesh: &str, base: &Path) -> Result<(Built, String),
         .collect::<Result<_, _>>()
         .map_err(CliError::input)?;
     let geometry = geometry_of(&airframe);
-    let model = AirframeModel::new(airframe, full).map_err(CliError::input)?;
-    let sub = Subspace::new(model, space)?.with_base(base_point)?;
+    let solver = AirframeModel::new(airframe, full).map_err(CliError::input)?;
+    let sub = Subspace::new(solver, space)?.with_base(base_point)?;
     let description = format!(
         "built-in airframe, {mesh} mesh, {} s, set {:?}",
-        options.end_time, config.model.set
+        options.end_time, model.set
     );
     Ok((Built::Airframe(Box::new(sub), geometry), description))
 }
@@ -372,8 +567,13 @@ pub fn geometry_of(airframe: &Airframe) -> Geometry {
     }
 }
 
-fn deck_model(config: &Config, path: &Path, base: &Path) -> Result<(Built, String), CliError> {
-    if !config.model.set.is_empty() || config.model.end_time.is_some() {
+fn deck_model(
+    config: &Config,
+    model_config: &ModelConfig,
+    path: &Path,
+    base: &Path,
+) -> Result<(Built, String), CliError> {
+    if !model_config.set.is_empty() || model_config.end_time.is_some() {
         return Err(CliError::input(
             "[model]: `set` and `end_time` apply to the airframe; edit the deck instead",
         ));

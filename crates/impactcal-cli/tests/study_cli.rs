@@ -52,6 +52,15 @@ fn study(config: &Path, out: &Path) -> std::process::Output {
     ])
 }
 
+/// The results a runner journal records (complete lines only).
+fn results_in(journal: &Path) -> usize {
+    std::fs::read_to_string(journal).map_or(0, |t| {
+        t.lines()
+            .filter(|l| l.starts_with("{\"event\":\"result\""))
+            .count()
+    })
+}
+
 const STRIP: &str = "ensemble = 160\nsensors = 3\nshapes = 2\nsensitivity_samples = 64\n\
                      reconcile_runs = 6\nnoise_runs = 3";
 
@@ -68,32 +77,12 @@ fn a_killed_study_resumes_to_the_uninterrupted_result() {
     );
 
     let killed = dir.path().join("killed");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_impactcal"))
-        .args([
-            "study",
-            "--config",
-            config.to_str().unwrap(),
-            "--out",
-            killed.to_str().unwrap(),
-        ])
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let ensemble = killed.join("journal/ensemble");
-    let count = || {
-        std::fs::read_dir(&ensemble).map_or(0, |d| {
-            d.filter_map(Result::ok)
-                .filter(|e| e.path().extension().is_some_and(|x| x == "run"))
-                .count()
-        })
-    };
-    let start = Instant::now();
-    while count() < 10 && start.elapsed() < Duration::from_secs(60) {
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    child.kill().unwrap(); // SIGKILL
-    child.wait().unwrap();
-    let done = count();
+    let done = kill_study_after(
+        &config,
+        &killed,
+        &killed.join("runs/ensemble/journal.jsonl"),
+        10,
+    );
     assert!(
         (10..160).contains(&done),
         "killed after {done} of 160 ensemble runs"
@@ -260,4 +249,139 @@ fn bad_input_exits_with_code_two_and_writes_nothing() {
     let c = variant("seed.toml", "ensemble = 4", "ensemble = 4\nseed = 9");
     refused(&c, &out, "another study");
     assert_eq!(std::fs::read(out.join("study.json")).unwrap(), before);
+}
+
+/// Spawns `impactcal study`, SIGKILLs it once `journal` records `after` results, and
+/// returns how many it had recorded by then.
+fn kill_study_after(config: &Path, out: &Path, journal: &Path, after: usize) -> usize {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_impactcal"))
+        .args([
+            "study",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while results_in(journal) < after && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    results_in(journal)
+}
+
+#[test]
+fn a_study_on_the_process_pool_killed_and_resumed_is_identical() {
+    // Our own `impactcal simulate --deck` as an external solver, two processes at a time.
+    let config = example_file("study", "processes.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole");
+    let out = study(&config, &whole);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let killed = dir.path().join("killed");
+    let journal = killed.join("runs/ensemble/journal.jsonl");
+    let done = kill_study_after(&config, &killed, &journal, 8);
+    assert!((8..40).contains(&done), "killed after {done} of 40 runs");
+    assert!(!killed.join("study.json").exists());
+    // Every result the journal holds was recorded as submitted before it.
+    let text = std::fs::read_to_string(&journal).unwrap();
+    let mut submitted = std::collections::BTreeSet::new();
+    for line in text.lines() {
+        let e: serde_json::Value = serde_json::from_str(line).unwrap();
+        let index = e["index"].as_u64();
+        match e["event"].as_str().unwrap() {
+            "submit" => {
+                submitted.insert(index.unwrap());
+            }
+            "result" => assert!(submitted.contains(&index.unwrap()), "{line}"),
+            _ => {}
+        }
+    }
+
+    let out = study(&config, &killed);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(&format!("ensemble: 40 runs ({done} from the journal)")),
+        "{stderr}"
+    );
+    let a = std::fs::read_to_string(whole.join("study.json")).unwrap();
+    let b = std::fs::read_to_string(killed.join("study.json")).unwrap();
+    assert_eq!(a, b);
+    let r: serde_json::Value = serde_json::from_str(&a).unwrap();
+    assert_eq!(r["m1"]["n_runs"], 40);
+    assert_eq!(r["reconcile"]["runs"], 4);
+    // Each run kept its files: the rendered deck, the solver's exit status, the result.
+    let run = killed.join("runs/ensemble/0");
+    for f in [
+        "strip.k",
+        "exit_status",
+        "stdout.txt",
+        "params.json",
+        "result.csv",
+    ] {
+        assert!(run.join(f).is_file(), "{f}");
+    }
+}
+
+#[test]
+fn a_built_in_model_on_the_process_pool_equals_the_in_process_study() {
+    // `impactcal study-point` runs the deck model in each run's directory.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(example_file("study", "deck-processes.toml")).unwrap();
+    let deck = example_file("decks", "strip_drop.k");
+    let test = example_file("study", "test.csv");
+    let text = text
+        .replace("\"../decks/strip_drop.k\"", &format!("{deck:?}"))
+        .replace("\"test.csv\"", &format!("{test:?}"));
+    let processes = dir.path().join("processes.toml");
+    std::fs::write(&processes, &text).unwrap();
+    let local = dir.path().join("local.toml");
+    std::fs::write(
+        &local,
+        text.replace("kind = \"processes\"", "kind = \"local\""),
+    )
+    .unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    for (config, out) in [(&processes, &a), (&local, &b)] {
+        let o = study(config, out);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    assert_eq!(
+        std::fs::read_to_string(a.join("study.json")).unwrap(),
+        std::fs::read_to_string(b.join("study.json")).unwrap()
+    );
+    // The process pool ran a process per point (its standard output kept), the local
+    // executor none.
+    assert!(a.join("runs/ensemble/3/stdout.txt").is_file());
+    assert!(!b.join("runs/ensemble/3/stdout.txt").exists());
+    // A worker given a point of another space says so.
+    let run = a.join("runs/ensemble/3");
+    let params = std::fs::read_to_string(run.join("params.json"))
+        .unwrap()
+        .replace("\"thickness\"", "\"thick\"");
+    std::fs::write(dir.path().join("params.json"), params).unwrap();
+    let o = impactcal(&[
+        "study-point",
+        "--config",
+        processes.to_str().unwrap(),
+        "--params",
+        dir.path().join("params.json").to_str().unwrap(),
+        "--out",
+        dir.path().join("o.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("thick") && e.contains("study's model takes"),
+        "{e}"
+    );
 }

@@ -11,7 +11,7 @@ use impactcal_core::{Histories, PointRows};
 
 use crate::error::{Result, RunnerError, io, run_io};
 use crate::journal::{Entry, Journal};
-use crate::solver::Solver;
+use crate::solver::{Solver, SolverCommand};
 use crate::template::{Template, check_names};
 use crate::workdir::{self, RunRecord, now, read_exit_status, run_dir, write_atomic};
 
@@ -46,6 +46,7 @@ pub struct Batch {
     names: Vec<String>,
     points: Vec<Vec<f64>>,
     retries: u32,
+    identity: Option<String>,
 }
 
 impl Batch {
@@ -82,7 +83,10 @@ impl Batch {
         }
         solver.check("configuration")?;
         let templates: Vec<&Template> = solver.inputs.iter().map(|(t, _)| t).collect();
-        check_names(&templates, &names)?;
+        // Without templates the names reach the solver only through `params.json`.
+        if !templates.is_empty() {
+            check_names(&templates, &names)?;
+        }
         let points = points.into();
         if points.is_empty() {
             return Err(impactcal_core::CoreError::Empty {
@@ -111,6 +115,7 @@ impl Batch {
             names,
             points: rows,
             retries: 2,
+            identity: None,
         })
     }
 
@@ -134,6 +139,16 @@ impl Batch {
     #[must_use]
     pub fn with_retries(mut self, retries: u32) -> Self {
         self.retries = retries;
+        self
+    }
+
+    /// The same batch whose journal is tied to `identity` instead of the solver's
+    /// fingerprint: a caller that knows what decides the results (a study's fingerprint,
+    /// which covers its model) may then run the batch on another executor, whose solver
+    /// command differs, and still resume it.
+    #[must_use]
+    pub fn with_identity(mut self, identity: impl Into<String>) -> Self {
+        self.identity = Some(identity.into());
         self
     }
 
@@ -162,17 +177,46 @@ impl Batch {
         &self.solver
     }
 
+    /// The coordinates of run `index`.
+    pub(crate) fn point(&self, index: usize) -> &[f64] {
+        &self.points[index]
+    }
+
     /// The study name.
     pub fn study(&self) -> &str {
         &self.study
     }
 }
 
-/// The outcome of a batch: one entry per point, in input order.
+/// Where the result of a finished run is: its histories in our CSV, and their unit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunResult {
+    /// `<out>/runs/<study>/<index>/result.csv`.
+    pub file: PathBuf,
+    /// The unit of the histories.
+    pub unit: String,
+}
+
+impl RunResult {
+    /// Reads the histories back, exactly as the batch handed them out.
+    ///
+    /// # Errors
+    /// [`RunnerError::Core`] when the file cannot be read or parsed (it was removed or
+    /// edited since).
+    pub fn read(&self) -> Result<Histories> {
+        Ok(Histories::read_csv(&self.file)?.with_unit(self.unit.clone()))
+    }
+}
+
+/// The outcome of a batch: one entry per point, in input order. The histories are not held
+/// (a batch of 10,000 runs of 30 channels x 1,000 samples would hold 2.4 GB): they go to
+/// [`Hooks::finished`] as each run finishes, and stay in each run's `result.csv`
+/// ([`BatchReport::histories`]).
 #[derive(Debug)]
 pub struct BatchReport {
-    /// `runs[i]`: the histories of run `i`, or why it failed (naming the run and the file).
-    pub runs: Vec<Result<Histories, RunnerError>>,
+    /// `runs[i]`: where the histories of run `i` are, or why it failed (naming the run and
+    /// the file).
+    pub runs: Vec<Result<RunResult, RunnerError>>,
     /// `reused[i]`: the result was found finished in the journal (a resumed batch).
     pub reused: Vec<bool>,
     /// `attempts[i]`: the number of the attempt that gave the outcome (1-based, counted
@@ -181,6 +225,26 @@ pub struct BatchReport {
 }
 
 impl BatchReport {
+    /// The histories of run `index`, read back from its result file.
+    ///
+    /// # Errors
+    /// The run's error when it failed (as text, in [`RunnerError::Output`]); an index out of
+    /// range; [`RunResult::read`]'s errors.
+    pub fn histories(&self, index: usize) -> Result<Histories> {
+        match self.runs.get(index) {
+            Some(Ok(r)) => r.read(),
+            Some(Err(e)) => Err(RunnerError::Output {
+                run: index,
+                path: PathBuf::new(),
+                message: e.to_string(),
+            }),
+            None => Err(RunnerError::Config {
+                file: "batch".into(),
+                message: format!("no run {index} (the batch has {})", self.runs.len()),
+            }),
+        }
+    }
+
     /// The failed runs.
     pub fn failures(&self) -> impl Iterator<Item = (usize, &RunnerError)> {
         self.runs
@@ -201,9 +265,36 @@ pub(crate) struct InFlight {
     pub slurm: Option<(String, Option<String>, usize)>,
 }
 
+/// Called with each run's final outcome: the histories (moved to the caller, exactly as a
+/// resumed batch reads them back) or the error. Runs reused from the journal come first, in
+/// index order; then runs as they finish, from any thread.
+pub type OnFinished<'a> = dyn Fn(usize, std::result::Result<Histories, &RunnerError>) + Sync + 'a;
+
+/// What a caller hooks into [`run_batch_with`](crate::run_batch_with).
+#[derive(Clone, Copy, Default)]
+pub struct Hooks<'a> {
+    /// The model that [`SolverCommand::InProcess`] runs.
+    pub model: Option<&'a dyn impactcal_core::Model>,
+    /// Called once the journal is read, before any run: the number of runs the journal
+    /// holds as finished (they are reused unless their result file no longer reads).
+    pub opened: Option<&'a (dyn Fn(usize) + Sync)>,
+    /// Called with each run's final outcome.
+    pub finished: Option<&'a OnFinished<'a>>,
+}
+
+impl std::fmt::Debug for Hooks<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Hooks")
+            .field("model", &self.model.is_some())
+            .field("opened", &self.opened.is_some())
+            .field("finished", &self.finished.is_some())
+            .finish()
+    }
+}
+
 #[derive(Debug)]
 struct State {
-    results: Vec<Option<Result<Histories, RunnerError>>>,
+    results: Vec<Option<Result<RunResult, RunnerError>>>,
     reused: Vec<bool>,
     last_attempt: Vec<u32>,
     session_attempts: Vec<u32>,
@@ -214,6 +305,7 @@ pub(crate) struct Driver<'a> {
     pub batch: &'a Batch,
     pub cancel: &'a Cancel,
     pub executor: &'static str,
+    pub hooks: Hooks<'a>,
     journal: Mutex<Journal>,
     state: Mutex<State>,
 }
@@ -227,6 +319,7 @@ impl<'a> Driver<'a> {
         batch: &'a Batch,
         cancel: &'a Cancel,
         executor: &'static str,
+        hooks: Hooks<'a>,
     ) -> Result<(Driver<'a>, Vec<usize>, BTreeMap<usize, InFlight>)> {
         std::fs::create_dir_all(&batch.root).map_err(io(&batch.root))?;
         let path = batch.journal_path();
@@ -235,7 +328,10 @@ impl<'a> Driver<'a> {
             study: batch.study.clone(),
             names: batch.names.clone(),
             points: batch.points.clone(),
-            solver: batch.solver.fingerprint(),
+            solver: batch
+                .identity
+                .clone()
+                .unwrap_or_else(|| batch.solver.fingerprint()),
         };
         match entries.first() {
             None => journal.append(&header)?,
@@ -252,7 +348,7 @@ impl<'a> Driver<'a> {
             }
         }
         let n = batch.len();
-        let mut done: Vec<Option<String>> = vec![None; n];
+        let mut done: Vec<Option<(String, String)>> = vec![None; n];
         let mut last_attempt = vec![0u32; n];
         let mut flight: BTreeMap<usize, InFlight> = BTreeMap::new();
         let mut tokens: BTreeMap<String, Option<String>> = BTreeMap::new();
@@ -290,9 +386,11 @@ impl<'a> Driver<'a> {
                 Entry::SlurmJob { token, job_id } => {
                     tokens.insert(token.clone(), Some(job_id.clone()));
                 }
-                Entry::Result { index, file, .. } if *index < n => {
+                Entry::Result {
+                    index, file, unit, ..
+                } if *index < n => {
                     flight.remove(index);
-                    done[*index] = Some(file.clone());
+                    done[*index] = Some((file.clone(), unit.clone()));
                 }
                 Entry::Failure { index, .. } => {
                     flight.remove(index);
@@ -309,6 +407,7 @@ impl<'a> Driver<'a> {
             batch,
             cancel,
             executor,
+            hooks,
             journal: Mutex::new(journal),
             state: Mutex::new(State {
                 results: (0..n).map(|_| None).collect(),
@@ -317,14 +416,27 @@ impl<'a> Driver<'a> {
                 session_attempts: vec![0; n],
             }),
         };
+        if let Some(opened) = hooks.opened {
+            opened(done.iter().filter(|d| d.is_some()).count());
+        }
+        let in_process = matches!(batch.solver.command, SolverCommand::InProcess { .. });
         let mut pending = Vec::new();
         let mut slurm = BTreeMap::new();
-        for (i, finished) in done.iter().enumerate() {
-            if let Some(file) = finished {
-                if let Ok(h) = Histories::read_csv(batch.root.join(file)) {
-                    let mut s = driver.lock_state();
-                    s.results[i] = Some(Ok(h));
-                    s.reused[i] = true;
+        for (i, finished) in done.into_iter().enumerate() {
+            if let Some((file, unit)) = finished {
+                let result = RunResult {
+                    file: batch.root.join(file),
+                    unit,
+                };
+                if let Ok(h) = result.read() {
+                    {
+                        let mut s = driver.lock_state();
+                        s.results[i] = Some(Ok(result));
+                        s.reused[i] = true;
+                    }
+                    if let Some(f) = hooks.finished {
+                        f(i, Ok(h));
+                    }
                     continue;
                 }
             }
@@ -336,9 +448,10 @@ impl<'a> Driver<'a> {
                     if let Some((pid, ticks)) = f.process {
                         stop_orphan(pid, ticks);
                     }
-                    // Ended while no driver watched: its exit status is on disk.
-                    if read_exit_status(&run_dir(&batch.root, i)).is_some() {
-                        let outcome = driver.collect(i, f.attempt);
+                    // Ended while no driver watched: its exit status is on disk (an
+                    // in-process model is run again: its unit was not kept).
+                    if !in_process && read_exit_status(&run_dir(&batch.root, i)).is_some() {
+                        let outcome = driver.collect(i, f.attempt, None);
                         if !driver.settle(i, f.attempt, outcome)? {
                             let mut s = driver.lock_state();
                             s.reused[i] = true;
@@ -441,8 +554,10 @@ impl<'a> Driver<'a> {
     }
 
     /// Reads the result of run `index` from its directory: the exit status, then the
-    /// output; writes `result.csv` atomically and completes `params.json`.
-    pub fn collect(&self, index: usize, attempt: u32) -> Result<Histories> {
+    /// output (given `unit` when the solver said it); writes `result.csv` atomically and
+    /// completes `params.json`. The histories returned are `result.csv` as written, read
+    /// back, so that a run and its reuse by a resumed batch give the same bits.
+    pub fn collect(&self, index: usize, attempt: u32, unit: Option<String>) -> Result<Histories> {
         let dir = self.dir(index);
         let Some(status) = read_exit_status(&dir) else {
             return Err(RunnerError::Output {
@@ -464,12 +579,18 @@ impl<'a> Driver<'a> {
                 stderr: dir.join(workdir::STDERR),
             })
         };
-        if let Ok(h) = &outcome {
-            let mut text = Vec::new();
-            h.write_csv_to(&mut text, workdir::RESULT)?;
-            let r = dir.join(workdir::RESULT);
-            write_atomic(&r, &text).map_err(run_io(index, r))?;
-        }
+        let outcome = match outcome {
+            Ok(h) => {
+                let unit = unit.unwrap_or_else(|| h.unit().to_string());
+                let mut text = Vec::new();
+                h.write_csv_to(&mut text, workdir::RESULT)?;
+                let r = dir.join(workdir::RESULT);
+                write_atomic(&r, &text).map_err(run_io(index, &r))?;
+                let back = String::from_utf8_lossy(&text);
+                Ok(Histories::parse_csv(&back, &r.display().to_string())?.with_unit(unit))
+            }
+            Err(e) => Err(e),
+        };
         if let Some(mut record) = record.filter(|r| r.attempt == attempt) {
             let t = now();
             record.finished_at = Some(t);
@@ -487,12 +608,20 @@ impl<'a> Driver<'a> {
     pub fn settle(&self, index: usize, attempt: u32, outcome: Result<Histories>) -> Result<bool> {
         match outcome {
             Ok(h) => {
+                let unit = h.unit().to_string();
                 self.record(&Entry::Result {
                     index,
                     attempt,
                     file: format!("{index}/{}", workdir::RESULT),
+                    unit: unit.clone(),
                 })?;
-                self.lock_state().results[index] = Some(Ok(h));
+                self.lock_state().results[index] = Some(Ok(RunResult {
+                    file: self.dir(index).join(workdir::RESULT),
+                    unit,
+                }));
+                if let Some(f) = self.hooks.finished {
+                    f(index, Ok(h));
+                }
                 Ok(false)
             }
             Err(e) => {
@@ -505,6 +634,9 @@ impl<'a> Driver<'a> {
                     retry,
                 })?;
                 if !retry {
+                    if let Some(f) = self.hooks.finished {
+                        f(index, Err(&e));
+                    }
                     self.lock_state().results[index] = Some(Err(e));
                 }
                 Ok(retry)
@@ -517,7 +649,7 @@ impl<'a> Driver<'a> {
     pub fn drive(
         &self,
         index: usize,
-        execute: impl Fn(&Self, usize, u32, &Path) -> Result<i32>,
+        execute: impl Fn(&Self, usize, u32, &Path) -> Result<(i32, Option<String>)>,
     ) -> Result<()> {
         loop {
             if self.cancel.is_cancelled() {
@@ -535,11 +667,11 @@ impl<'a> Driver<'a> {
                     match execute(self, index, attempt, &dir) {
                         Err(e @ RunnerError::Cancelled { .. }) => return Err(e),
                         Err(e) => Err(e),
-                        Ok(status) => {
+                        Ok((status, unit)) => {
                             let p = dir.join(workdir::EXIT_STATUS);
                             write_atomic(&p, format!("{status}\n").as_bytes())
                                 .map_err(run_io(index, p))?;
-                            self.collect(index, attempt)
+                            self.collect(index, attempt, unit)
                         }
                     }
                 }

@@ -163,25 +163,49 @@ impl BatchConfig {
 
     /// The executor.
     pub fn executor(&self) -> Executor {
-        match &self.executor {
+        self.executor.executor()
+    }
+
+    /// The solver: [`SolverSection::solver`] with this file's directory and executor.
+    ///
+    /// # Errors
+    /// As [`SolverSection::solver`].
+    pub fn solver(&self, impactcal: Option<&Path>) -> Result<Solver> {
+        self.solver
+            .solver(&self.base(), &self.source, &self.executor, impactcal)
+    }
+}
+
+impl ExecutorSection {
+    /// The executor this table describes.
+    pub fn executor(&self) -> Executor {
+        match self {
             ExecutorSection::Local => Executor::Local,
             ExecutorSection::Processes(p) => Executor::Processes(p.clone()),
             ExecutorSection::Slurm(s) => Executor::Slurm(s.clone()),
         }
     }
+}
 
-    /// The solver: the templates read, the command resolved. Without a `command`, the
-    /// local executor runs the built-in solver in process and the others run
+impl SolverSection {
+    /// The solver: the templates read (relative to `base`), the command resolved. Without a
+    /// `command`, the local executor runs the built-in solver in process and the others run
     /// `<impactcal> simulate --deck <deck> --out <output> --quantity <q>`, `impactcal` being
-    /// the program given (the running `impactcal` binary).
+    /// the program given (the running `impactcal` binary). `source` names the
+    /// configuration file in messages.
     ///
     /// # Errors
     /// [`RunnerError::Io`] / [`RunnerError::Template`] for a template that cannot be read
     /// or parsed; [`RunnerError::Config`] when the built-in solver is asked of another
     /// executor and no program is given.
-    pub fn solver(&self, impactcal: Option<&Path>) -> Result<Solver> {
-        let s = &self.solver;
-        let base = self.base();
+    pub fn solver(
+        &self,
+        base: &Path,
+        source: &Path,
+        executor: &ExecutorSection,
+        impactcal: Option<&Path>,
+    ) -> Result<Solver> {
+        let s = self;
         let template_path = base.join(&s.template);
         let deck = match &s.deck {
             Some(d) => d.clone(),
@@ -204,13 +228,13 @@ impl BatchConfig {
             NodalQuantity::Velocity => Quantity::Velocity,
             NodalQuantity::Acceleration => Quantity::Acceleration,
         };
-        let command = match (&s.command, &self.executor) {
+        let command = match (&s.command, executor) {
             (Some(argv), _) => SolverCommand::Argv(argv.clone()),
             (None, ExecutorSection::Local) => SolverCommand::BuiltIn { quantity },
             (None, _) => {
                 let Some(exe) = impactcal else {
                     return Err(RunnerError::Config {
-                        file: self.source.display().to_string(),
+                        file: source.display().to_string(),
                         message: "solver.command is required for this executor".into(),
                     });
                 };
@@ -236,7 +260,7 @@ impl BatchConfig {
             command,
             output: s.output.clone(),
         };
-        solver.check(&self.source.display().to_string())?;
+        solver.check(&source.display().to_string())?;
         Ok(solver)
     }
 }

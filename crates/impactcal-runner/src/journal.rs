@@ -19,7 +19,8 @@ use crate::error::{Result, RunnerError, io};
 #[serde(tag = "event", rename_all = "snake_case")]
 pub enum Entry {
     /// The batch: its study, parameter names, points and a fingerprint of the solver
-    /// (templates, command, output). Written once, first.
+    /// (templates, command, output), or of whatever the batch was given as its identity
+    /// ([`Batch::with_identity`](crate::Batch::with_identity)). Written once, first.
     Batch {
         /// Study name.
         study: String,
@@ -74,6 +75,9 @@ pub enum Entry {
         attempt: u32,
         /// The result file.
         file: String,
+        /// The unit of the histories (our CSV does not carry it).
+        #[serde(default)]
+        unit: String,
     },
     /// Run `index` failed; `retry` says whether another attempt follows.
     Failure {
@@ -183,6 +187,7 @@ mod tests {
             index: 0,
             attempt: 1,
             file: "0/result.csv".into(),
+            unit: "in/s".into(),
         };
         j.append(&a).unwrap();
         j.append(&b).unwrap();

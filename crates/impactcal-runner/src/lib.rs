@@ -28,7 +28,7 @@
 //! let points = vec![vec![1.5], vec![-2.0]];
 //! let batch = Batch::new(out.path(), "demo", solver, vec!["a".into()], &points)?;
 //! let report = run_batch(&batch, &Executor::Local, &Cancel::new())?;
-//! let second = report.runs[1].as_ref().map_err(|e| e.to_string())?;
+//! let second = report.histories(1)?;
 //! assert_eq!(second.channel(0), [0.0, -2.0, 0.0]);
 //! // Run again: every result comes from the journal.
 //! let again = run_batch(&batch, &Executor::Local, &Cancel::new())?;
@@ -47,11 +47,11 @@ pub mod solver;
 pub mod template;
 pub mod workdir;
 
-pub use batch::{Batch, BatchReport, Cancel};
+pub use batch::{Batch, BatchReport, Cancel, Hooks, OnFinished, RunResult};
 pub use config::BatchConfig;
 pub use error::{Result, RunnerError};
-pub use executor::{Executor, ProcessOptions, SlurmOptions, run_batch};
+pub use executor::{Executor, ProcessOptions, SlurmOptions, run_batch, run_batch_with};
 pub use model::SolverModel;
 pub use outputs::{NodalQuantity, OutputFormat, OutputSpec};
-pub use solver::{Solver, SolverCommand};
+pub use solver::{Solver, SolverCommand, fingerprint};
 pub use template::Template;

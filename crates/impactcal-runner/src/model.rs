@@ -64,12 +64,14 @@ impl SolverModel {
         let point = vec![params.to_vec()];
         let batch = Batch::new(&self.root, &study, self.solver.clone(), names, &point)?;
         let mut report = run_batch(&batch, &Executor::Local, &Cancel::new())?;
-        report.runs.pop().unwrap_or_else(|| {
-            Err(RunnerError::Config {
+        match report.runs.pop() {
+            Some(Ok(r)) => r.read(),
+            Some(Err(e)) => Err(e),
+            None => Err(RunnerError::Config {
                 file: "model".into(),
                 message: "no run".into(),
-            })
-        })
+            }),
+        }
     }
 }
 

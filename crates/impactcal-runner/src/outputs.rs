@@ -74,6 +74,10 @@ pub struct OutputSpec {
     /// step) is reported as truncated.
     #[serde(default)]
     pub end_time: Option<f64>,
+    /// The unit given to the histories read back (none of the formats carries one); empty
+    /// by default.
+    #[serde(default)]
+    pub unit: Option<String>,
 }
 
 impl OutputSpec {
@@ -87,6 +91,7 @@ impl OutputSpec {
             time_column: None,
             columns: None,
             end_time: None,
+            unit: None,
         }
     }
 
@@ -159,7 +164,10 @@ impl OutputSpec {
                 )));
             }
         }
-        Ok(h)
+        Ok(match &self.unit {
+            Some(u) => h.with_unit(u.clone()),
+            None => h,
+        })
     }
 
     fn parse_user_csv(&self, text: &str, name: &str) -> std::result::Result<Histories, String> {

@@ -20,6 +20,15 @@ pub enum SolverCommand {
         /// The nodal quantity written.
         quantity: Quantity,
     },
+    /// A [`Model`](impactcal_core::Model) in this process: the one handed to
+    /// [`run_batch_with`](crate::run_batch_with) in [`Hooks::model`](crate::Hooks::model),
+    /// called with the run's point; its histories are written to the output file as our CSV
+    /// (a failure's message to `stderr.txt`, exit status 1), as if it were a process. Only
+    /// the in-process executor runs it. `description` names the model in the fingerprint.
+    InProcess {
+        /// What the model is (enters the solver's fingerprint).
+        description: String,
+    },
     /// An external program: `argv[0]` (a path, or a name looked up on `PATH`) with the
     /// arguments `argv[1..]`, started without a shell in the run's directory. Nothing is
     /// substituted into it: the inputs and outputs have fixed names inside the directory.
@@ -27,6 +36,10 @@ pub enum SolverCommand {
 }
 
 /// A solver: templated inputs (the deck first), the command, and the output to read back.
+///
+/// A solver without inputs takes its parameters from the run's `params.json` (the names
+/// and values of the point, see [`RunRecord`](crate::workdir::RunRecord)), as
+/// `impactcal study-point` does for the built-in models.
 #[derive(Debug, Clone)]
 pub struct Solver {
     /// Each template with the file name it is written to in a run's directory.
@@ -38,9 +51,9 @@ pub struct Solver {
 }
 
 impl Solver {
-    /// Checks the solver: at least one input, input names that are plain file names, a
-    /// non-empty command, an output spec inside the directory (and our CSV for the built-in
-    /// solver).
+    /// Checks the solver: input names that are plain file names (and a deck for the
+    /// built-in solver), a non-empty command, an output spec inside the directory (and our
+    /// CSV for the built-in solver and an in-process model).
     ///
     /// # Errors
     /// [`RunnerError::Config`] naming what is wrong.
@@ -49,8 +62,8 @@ impl Solver {
             file: file.to_string(),
             message,
         };
-        if self.inputs.is_empty() {
-            return Err(config("the solver needs a deck template".into()));
+        if self.inputs.is_empty() && matches!(self.command, SolverCommand::BuiltIn { .. }) {
+            return Err(config("the built-in solver needs a deck template".into()));
         }
         for (_, name) in &self.inputs {
             let p = Path::new(name);
@@ -64,7 +77,9 @@ impl Solver {
             SolverCommand::Argv(argv) if argv.is_empty() || argv[0].is_empty() => {
                 return Err(config("the solver command is empty".into()));
             }
-            SolverCommand::BuiltIn { .. } if self.output.format != OutputFormat::Csv => {
+            SolverCommand::BuiltIn { .. } | SolverCommand::InProcess { .. }
+                if self.output.format != OutputFormat::Csv =>
+            {
                 return Err(config(
                     "the built-in solver writes our CSV: the output format must be `csv`".into(),
                 ));
@@ -88,21 +103,34 @@ impl Solver {
         format!("{:016x}", h.0)
     }
 
-    /// Runs the built-in solver in this process on the deck in `dir` and writes the output.
-    /// On failure the message is written to the run's `stderr.txt` and the exit status is
-    /// 1, as if the solver had been a process.
-    pub(crate) fn run_builtin(&self, run: usize, dir: &Path, quantity: Quantity) -> Result<i32> {
-        let deck = dir.join(&self.inputs[0].1);
-        let outcome = (|| -> std::result::Result<Histories, String> {
-            let deck = impactcal_shell::keyword::read_deck(&deck).map_err(|e| e.to_string())?;
-            let mut sim =
-                impactcal_shell::Simulation::new(&deck.model).map_err(|e| e.to_string())?;
-            let result = sim.run().map_err(|e| e.to_string())?;
-            result
-                .histories(quantity)
-                .cloned()
-                .ok_or_else(|| "the deck has no history nodes (*DATABASE_HISTORY_NODE)".to_string())
-        })();
+    /// Runs `model` in this process at `values` and writes its histories to the output file
+    /// in `dir` (our CSV); on failure the message goes to `stderr.txt` and the exit status
+    /// is 1, as if the model had been a process. Returns the exit status and the unit of
+    /// the histories (our CSV does not carry it).
+    pub(crate) fn run_model(
+        &self,
+        run: usize,
+        dir: &Path,
+        model: &dyn impactcal_core::Model,
+        values: &[f64],
+    ) -> Result<(i32, Option<String>)> {
+        let outcome = model
+            .space()
+            .to_unit(values)
+            .and_then(|_| model.simulate(values))
+            .map_err(|e| e.to_string());
+        let unit = outcome.as_ref().ok().map(|h| h.unit().to_string());
+        Ok((self.write_outcome(run, dir, outcome)?, unit))
+    }
+
+    /// Writes an in-process outcome as a process would leave it: the histories to the
+    /// output file, the message of a failure to `stderr.txt`; returns the exit status.
+    fn write_outcome(
+        &self,
+        run: usize,
+        dir: &Path,
+        outcome: std::result::Result<Histories, String>,
+    ) -> Result<i32> {
         let io = crate::error::run_io(run, dir.join(crate::workdir::STDERR));
         match outcome {
             Ok(h) => {
@@ -120,6 +148,35 @@ impl Solver {
             }
         }
     }
+
+    /// Runs the built-in solver in this process on the deck in `dir` and writes the output.
+    /// On failure the message is written to the run's `stderr.txt` and the exit status is
+    /// 1, as if the solver had been a process.
+    pub(crate) fn run_builtin(&self, run: usize, dir: &Path, quantity: Quantity) -> Result<i32> {
+        let deck = dir.join(&self.inputs[0].1);
+        let outcome = (|| -> std::result::Result<Histories, String> {
+            let deck = impactcal_shell::keyword::read_deck(&deck).map_err(|e| e.to_string())?;
+            let mut sim =
+                impactcal_shell::Simulation::new(&deck.model).map_err(|e| e.to_string())?;
+            let result = sim.run().map_err(|e| e.to_string())?;
+            result
+                .histories(quantity)
+                .cloned()
+                .ok_or_else(|| "the deck has no history nodes (*DATABASE_HISTORY_NODE)".to_string())
+        })();
+        self.write_outcome(run, dir, outcome)
+    }
+}
+
+/// A 64-bit FNV-1a fingerprint of `bytes`, as 16 hex digits: what a journal compares to
+/// tell its own batch (or study) from another. Not a cryptographic hash.
+pub fn fingerprint(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= u64::from(*b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
 }
 
 /// FNV-1a, 64 bits: a fingerprint, not a cryptographic hash.

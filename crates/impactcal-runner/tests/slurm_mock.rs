@@ -78,8 +78,8 @@ fn lost_tasks_are_resubmitted() {
     };
     let b = batch(&dir.path().join("out"));
     let report = run_batch(&b, &Executor::Slurm(options), &Cancel::new()).unwrap();
-    for (i, r) in report.runs.iter().enumerate() {
-        let h = r.as_ref().unwrap();
+    for i in 0..report.runs.len() {
+        let h = report.histories(i).unwrap();
         assert_eq!(h.channel(0), [0.0, i as f64 + 0.5, 0.0]);
     }
     assert_eq!(report.attempts, vec![1, 2, 1, 1]);

@@ -191,6 +191,43 @@ fn title_and_id_variants_give_the_model_of_the_plain_cards() {
 }
 
 #[test]
+fn an_spc_id_card_heads_every_node_card_after_it_and_history_ids_take_columns_1_to_10() {
+    // LS-DYNA's layout: one id card (the SPC set's id and heading), then as many node
+    // cards as necessary. Three constrained nodes under one id read as three plain cards.
+    let spc = |header: &str| {
+        format!(
+            "{header}{}{}{}",
+            "         1         0         1         0         0         0         0         0\n",
+            "         2         0         1         0         0         0         0         0\n",
+            "         3         0         0         0         1         0         0         0\n",
+        )
+    };
+    let plain = edit(
+        PLAIN,
+        "*BOUNDARY_SPC_NODE\n$#     nid       cid      dofx      dofy      dofz     dofrx     dofry     dofrz\n         2         0         1         0         0         0         0         0\n",
+        &spc("*BOUNDARY_SPC_NODE\n"),
+    );
+    let with_id = edit(
+        PLAIN,
+        "*BOUNDARY_SPC_NODE\n$#     nid       cid      dofx      dofy      dofz     dofrx     dofry     dofrz\n         2         0         1         0         0         0         0         0\n",
+        &spc("*BOUNDARY_SPC_NODE_ID\n        10clamped edge 2\n"),
+    );
+    let a = parse_deck(&plain, "plain.k").unwrap().model;
+    let b = parse_deck(&with_id, "id.k").unwrap().model;
+    assert_eq!(a.spcs.len(), 3);
+    assert_eq!(b.spcs, a.spcs);
+    // History nodes: the id is columns 1-10, the heading (digits and all) the rest; comma
+    // separated cards too.
+    let history = edit(
+        PLAIN,
+        "*DATABASE_HISTORY_NODE\n$#     id1       id2       id3       id4       id5       id6       id7       id8\n         3         6\n",
+        "*DATABASE_HISTORY_NODE_ID\n         3gauge 12 at 45 deg\n6,other corner\n",
+    );
+    let h = parse_deck(&history, "h.k").unwrap().model;
+    assert_eq!(h.output.history_nodes, [3, 6]);
+}
+
+#[test]
 fn includes_are_read_relative_to_the_including_file_nested_and_cycles_are_errors() {
     let dir = scratch("include");
     std::fs::create_dir_all(dir.join("mesh")).unwrap();

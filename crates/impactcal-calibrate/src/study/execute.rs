@@ -1,26 +1,64 @@
 //! How the study's true-model runs are executed: one small seam ([`Executor`]) between the
-//! study and whatever runs the model, and the journaled stage runner built on it.
+//! study and whatever runs the model, and `Runs` (crate-internal), which runs each stage of
+//! a study as a batch of [`impactcal_runner`] with its journal.
+//!
+//! Layout of a study's output folder `<dir>`: `<dir>/runs/fingerprint` holds the study's
+//! fingerprint; each stage of runs is a batch `<dir>/runs/<stage>/` with the runner's
+//! journal `journal.jsonl` and one work directory per run (`<index>/`: `params.json`, the
+//! solver's files, `result.csv`). The reconciliation proposes its points a few at a time,
+//! each proposal depending on the results before it, so each proposal is its own batch
+//! `reconcile-<first run>`. The journal records each run before it is started (for Slurm,
+//! the job array's name and id before and after `sbatch`) and each result after it is read;
+//! the study always works with the histories as read back from `result.csv` (our CSV
+//! writes the shortest text that reads back as the same number), so a resumed study uses
+//! the same bits as an uninterrupted one.
 
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use impactcal_core::{CoreError, Histories, Model, ParameterSpace};
-use rayon::prelude::*;
+use impactcal_runner::{
+    Batch, Cancel, Hooks, OutputSpec, RunnerError, Solver, SolverCommand, run_batch_with,
+};
 
-use super::journal::{Journal, RunOutcome};
 use crate::error::{CalibrateError, Result};
 
-/// Runs batches of points of a model. [`InProcess`] runs a [`Model`] on rayon's pool;
-/// other executors (a process pool, a cluster) implement the same two methods.
+/// The outcome of one run as the study keeps it: the histories or the failure's message.
+pub type RunOutcome = std::result::Result<Histories, String>;
+
+/// Where a study's true-model runs happen: the parameter space, the runner's [`Solver`]
+/// that runs one point, and the runner's executor. [`InProcess`] runs a [`Model`] in this
+/// process; [`Runner`] runs any solver on any executor (a process pool, a Slurm cluster).
 pub trait Executor: Sync {
     /// The parameters every point has, in order.
     fn space(&self) -> &ParameterSpace;
 
-    /// Runs every point of `points` and calls `done(i, outcome)` as each run finishes (in
-    /// any order, from any thread); returns when all have finished.
-    fn run(&self, points: &[Vec<f64>], done: &(dyn Fn(usize, RunOutcome) + Sync));
+    /// The solver that runs one point.
+    fn solver(&self) -> Solver;
+
+    /// Where the runs happen (default: this process).
+    fn executor(&self) -> impactcal_runner::Executor {
+        impactcal_runner::Executor::Local
+    }
+
+    /// The model a [`SolverCommand::InProcess`] solver runs (default: none).
+    fn model(&self) -> Option<&dyn Model> {
+        None
+    }
+
+    /// Further attempts of a run that fails in a way another attempt may cure (default 0).
+    fn retries(&self) -> u32 {
+        0
+    }
+
+    /// A token that stops the runs when set (default: never set).
+    fn cancel(&self) -> Cancel {
+        Cancel::new()
+    }
 }
 
-/// A [`Model`] run in this process, points in parallel with rayon.
+/// A [`Model`] run in this process, points in parallel on rayon's pool, through the
+/// runner's in-process solver (its journal and work directories, no child process).
 #[derive(Debug)]
 pub struct InProcess<'m, M>(pub &'m M);
 
@@ -29,14 +67,54 @@ impl<M: Model> Executor for InProcess<'_, M> {
         self.0.space()
     }
 
-    fn run(&self, points: &[Vec<f64>], done: &(dyn Fn(usize, RunOutcome) + Sync)) {
-        points.par_iter().enumerate().for_each(|(i, p)| {
-            let outcome = match self.0.space().to_unit(p) {
-                Ok(_) => self.0.simulate(p).map_err(|e| e.to_string()),
-                Err(e) => Err(e.to_string()),
-            };
-            done(i, outcome);
-        });
+    fn solver(&self) -> Solver {
+        Solver {
+            inputs: Vec::new(),
+            command: SolverCommand::InProcess {
+                description: "in-process model".into(),
+            },
+            // The model's histories go straight to the run's result file: no second copy.
+            output: OutputSpec::csv(impactcal_runner::workdir::RESULT),
+        }
+    }
+
+    fn model(&self) -> Option<&dyn Model> {
+        Some(self.0)
+    }
+}
+
+/// Any solver of the runner on any of its executors: an external solver through deck
+/// templates, or a program that reads each run's `params.json` (as `impactcal study-point`
+/// does for the built-in models), on a local process pool or a Slurm cluster.
+#[derive(Debug, Clone)]
+pub struct Runner {
+    /// The parameters.
+    pub space: ParameterSpace,
+    /// The solver.
+    pub solver: Solver,
+    /// Where the runs happen.
+    pub executor: impactcal_runner::Executor,
+    /// Further attempts per failing run.
+    pub retries: u32,
+    /// Stops the runs when set (a Ctrl-C handler sets it).
+    pub cancel: Cancel,
+}
+
+impl Executor for Runner {
+    fn space(&self) -> &ParameterSpace {
+        &self.space
+    }
+    fn solver(&self) -> Solver {
+        self.solver.clone()
+    }
+    fn executor(&self) -> impactcal_runner::Executor {
+        self.executor.clone()
+    }
+    fn retries(&self) -> u32 {
+        self.retries
+    }
+    fn cancel(&self) -> Cancel {
+        self.cancel.clone()
     }
 }
 
@@ -56,25 +134,65 @@ pub struct Silent;
 
 impl Observer for Silent {}
 
-/// The executor, journal and observer of one study.
+/// The executor, output folder and observer of one study.
 pub(crate) struct Runs<'a> {
-    pub executor: &'a dyn Executor,
-    pub journal: &'a Journal,
-    pub observer: &'a dyn Observer,
+    executor: &'a dyn Executor,
+    root: PathBuf,
+    fingerprint: String,
+    observer: &'a dyn Observer,
 }
 
-impl Runs<'_> {
-    /// The outcomes of `points` as stage `stage`: journaled runs are read back, the others
-    /// run through the executor, each journaled as it finishes. Outcomes in input order.
+impl<'a> Runs<'a> {
+    /// The runs of the study with `fingerprint` in the folder `dir` (created if needed).
     ///
     /// # Errors
-    /// [`CalibrateError::Journal`] when a run cannot be read or recorded.
+    /// [`CalibrateError::ForeignJournal`] when `dir` holds another study's runs (nothing is
+    /// written then); [`CalibrateError::Journal`] when the folder cannot be written.
+    pub fn open(
+        executor: &'a dyn Executor,
+        dir: &Path,
+        fingerprint: &str,
+        observer: &'a dyn Observer,
+    ) -> Result<Runs<'a>> {
+        let stamp = dir.join("runs").join("fingerprint");
+        match std::fs::read_to_string(&stamp) {
+            Ok(found) if found.trim() == fingerprint => {}
+            Ok(found) => {
+                return Err(CalibrateError::ForeignJournal {
+                    dir: dir.display().to_string(),
+                    found: found.trim().to_string(),
+                    expected: fingerprint.to_string(),
+                });
+            }
+            Err(_) => {
+                let root = dir.join("runs");
+                std::fs::create_dir_all(&root).map_err(|e| io(&root, e))?;
+                impactcal_runner::workdir::write_atomic(&stamp, fingerprint.as_bytes())
+                    .map_err(|e| io(&stamp, e))?;
+            }
+        }
+        Ok(Runs {
+            executor,
+            root: dir.to_path_buf(),
+            fingerprint: fingerprint.to_string(),
+            observer,
+        })
+    }
+
+    /// The outcomes of `points` as stage `stage`: runs the journal holds as finished are
+    /// read back, the others run through the executor, each journaled before it starts and
+    /// after its result is read. Outcomes in input order.
+    ///
+    /// # Errors
+    /// [`CalibrateError::Runner`] when the stage's journal cannot be written or belongs to
+    /// another study, the executor cannot run the solver, or the runs were cancelled.
     pub fn stage(&self, stage: &str, points: &[Vec<f64>]) -> Result<Vec<RunOutcome>> {
         self.stage_from(stage, 0, points, true)
     }
 
     /// [`stage`](Self::stage) for runs `first..first + points.len()` of a stage run in
-    /// parts; `announce` tells the observer a stage starts.
+    /// parts (each part its own batch, `<stage>-<first>`); `announce` tells the observer a
+    /// stage starts.
     ///
     /// # Errors
     /// As [`stage`](Self::stage).
@@ -85,44 +203,95 @@ impl Runs<'_> {
         points: &[Vec<f64>],
         announce: bool,
     ) -> Result<Vec<RunOutcome>> {
-        let mut outcomes: Vec<Option<RunOutcome>> = Vec::with_capacity(points.len());
-        for (i, p) in points.iter().enumerate() {
-            outcomes.push(self.journal.read(stage, first + i, p)?);
-        }
-        let missing: Vec<usize> = (0..points.len())
-            .filter(|&i| outcomes[i].is_none())
-            .collect();
-        if announce {
-            self.observer
-                .stage(stage, points.len(), points.len() - missing.len());
-        } else {
-            (missing.len()..points.len()).for_each(|_| self.observer.run_finished());
-        }
-        if !missing.is_empty() {
-            let todo: Vec<Vec<f64>> = missing.iter().map(|&i| points[i].clone()).collect();
-            let results: Mutex<Vec<(usize, Result<RunOutcome>)>> = Mutex::new(Vec::new());
-            self.executor.run(&todo, &|k, outcome| {
-                let i = missing[k];
-                let stored = self.journal.write(stage, first + i, &points[i], &outcome);
-                self.observer.run_finished();
-                if let Ok(mut r) = results.lock() {
-                    r.push((i, stored));
-                }
-            });
-            let results = results
-                .into_inner()
-                .map_err(|_| CalibrateError::study(stage, "a run panicked"))?;
-            for (i, r) in results {
-                outcomes[i] = Some(r?);
+        if points.is_empty() {
+            if announce {
+                self.observer.stage(stage, 0, 0);
             }
+            return Ok(Vec::new());
         }
+        let name = batch_name(stage, first, announce);
+        let space = self.executor.space();
+        let batch = Batch::for_space(&self.root, &name, self.executor.solver(), space, points)?
+            .with_retries(self.executor.retries())
+            .with_identity(self.fingerprint.clone());
+        let outcomes: Mutex<Vec<Option<RunOutcome>>> = Mutex::new(vec![None; points.len()]);
+        let opened = |reused: usize| {
+            if announce {
+                self.observer.stage(stage, points.len(), reused);
+            }
+        };
+        let finished = |i: usize, o: std::result::Result<Histories, &RunnerError>| {
+            let o = o.map_err(failure_message);
+            if let Ok(mut all) = outcomes.lock() {
+                all[i] = Some(o);
+            }
+            self.observer.run_finished();
+        };
+        let hooks = Hooks {
+            model: self.executor.model(),
+            opened: Some(&opened),
+            finished: Some(&finished),
+        };
+        run_batch_with(
+            &batch,
+            &self.executor.executor(),
+            &self.executor.cancel(),
+            hooks,
+        )?;
+        let outcomes = outcomes
+            .into_inner()
+            .map_err(|_| CalibrateError::study(stage, "a run panicked"))?;
         outcomes
             .into_iter()
             .enumerate()
             .map(|(i, o)| {
-                o.ok_or_else(|| CalibrateError::study(stage, format!("run {i} never finished")))
+                o.ok_or_else(|| {
+                    CalibrateError::study(stage, format!("run {} never finished", first + i))
+                })
             })
             .collect()
+    }
+}
+
+/// The batch of a stage (or of the part of a stage starting at run `first`): letters,
+/// digits, `_`, `-` and `.` of the stage's name.
+fn batch_name(stage: &str, first: usize, whole: bool) -> String {
+    let clean: String = stage
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if whole {
+        clean
+    } else {
+        format!("{clean}-{first}")
+    }
+}
+
+/// The message a study keeps of a failed run: for a solver that exited with an error, its
+/// status and the last line of its standard error (no path, so that the record does not
+/// depend on where the study ran); otherwise the runner's message.
+fn failure_message(e: &RunnerError) -> String {
+    if let RunnerError::SolverExit { status, stderr, .. } = e {
+        let text = std::fs::read_to_string(stderr).unwrap_or_default();
+        let last = text.lines().rev().find(|l| !l.trim().is_empty());
+        return match last {
+            Some(line) => format!("solver exited with {status}: {}", line.trim()),
+            None => format!("solver exited with {status}"),
+        };
+    }
+    e.to_string()
+}
+
+fn io(path: &Path, e: std::io::Error) -> CalibrateError {
+    CalibrateError::Journal {
+        path: path.display().to_string(),
+        message: e.to_string(),
     }
 }
 

@@ -18,15 +18,15 @@
 //! 9. the before/after table: prediction error, `Q(t)` error, M2 count above 0.9, and per
 //!    sensor relative L2, Sprague-Geers C and ISO/TS 18571 R.
 //!
-//! Every true-model run goes through one [`Executor`] and is recorded in the output folder's
-//! [`Journal`] as it finishes; running the same study again reuses finished runs and gives
-//! the same result, bit for bit. [`StudyResult`] holds every number (`study.json`);
+//! Every true-model run goes through one [`Executor`] and the runner's journal in the output
+//! folder ([`execute`]: recorded before it starts and after its result is read); running the
+//! same study again, after an interruption at any moment, reuses finished runs, re-attaches
+//! to runs still queued or running and gives the same result, bit for bit. [`StudyResult`] holds every number (`study.json`);
 //! [`document::report`] turns it into the report document.
 
 pub mod channels;
 pub mod document;
 pub mod execute;
-pub mod journal;
 pub mod m1;
 pub mod m2;
 pub mod options;
@@ -47,8 +47,7 @@ use impactcal_core::{Cfc, ChannelMap, Histories, Model, SamplingMethod};
 use crate::error::{CalibrateError, Result};
 use crate::metrics::{CurveMetrics, Iso18571};
 
-pub use execute::{Executor, InProcess, Observer, Silent};
-pub use journal::{Journal, RunOutcome};
+pub use execute::{Executor, InProcess, Observer, RunOutcome, Runner, Silent};
 pub use m1::{M1, Verdict};
 pub use options::{StudyOptions, ValidStudyOptions};
 pub use result::StudyResult;
@@ -115,7 +114,7 @@ pub fn fingerprint(
     bytes.extend(h.dt().to_le_bytes());
     bytes.extend(h.start().to_le_bytes());
     h.data().iter().for_each(|v| bytes.extend(v.to_le_bytes()));
-    journal::fingerprint(&bytes)
+    impactcal_runner::fingerprint(&bytes)
 }
 
 /// [`run_model`] with any [`Executor`].
@@ -132,12 +131,7 @@ pub fn run(
 ) -> Result<StudyResult> {
     let space = executor.space().clone();
     let fp = fingerprint(executor, description, test, options);
-    let journal = Journal::open(dir, &fp)?;
-    let runs = Runs {
-        executor,
-        journal: &journal,
-        observer,
-    };
+    let runs = Runs::open(executor, dir, &fp, observer)?;
     let prep = |h: &Histories| -> Result<Histories> {
         Ok(match test.cfc {
             Some(c) => h.filtered(c)?,

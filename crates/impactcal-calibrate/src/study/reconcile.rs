@@ -7,7 +7,7 @@ use impactcal_core::{Histories, ParameterSpace};
 use impactcal_cors::{Cors, CorsOptions, Transform};
 use serde::{Deserialize, Serialize};
 
-use super::journal::RunOutcome;
+use super::execute::RunOutcome;
 use crate::error::Result;
 
 /// Runs a batch of points as runs `first..first + points.len()` of the reconciliation.

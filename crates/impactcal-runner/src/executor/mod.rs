@@ -20,7 +20,7 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
-use crate::batch::{Batch, BatchReport, Cancel, Driver};
+use crate::batch::{Batch, BatchReport, Cancel, Driver, Hooks};
 use crate::error::{Result, RunnerError};
 pub use slurm::SlurmOptions;
 
@@ -63,9 +63,10 @@ impl ProcessOptions {
 fn argv<'d>(driver: &'d Driver<'_>) -> Result<&'d [String]> {
     match &driver.batch.solver().command {
         crate::solver::SolverCommand::Argv(argv) => Ok(argv),
-        crate::solver::SolverCommand::BuiltIn { .. } => Err(config(
-            "the processes and slurm executors run a solver command; the built-in solver runs \
-             in process only (executor kind = \"local\")",
+        crate::solver::SolverCommand::BuiltIn { .. }
+        | crate::solver::SolverCommand::InProcess { .. } => Err(config(
+            "the processes and slurm executors run a solver command; the built-in solver and \
+             an in-process model run in process only (executor kind = \"local\")",
         )),
     }
 }
@@ -112,7 +113,32 @@ impl Executor {
 /// cannot be queried; [`RunnerError::Cancelled`] when `cancel` was set (runs in flight are
 /// killed or cancelled; the journal holds the rest).
 pub fn run_batch(batch: &Batch, executor: &Executor, cancel: &Cancel) -> Result<BatchReport> {
-    let (driver, pending, in_flight) = Driver::open(batch, cancel, executor.name())?;
+    run_batch_with(batch, executor, cancel, Hooks::default())
+}
+
+/// [`run_batch`] with [`Hooks`]: the model an in-process solver runs, and callbacks that
+/// receive each run's histories as it finishes (so that nothing holds every run's
+/// histories unless the caller keeps them).
+///
+/// # Errors
+/// As [`run_batch`]; [`RunnerError::Config`] when the solver runs an in-process model and
+/// `hooks.model` is `None`.
+pub fn run_batch_with(
+    batch: &Batch,
+    executor: &Executor,
+    cancel: &Cancel,
+    hooks: Hooks<'_>,
+) -> Result<BatchReport> {
+    if matches!(
+        batch.solver().command,
+        crate::solver::SolverCommand::InProcess { .. }
+    ) && hooks.model.is_none()
+    {
+        return Err(config(
+            "the solver runs an in-process model, but no model was given",
+        ));
+    }
+    let (driver, pending, in_flight) = Driver::open(batch, cancel, executor.name(), hooks)?;
     match executor {
         Executor::Local => {
             let mut pending = pending;

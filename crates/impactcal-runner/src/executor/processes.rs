@@ -35,7 +35,7 @@ pub(crate) fn run(
                 scope.spawn(|| -> Result<()> {
                     while let Some(index) = next() {
                         driver.drive(index, |d, index, attempt, dir| {
-                            run_process(d, index, attempt, dir, argv, timeout)
+                            run_process(d, index, attempt, dir, argv, timeout).map(|s| (s, None))
                         })?;
                     }
                     Ok(())

@@ -258,7 +258,7 @@ pub(crate) fn run(
                 // Never reached the scheduler, or finished and forgotten: its directory
                 // says which.
                 if read_exit_status(&driver.dir(index)).is_some() {
-                    let outcome = driver.collect(index, f.attempt);
+                    let outcome = driver.collect(index, f.attempt, None);
                     if driver.settle(index, f.attempt, outcome)? {
                         todo.push(index);
                     }
@@ -308,7 +308,7 @@ pub(crate) fn run(
             }
             let dir = driver.dir(t.index);
             let outcome = if read_exit_status(&dir).is_some() {
-                driver.collect(t.index, t.attempt)
+                driver.collect(t.index, t.attempt, None)
             } else if t.missing_polls == 0 {
                 // Give the file system one poll to show the exit status.
                 t.missing_polls += 1;

@@ -349,13 +349,16 @@ const TITLED: &[(&str, usize)] = &[
     ("*SET_NODE_LIST", 0),
 ];
 
-/// Keywords with an `_ID` variant (an id card `ID, HEADING` ahead of each definition) and
-/// the number of cards of one definition. `*DATABASE_HISTORY_NODE_ID` is different: one
-/// node per card, `ID` then a heading.
+/// Keywords with an `_ID` variant and the number of cards of one definition after its id
+/// card `ID, HEADING` (0: one id card for the whole keyword, then as many data cards as
+/// necessary). LS-DYNA's manual: `*RIGIDWALL_PLANAR_ID` has an id card ahead of each wall;
+/// `*BOUNDARY_SPC_{NODE|SET}_ID` one id card (the SPC set's id and heading) and then any
+/// number of node or set cards, all of that SPC set. `*DATABASE_HISTORY_NODE_ID` is
+/// different: one node per card, its id in columns 1-10 and a heading in 11-80.
 const WITH_ID: &[(&str, usize)] = &[
     ("*RIGIDWALL_PLANAR", 2),
-    ("*BOUNDARY_SPC_NODE", 1),
-    ("*BOUNDARY_SPC_SET", 1),
+    ("*BOUNDARY_SPC_NODE", 0),
+    ("*BOUNDARY_SPC_SET", 0),
 ];
 
 /// Every keyword this reader reads (beside the `_TITLE` and `_ID` variants above and the

@@ -1,0 +1,168 @@
+//! An in-process model through the runner: results streamed to the caller as they finish,
+//! equal bit for bit to what a resumed batch reads back; a batch tied to an identity
+//! resumes under another solver command and refuses another identity.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::sync::Mutex;
+
+use impactcal_core::{CoreError, Histories, Model, Parameter, ParameterSpace};
+use impactcal_runner::{
+    Batch, Cancel, Executor, Hooks, OutputSpec, Solver, SolverCommand, run_batch_with,
+};
+
+/// `y(t) = a sin(b t) / 3` on 50 samples (thirds and sines do not print short), failing
+/// for `a < 0`.
+struct Wave(ParameterSpace);
+
+impl Model for Wave {
+    fn space(&self) -> &ParameterSpace {
+        &self.0
+    }
+    fn simulate(&self, p: &[f64]) -> impactcal_core::Result<Histories> {
+        if p[0] < 0.0 {
+            return Err(CoreError::Simulation("negative amplitude".into()));
+        }
+        let y: Vec<f64> = (0..50)
+            .map(|k| p[0] * (p[1] * k as f64 * 1e-3).sin() / 3.0)
+            .collect();
+        Histories::from_channels(vec!["1.z".into()], vec![y], 1e-3 / 3.0, 0.0, "in/s")
+    }
+}
+
+fn wave() -> Wave {
+    Wave(
+        ParameterSpace::new(vec![
+            Parameter::new("amp.a", -1.0, 2.0, 1.0).unwrap(),
+            Parameter::new("freq.b", 1.0, 900.0, 100.0).unwrap(),
+        ])
+        .unwrap(),
+    )
+}
+
+fn in_process() -> Solver {
+    Solver {
+        inputs: vec![],
+        command: SolverCommand::InProcess {
+            description: "wave".into(),
+        },
+        output: OutputSpec::csv("out.csv"),
+    }
+}
+
+type Outcomes = Vec<(usize, Result<Histories, String>)>;
+type Seen = Mutex<Outcomes>;
+
+fn run(batch: &Batch, model: &Wave) -> (usize, Outcomes) {
+    let seen: Seen = Mutex::new(Vec::new());
+    let opened = Mutex::new(usize::MAX);
+    let finished = |i: usize, o: Result<Histories, &impactcal_runner::RunnerError>| {
+        seen.lock().unwrap().push((i, o.map_err(|e| e.to_string())));
+    };
+    let on_open = |n: usize| *opened.lock().unwrap() = n;
+    let hooks = Hooks {
+        model: Some(model),
+        opened: Some(&on_open),
+        finished: Some(&finished),
+    };
+    let report = run_batch_with(batch, &Executor::Local, &Cancel::new(), hooks).unwrap();
+    let mut seen = seen.into_inner().unwrap();
+    seen.sort_by_key(|s| s.0);
+    // The report holds where each result is; reading it back gives the streamed bits.
+    for (i, o) in &seen {
+        match o {
+            Ok(h) => assert_eq!(&report.histories(*i).unwrap(), h),
+            Err(_) => assert!(report.runs[*i].is_err()),
+        }
+    }
+    (opened.into_inner().unwrap(), seen)
+}
+
+#[test]
+fn streamed_results_equal_the_resumed_ones_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = wave();
+    let names = vec!["amp.a".to_string(), "freq.b".to_string()];
+    let points: Vec<Vec<f64>> = (0..6)
+        .map(|i| vec![i as f64 * 0.37 - 0.5, 100.0 + 97.0 * i as f64])
+        .collect();
+    let batch = Batch::new(dir.path(), "wave", in_process(), names.clone(), &points)
+        .unwrap()
+        .with_retries(0)
+        .with_identity("study-1");
+    let (opened, first) = run(&batch, &model);
+    assert_eq!(opened, 0);
+    assert_eq!(first.len(), 6);
+    // Runs 0 and 1 have a < 0: their failure is streamed with its message.
+    for (i, o) in &first[..2] {
+        let e = o.as_ref().unwrap_err();
+        assert!(
+            e.contains(&format!("run {i}")) && e.contains("stderr.txt"),
+            "{e}"
+        );
+    }
+    for (i, o) in &first[2..] {
+        let h = o.as_ref().unwrap();
+        let direct = model.simulate(&points[*i]).unwrap();
+        // Values survive our CSV exactly; the unit comes with them.
+        assert_eq!(h.data(), direct.data());
+        assert_eq!(h.unit(), "in/s");
+        assert_eq!(h.labels(), direct.labels());
+    }
+    // Again: the four results are reused (and streamed first), the failures are retried.
+    let (opened, second) = run(&batch, &model);
+    assert_eq!(opened, 4);
+    for ((i, a), (j, b)) in first.iter().zip(&second) {
+        assert_eq!(i, j);
+        if let (Ok(a), Ok(b)) = (a, b) {
+            assert_eq!(a, b);
+            assert_eq!(a.dt().to_bits(), b.dt().to_bits());
+        }
+    }
+    // Tied to its identity, the batch resumes under another command (a process that
+    // would fail every run: nothing is run again)...
+    let other = Solver {
+        inputs: vec![],
+        command: SolverCommand::Argv(vec!["false".into()]),
+        output: OutputSpec::csv("out.csv"),
+    };
+    let resumed = Batch::new(dir.path(), "wave", other.clone(), names.clone(), &points)
+        .unwrap()
+        .with_retries(0)
+        .with_identity("study-1");
+    let report = impactcal_runner::run_batch(&resumed, &Executor::Local, &Cancel::new()).unwrap();
+    assert_eq!(report.reused, vec![false, false, true, true, true, true]);
+    // ... and another identity is refused.
+    let foreign = Batch::new(dir.path(), "wave", other, names, &points)
+        .unwrap()
+        .with_identity("study-2");
+    let e = impactcal_runner::run_batch(&foreign, &Executor::Local, &Cancel::new()).unwrap_err();
+    assert!(e.to_string().contains("different batch"), "{e}");
+}
+
+#[test]
+fn an_in_process_solver_needs_its_model_and_the_local_executor() {
+    let dir = tempfile::tempdir().unwrap();
+    let points = vec![vec![1.0, 100.0]];
+    let batch = Batch::new(
+        dir.path(),
+        "wave",
+        in_process(),
+        vec!["amp.a".into(), "freq.b".into()],
+        &points,
+    )
+    .unwrap();
+    let e = run_batch_with(&batch, &Executor::Local, &Cancel::new(), Hooks::default()).unwrap_err();
+    assert!(e.to_string().contains("no model was given"), "{e}");
+    let model = wave();
+    let hooks = Hooks {
+        model: Some(&model),
+        ..Hooks::default()
+    };
+    let processes = Executor::Processes(impactcal_runner::ProcessOptions {
+        jobs: 1,
+        timeout: None,
+    });
+    let e = run_batch_with(&batch, &processes, &Cancel::new(), hooks).unwrap_err();
+    assert!(e.to_string().contains("run in process only"), "{e}");
+}
