@@ -332,6 +332,11 @@ impl Components {
         self.points.nrows()
     }
 
+    /// The training points in unit-scaled inputs, `N x m`.
+    pub fn unit_points(&self) -> MatRef<'_, f64> {
+        self.unit.as_ref()
+    }
+
     /// The training outputs, `N x T`.
     pub fn values(&self) -> MatRef<'_, f64> {
         self.values.as_ref()

@@ -34,7 +34,8 @@ pub const TRUNCATION_RATIO: f64 = 0.25;
 pub struct ShapeBasis {
     /// Mean history `f_bar` (length `T`).
     mean: Vec<f64>,
-    /// Time functions `G` (`T x k`), orthonormal columns.
+    /// `[G | f_bar]` (`T x (k + 1)`): the time functions kept (orthonormal columns) and the
+    /// mean history last, so that a rebuild is one product.
     functions: Mat<f64>,
     /// Singular values of the deviations, all of them up to the numerical rank.
     sigma: Vec<f64>,
@@ -71,9 +72,12 @@ impl ShapeBasis {
         let sigma = shapes.singular_values().to_vec();
         let u = shapes.shapes();
         let coords = Mat::from_fn(n, sigma.len(), |k, i| sigma[i] * u[(k, i)]);
+        let g = shapes.time_functions();
+        let r = g.ncols();
+        let functions = Mat::from_fn(t, r + 1, |i, j| if j < r { g[(i, j)] } else { mean[i] });
         let basis = ShapeBasis {
             mean,
-            functions: shapes.time_functions().to_owned(),
+            functions,
             sigma,
             total,
         };
@@ -82,12 +86,12 @@ impl ShapeBasis {
 
     /// Number of shapes kept `k`.
     pub fn len(&self) -> usize {
-        self.functions.ncols()
+        self.functions.ncols() - 1
     }
 
     /// Whether no shape is kept (never true for a basis from [`new`](Self::new)).
     pub fn is_empty(&self) -> bool {
-        self.functions.ncols() == 0
+        self.len() == 0
     }
 
     /// Number of samples `T` of a history.
@@ -108,7 +112,7 @@ impl ShapeBasis {
 
     /// The time functions kept, `T x k`, orthonormal columns.
     pub fn functions(&self) -> MatRef<'_, f64> {
-        self.functions.as_ref()
+        self.functions.as_ref().subcols(0, self.len())
     }
 
     /// Relative truncation error of `k` shapes on the training data,
@@ -127,8 +131,11 @@ impl ShapeBasis {
     /// Keeps the first `k` shapes (`k` is capped at the number kept; at least one).
     pub fn truncate(&mut self, k: usize) {
         let k = k.clamp(1, self.len().max(1));
-        if k < self.len() {
-            self.functions = self.functions.subcols(0, k).to_owned();
+        let len = self.len();
+        if k < len {
+            let f = &self.functions;
+            self.functions =
+                Mat::from_fn(f.nrows(), k + 1, |i, j| f[(i, if j < k { j } else { len })]);
         }
     }
 
@@ -136,17 +143,28 @@ impl ShapeBasis {
     /// (`Q x k`): a `Q x T` matrix, `O(Q k T)`.
     pub fn rebuild(&self, coords: MatRef<'_, f64>) -> Mat<f64> {
         let q = coords.nrows();
-        let t = self.samples();
-        let mut out = buffer::zeros(q, t);
-        for j in 0..t {
-            out.col_mut(j).iter_mut().for_each(|v| *v = self.mean[j]);
-        }
         let k = coords.ncols().min(self.len());
+        // [a | 1] [G_k | f_bar]^T: the mean rides along as one more coordinate.
+        let mut ext = Mat::<f64>::zeros(q, k + 1);
+        ext.as_mut()
+            .subcols_mut(0, k)
+            .copy_from(coords.subcols(0, k));
+        ext.col_mut(k).iter_mut().for_each(|v| *v = 1.0);
+        let len = self.len();
+        let fewer = (k < len).then(|| {
+            Mat::from_fn(self.samples(), k + 1, |i, j| {
+                self.functions[(i, if j < k { j } else { len })]
+            })
+        });
+        let basis = fewer
+            .as_ref()
+            .map_or(self.functions.as_ref(), |b| b.as_ref());
+        let mut out = buffer::zeros(q, self.samples());
         matmul(
             out.as_mut(),
-            Accum::Add,
-            coords.subcols(0, k),
-            self.functions.as_ref().subcols(0, k).transpose(),
+            Accum::Replace,
+            ext.as_ref(),
+            basis.transpose(),
             1.0,
             faer::get_global_parallelism(),
         );

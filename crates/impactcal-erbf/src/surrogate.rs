@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use crate::components::{Components, OutputBasis, Tuning};
 use crate::erbf::Erbf;
 use crate::error::Result;
-use crate::loo::LooMethod;
+use crate::loo::{ErrorSummary, LooMethod};
 use crate::options::ValidErbfOptions;
 use crate::radial::RadialFunction;
 use crate::rbf::{RbfInterpolant, RbfOptions};
@@ -93,6 +93,33 @@ impl Default for SurrogateKind {
     /// ERBF, the source paper's surrogate.
     fn default() -> Self {
         SurrogateKind::Erbf
+    }
+}
+
+/// Leave-one-out errors of a surrogate and of the linear trend, as `rms / std` of the
+/// training values (see [`ResponseSurrogate::loo_against_trend`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LooComparison {
+    /// The surrogate's, per output.
+    pub model: Vec<f64>,
+    /// The linear trend's, per output (`NaN` when undefined).
+    pub trend: Vec<f64>,
+    /// The surrogate's, pooled over outputs ([`ErrorSummary::relative_rms`]).
+    pub pooled_model: f64,
+    /// The linear trend's, pooled.
+    pub pooled_trend: f64,
+    /// The surrogate's errors summarised (pooled).
+    pub summary: ErrorSummary,
+}
+
+impl LooComparison {
+    /// The outputs whose leave-one-out error exceeds the linear trend's: where the
+    /// surrogate, by its own cross-validation, does worse than a straight line (fitting
+    /// noise, or a shape parameter unsuited to the sample spacing).
+    pub fn worse_than_trend(&self) -> Vec<usize> {
+        (0..self.model.len())
+            .filter(|&c| self.model[c] > self.trend[c])
+            .collect()
     }
 }
 
@@ -303,6 +330,52 @@ impl ResponseSurrogate {
             SurrogateModel::Rbf { interpolant, .. } => interpolant.loo_errors(method),
             SurrogateModel::Components(c) => c.loo_errors(method),
         }
+    }
+
+    /// The training points in unit-scaled inputs, `N x m`.
+    ///
+    /// # Errors
+    /// Only if the stored points fell outside what the space can scale, which a fitted
+    /// model excludes.
+    pub fn unit_points(&self) -> Result<Mat<f64>> {
+        Ok(match &self.model {
+            SurrogateModel::Erbf(e) => e.space().to_unit_matrix(e.points())?,
+            SurrogateModel::Rbf { interpolant, .. } => interpolant.points().to_owned(),
+            SurrogateModel::Components(c) => c.unit_points().to_owned(),
+        })
+    }
+
+    /// The leave-one-out errors of the model beside those of the linear trend (plain
+    /// linear regression, [`linear_trend_loo`](crate::linear_trend_loo)), per output and
+    /// pooled, each as `rms / std` of the training values.
+    ///
+    /// # Errors
+    /// [`ErbfError::LooUndefined`](crate::ErbfError::LooUndefined) when the model's
+    /// leave-one-out errors are undefined; the trend's being undefined (too few samples)
+    /// leaves its entries `NaN` instead.
+    pub fn loo_against_trend(&self, method: LooMethod) -> Result<LooComparison> {
+        let values = self.values();
+        let model = self.loo_errors(method)?;
+        let unit = self.unit_points()?;
+        let trend = crate::trend::linear_trend_loo(unit.as_ref(), values).ok();
+        let per = |e: MatRef<'_, f64>| -> Vec<f64> {
+            (0..e.ncols())
+                .map(|c| ErrorSummary::new(e.subcols(c, 1), values.subcols(c, 1)).relative_rms)
+                .collect()
+        };
+        let t = values.ncols();
+        let summary = ErrorSummary::new(model.as_ref(), values);
+        Ok(LooComparison {
+            summary,
+            model: per(model.as_ref()),
+            trend: trend
+                .as_ref()
+                .map_or(vec![f64::NAN; t], |e| per(e.as_ref())),
+            pooled_model: summary.relative_rms,
+            pooled_trend: trend.as_ref().map_or(f64::NAN, |e| {
+                ErrorSummary::new(e.as_ref(), values).relative_rms
+            }),
+        })
     }
 
     /// The training responses, `N x T`.
