@@ -233,12 +233,12 @@ fn shape_basis_fit_reproduces_the_training_runs_within_its_truncation() {
         "--basis",
         "shapes",
         "--shapes",
-        "22",
+        "14",
         "--out",
         &d("m.json"),
     ]);
     assert_eq!(code, 0, "{err}");
-    assert!(err.contains("22 impact shapes"), "{err}");
+    assert!(err.contains("14 impact shapes"), "{err}");
     assert!(err.contains("linear trend"), "{err}");
     let (code, _, err) = impactcal(&[
         "surrogate",
@@ -252,7 +252,7 @@ fn shape_basis_fit_reproduces_the_training_runs_within_its_truncation() {
     ]);
     assert_eq!(code, 0, "{err}");
     let (_, rows) = read_csv(&dir.path().join("Yhat.csv"));
-    // All 22 shapes of 23 centred runs: exact reproduction.
+    // The 14 shapes are the numerical rank of the centred runs: exact reproduction.
     for (r, y) in rows.iter().zip(&ys) {
         for (a, b) in r.iter().zip(y) {
             assert!((a - b).abs() < 1e-8 * (1.0 + b.abs()), "{a} vs {b}");
