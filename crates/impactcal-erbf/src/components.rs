@@ -33,7 +33,7 @@ pub enum OutputBasis {
     Shapes {
         /// How many shapes to keep; `None` chooses the fewest whose truncation error stays
         /// below the surrogate's own leave-one-out error
-        /// ([`choose_count`](crate::shape_basis::choose_count)).
+        /// ([`choose_count`]).
         count: Option<usize>,
     },
 }
