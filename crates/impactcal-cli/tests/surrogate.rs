@@ -212,6 +212,27 @@ fn bad_input_exits_with_code_2_and_says_where() {
     assert!(err.contains("not a surrogate model"), "{err}");
 }
 
+/// `impactcal surrogate fit` on `bounds.csv`, `P.csv` and `Y.csv` of `dir`, writing
+/// `m.json`, with `extra` arguments.
+fn fit_in(dir: &Path, extra: &[&str]) -> (i32, String, String) {
+    let d = |f: &str| dir.join(f).display().to_string();
+    let (b, p, y, m) = (d("bounds.csv"), d("P.csv"), d("Y.csv"), d("m.json"));
+    let mut args = vec![
+        "surrogate",
+        "fit",
+        "--bounds",
+        &b,
+        "--params",
+        &p,
+        "--outputs",
+        &y,
+        "--out",
+        &m,
+    ];
+    args.extend_from_slice(extra);
+    impactcal(&args)
+}
+
 /// `--basis shapes --shapes K`: the training histories come back to within the truncation
 /// of K shapes, the summary names the shapes, and the saved model predicts the same.
 #[test]
@@ -263,22 +284,7 @@ fn shape_basis_fit_reproduces_the_training_runs_within_its_truncation() {
         &["--shapes", "3"][..],
         &["--basis", "shapes", "--shapes", "40"][..],
     ] {
-        let mut args = vec![
-            "surrogate",
-            "fit",
-            "--bounds",
-            &d("bounds.csv"),
-            "--params",
-            &d("P.csv"),
-            "--outputs",
-            &d("Y.csv"),
-        ]
-        .into_iter()
-        .map(String::from)
-        .collect::<Vec<_>>();
-        args.extend(extra.iter().map(|s| s.to_string()));
-        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-        let (code, _, err) = impactcal(&refs);
+        let (code, _, err) = fit_in(dir.path(), extra);
         assert_eq!(code, 2, "{extra:?}: {err}");
         assert!(err.contains("shape"), "{err}");
     }
@@ -308,27 +314,7 @@ fn fit_warns_when_worse_than_a_linear_trend() {
     }
     std::fs::write(dir.path().join("P.csv"), p).unwrap();
     std::fs::write(dir.path().join("Y.csv"), y).unwrap();
-    let d = |f: &str| dir.path().join(f).display().to_string();
-    let fit = |extra: &[&str]| {
-        let mut args = vec![
-            "surrogate",
-            "fit",
-            "--bounds",
-            &d("bounds.csv"),
-            "--params",
-            &d("P.csv"),
-            "--outputs",
-            &d("Y.csv"),
-            "--out",
-            &d("m.json"),
-        ]
-        .into_iter()
-        .map(String::from)
-        .collect::<Vec<_>>();
-        args.extend(extra.iter().map(|s| s.to_string()));
-        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-        impactcal(&refs)
-    };
+    let fit = |extra: &[&str]| fit_in(dir.path(), extra);
     let (code, _, err) = fit(&["--kind", "cubic"]);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("warning: y: the leave-one-out error"), "{err}");
