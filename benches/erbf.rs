@@ -1,11 +1,15 @@
 //! Criterion benchmarks of the ERBF and cubic RBF surrogates at N = 150 samples, n_p = 10
 //! parameters and T = 10^4 outputs (a long time history): fit, one-point predict and a
-//! 1000-point batch predict.
+//! 1000-point batch predict; and the cubic RBF in the impact-shape basis (shape count chosen
+//! automatically): fit, and 1000 predictions of whole histories.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use impactcal::erbf::{Erbf, ErbfOptions, RbfInterpolant, RbfOptions};
+use impactcal::erbf::{
+    Erbf, ErbfOptions, FitOptions, OutputBasis, RbfInterpolant, RbfOptions, ResponseSurrogate,
+    SurrogateKind, Tuning,
+};
 
 #[path = "common/surrogate_data.rs"]
 mod surrogate_data;
@@ -33,6 +37,19 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("cubic_predict_1000", |b| {
         b.iter(|| cubic.predict_batch(q.as_ref()).unwrap())
+    });
+    let names: Vec<String> = (0..f.ncols()).map(|t| format!("y{t}")).collect();
+    let shapes = FitOptions {
+        kind: SurrogateKind::Cubic,
+        basis: OutputBasis::Shapes { count: None },
+        tuning: Tuning::Off,
+    };
+    let fit_shapes =
+        || ResponseSurrogate::fit_with(&space, x.as_ref(), f.as_ref(), names.clone(), &shapes);
+    g.bench_function("shapes_cubic_fit", |b| b.iter(|| fit_shapes().unwrap()));
+    let shaped = fit_shapes().unwrap();
+    g.bench_function("shapes_cubic_predict_1000", |b| {
+        b.iter(|| shaped.predict_batch(q.as_ref()).unwrap())
     });
     g.finish();
 }

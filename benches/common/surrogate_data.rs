@@ -27,12 +27,19 @@ pub fn surrogate_data() -> (ParameterSpace, Mat<f64>, Mat<f64>, Mat<f64>) {
     .unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(42);
     let x = latin_hypercube(N, M, &mut rng).unwrap();
-    let f = Mat::from_fn(N, T, |i, t| {
+    let f = family(&x);
+    let q = Mat::from_fn(Q, M, |_, _| rng.random::<f64>());
+    (space, x, f, q)
+}
+
+/// The history family at the rows of `x` (`n x M`): `n x T`, row `i` the damped sum
+/// `sum_j sin(3 x_ij + 1e-3 (j + 1) t) exp(-2e-4 t)` (rank `2 M` around its mean).
+#[allow(dead_code)]
+pub fn family(x: &Mat<f64>) -> Mat<f64> {
+    Mat::from_fn(x.nrows(), T, |i, t| {
         let s: f64 = (0..M)
             .map(|j| (3.0 * x[(i, j)] + 1e-3 * (t * (j + 1)) as f64).sin())
             .sum();
         s * (-2e-4 * t as f64).exp()
-    });
-    let q = Mat::from_fn(Q, M, |_, _| rng.random::<f64>());
-    (space, x, f, q)
+    })
 }

@@ -2,8 +2,16 @@
 //! input (N = 150, n_p = 10, T = 10^4, 1000 queries) as little-endian f64 files, times our
 //! fits and predictions, and writes a slice of our predictions for the agreement check.
 //!
-//! `cargo run --release --example erbf_peer -- <dir> [reps]` (set `ERBF_PEER_VERBOSE=1` to
-//! print every timed call to stderr).
+//! With a third argument, the directory of an airframe ensemble written by the
+//! `airframe_ensemble` example, it also times the surrogates on it (the last
+//! `AIRFRAME_HELD_OUT` runs held out).
+//!
+//! The impact-shape basis (`--basis shapes`) is timed as a user meets it: fit with the shape
+//! count chosen automatically, then 1000 predictions of whole histories (rebuilt from the
+//! predicted coordinates); held-out errors are `||prediction - truth||_F / ||truth - mean||_F`.
+//!
+//! `cargo run --release --example erbf_peer -- <dir> [reps] [airframe-dir]` (set
+//! `ERBF_PEER_VERBOSE=1` to print every timed call to stderr).
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -11,12 +19,21 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-use faer::MatRef;
-use impactcal::erbf::{Erbf, ErbfOptions, RadialFunction, RbfInterpolant, RbfOptions};
+use faer::{Mat, MatRef};
+use impactcal::core::{Parameter, ParameterSpace};
+use impactcal::erbf::{
+    Erbf, ErbfOptions, FitOptions, OutputBasis, RadialFunction, RbfInterpolant, RbfOptions,
+    ResponseSurrogate, SurrogateKind, SurrogateModel, Tuning,
+};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 #[path = "../common/surrogate_data.rs"]
 mod surrogate_data;
-use surrogate_data::{M, T, surrogate_data};
+use surrogate_data::{M, T, family, surrogate_data};
+
+/// Runs of the airframe ensemble held out for the accuracy check.
+const AIRFRAME_HELD_OUT: usize = 8;
 
 /// Untimed calls before the timed ones, so that both sides are measured warm (allocator
 /// and page mappings settled).
@@ -58,17 +75,105 @@ fn time<R>(reps: usize, mut f: impl FnMut() -> R) -> (f64, R) {
     (median(times), last.unwrap())
 }
 
+/// `||a - b||_F / ||b - mean(b)||_F` (row means of `b` taken over its rows).
+fn held_out_error(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> f64 {
+    let (n, t) = b.shape();
+    let (mut num, mut den) = (0.0, 0.0);
+    for j in 0..t {
+        let mean = b.col(j).iter().sum::<f64>() / n as f64;
+        for i in 0..n {
+            num += (a[(i, j)] - b[(i, j)]).powi(2);
+            den += (b[(i, j)] - mean).powi(2);
+        }
+    }
+    (num / den).sqrt()
+}
+
+fn read_bin(path: &Path, nrows: usize, ncols: usize) -> Mat<f64> {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(bytes.len(), nrows * ncols * 8, "{}", path.display());
+    Mat::from_fn(nrows, ncols, |i, j| {
+        let k = (i * ncols + j) * 8;
+        f64::from_le_bytes(bytes[k..k + 8].try_into().unwrap())
+    })
+}
+
+fn shapes_options(kind: SurrogateKind) -> FitOptions {
+    FitOptions {
+        kind,
+        basis: OutputBasis::Shapes { count: None },
+        tuning: Tuning::Off,
+    }
+}
+
+fn shape_count(s: &ResponseSurrogate) -> usize {
+    match s.model() {
+        SurrogateModel::Components(c) => c.basis().map_or(0, |b| b.len()),
+        _ => 0,
+    }
+}
+
+/// Times the shape-basis cubic RBF and ERBF (fit + `q` predictions) and prints their
+/// held-out errors on (`xh`, `fh`), under `prefix`.
+#[allow(clippy::too_many_arguments)]
+fn shape_cases(
+    prefix: &str,
+    reps: usize,
+    space: &ParameterSpace,
+    x: MatRef<'_, f64>,
+    f: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    xh: MatRef<'_, f64>,
+    fh: MatRef<'_, f64>,
+) {
+    let names: Vec<String> = (0..f.ncols()).map(|t| format!("y{t}")).collect();
+    for (label, kind) in [
+        ("shapes_cubic", SurrogateKind::Cubic),
+        ("shapes_erbf", SurrogateKind::Erbf),
+    ] {
+        let options = shapes_options(kind);
+        let (fit, model) = time(reps, || {
+            ResponseSurrogate::fit_with(space, x, f, names.clone(), &options).unwrap()
+        });
+        let (pred, _) = time(reps, || model.predict_batch(q).unwrap());
+        let err = held_out_error(model.predict_batch(xh).unwrap().as_ref(), fh);
+        println!("ours {prefix}{label}_fit {fit:.6}");
+        println!("ours {prefix}{label}_predict_1000 {pred:.6}");
+        println!("ours {prefix}{label}_held_out {err:.6e}");
+        println!("ours {prefix}{label}_count {}", shape_count(&model));
+        println!(
+            "ours {prefix}{label}_training_residual {:.3e}",
+            model.training_residual()
+        );
+    }
+    for (label, kind) in [
+        ("full_cubic", SurrogateKind::Cubic),
+        ("full_erbf", SurrogateKind::Erbf),
+    ] {
+        let model = ResponseSurrogate::fit(space, kind, x, f, names.clone()).unwrap();
+        let err = held_out_error(model.predict_batch(xh).unwrap().as_ref(), fh);
+        println!("ours {prefix}{label}_held_out {err:.6e}");
+    }
+}
+
 fn main() {
     let dir = std::env::args()
         .nth(1)
-        .expect("usage: erbf_peer <dir> [reps]");
+        .expect("usage: erbf_peer <dir> [reps] [airframe-dir]");
     let reps: usize = std::env::args().nth(2).map_or(5, |s| s.parse().unwrap());
+    let airframe = std::env::args().nth(3);
     let dir = Path::new(&dir);
     std::fs::create_dir_all(dir).unwrap();
     let (space, x, f, q) = surrogate_data();
     write_bin(&dir.join("points.bin"), x.as_ref(), M);
     write_bin(&dir.join("values.bin"), f.as_ref(), T);
     write_bin(&dir.join("queries.bin"), q.as_ref(), M);
+    // Held-out runs of the same family for the accuracy of both sides.
+    let mut rng = ChaCha8Rng::seed_from_u64(4242);
+    let xh = Mat::from_fn(100, M, |_, _| rng.random::<f64>());
+    let fh = family(&xh);
+    write_bin(&dir.join("held_points.bin"), xh.as_ref(), M);
+    write_bin(&dir.join("held_values.bin"), fh.as_ref(), T);
 
     let (fit_e, erbf) = time(reps, || {
         Erbf::fit(&space, x.as_ref(), f.as_ref(), ErbfOptions::default()).unwrap()
@@ -98,4 +203,61 @@ fn main() {
         "ours erbf_training_residual {:.3e}",
         erbf.training_residual()
     );
+    shape_cases(
+        "",
+        reps,
+        &space,
+        x.as_ref(),
+        f.as_ref(),
+        q.as_ref(),
+        xh.as_ref(),
+        fh.as_ref(),
+    );
+    if let Some(adir) = airframe {
+        airframe_cases(Path::new(&adir), reps);
+    }
+}
+
+/// The airframe ensemble: the last `AIRFRAME_HELD_OUT` runs held out, 1000 uniform queries
+/// in the unit cube; shape-basis cubic and ERBF, full-history cubic, Gaussian and ERBF.
+fn airframe_cases(adir: &Path, reps: usize) {
+    let shape = std::fs::read_to_string(adir.join("airframe_shape.txt")).unwrap();
+    let dims: Vec<usize> = shape
+        .split_whitespace()
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let (n, m, t) = (dims[0], dims[1], dims[2]);
+    let x_all = read_bin(&adir.join("airframe_points.bin"), n, m);
+    let f_all = read_bin(&adir.join("airframe_values.bin"), n, t);
+    let nf = n - AIRFRAME_HELD_OUT;
+    let (x, f) = (x_all.as_ref().subrows(0, nf), f_all.as_ref().subrows(0, nf));
+    let (xh, fh) = (
+        x_all.as_ref().subrows(nf, AIRFRAME_HELD_OUT),
+        f_all.as_ref().subrows(nf, AIRFRAME_HELD_OUT),
+    );
+    let space = ParameterSpace::new(
+        (0..m)
+            .map(|j| Parameter::new(format!("p{j}"), 0.0, 1.0, 0.5).unwrap())
+            .collect(),
+    )
+    .unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(77);
+    let q = Mat::from_fn(1000, m, |_, _| rng.random::<f64>());
+    write_bin(&adir.join("airframe_queries.bin"), q.as_ref(), m);
+    shape_cases("airframe_", reps, &space, x, f, q.as_ref(), xh, fh);
+    let (fit_e, erbf) = time(reps, || {
+        Erbf::fit(&space, x, f, ErbfOptions::default()).unwrap()
+    });
+    let (pred_e, _) = time(reps, || erbf.predict_batch(q.as_ref()).unwrap());
+    let (fit_c, cubic) = time(reps, || {
+        RbfInterpolant::fit(x, f, RbfOptions::cubic()).unwrap()
+    });
+    let (pred_c, _) = time(reps, || cubic.predict_batch(q.as_ref()).unwrap());
+    println!("ours airframe_erbf_fit {fit_e:.6}");
+    println!("ours airframe_erbf_predict_1000 {pred_e:.6}");
+    println!("ours airframe_cubic_fit {fit_c:.6}");
+    println!("ours airframe_cubic_predict_1000 {pred_c:.6}");
+    println!("ours airframe_n {n}");
+    println!("ours airframe_m {m}");
+    println!("ours airframe_t {t}");
 }

@@ -4,6 +4,13 @@
 # timed in the same run. Prints medians, ratios, and the agreement of the predictions of
 # the two cubic (and the two Gaussian) interpolants, which are the same mathematical model.
 #
+# The same for surrogates in the impact-shape basis (`--basis shapes`, shape count chosen
+# automatically): fit + 1000 predictions of whole histories against scipy's cubic on the full
+# histories, with the held-out relative error of both (100 further runs of the same family).
+# Then the same comparisons on an ensemble of coarse airframe crashes (40 runs, 12 sensor
+# nodes x 3 velocity channels x 801 samples; the last 8 held out), generated once by the
+# `airframe_ensemble` example into benches/peers/out/airframe (minutes; kept for later runs).
+#
 # Usage: benches/peers/erbf_scipy.sh [reps]   (from the repository root)
 # Our side is benches/harness/erbf_peer.rs, built as the `erbf_peer` example target.
 set -euo pipefail
@@ -17,14 +24,19 @@ fi
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-target}"
-cargo run --quiet --release --example erbf_peer -- "$WORK" "$REPS" > "$WORK/ours.txt"
-"$VENV/bin/python" - "$WORK" "$REPS" <<'PY'
+AIRFRAME=benches/peers/out/airframe
+if [ ! -f "$AIRFRAME/airframe_shape.txt" ]; then
+    echo "generating the airframe ensemble once (minutes) into $AIRFRAME" >&2
+    cargo run --quiet --release --example airframe_ensemble -- "$AIRFRAME" 40
+fi
+cargo run --quiet --release --example erbf_peer -- "$WORK" "$REPS" "$AIRFRAME" > "$WORK/ours.txt"
+"$VENV/bin/python" - "$WORK" "$REPS" "$AIRFRAME" <<'PY'
 import sys, time, statistics, math
 import numpy as np
 import scipy
 from scipy.interpolate import RBFInterpolator
 
-work, reps = sys.argv[1], int(sys.argv[2])
+work, reps, airframe = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 N, M, T, Q, CHECK = 150, 10, 10_000, 1000, 8
 x = np.fromfile(f"{work}/points.bin", dtype="<f8").reshape(N, M)
 f = np.fromfile(f"{work}/values.bin", dtype="<f8").reshape(N, T)
@@ -74,4 +86,48 @@ print(f"ERBF fit alone {ours['erbf_fit']:.4f} s, 1000-point predict {ours['erbf_
       f"{ours['erbf_training_residual']:.1e}")
 print(f"agreement with scipy (max |ours - scipy| / max |scipy|, first {CHECK} outputs): "
       f"cubic {agreement('cubic', yc):.1e}, gaussian {agreement('gaussian', yg):.1e}")
+
+def held_out(pred, truth):
+    return np.linalg.norm(pred - truth) / np.linalg.norm(truth - truth.mean(axis=0))
+
+def shapes_table(title, prefix, fit_c, pred_c, err_c, fit_g, pred_g, erbf_full):
+    print(title)
+    print(f"{'case':<44} {'ours [s]':>10} {'scipy [s]':>10} {'scipy/ours':>10}")
+    for label in ["shapes_cubic", "shapes_erbf"]:
+        a = ours[f"{prefix}{label}_fit"] + ours[f"{prefix}{label}_predict_1000"]
+        name = f"{label.replace('_', ' ')} ({int(ours[f'{prefix}{label}_count'])} shapes) vs scipy cubic"
+        print(f"{name:<44} {a:>10.4f} {fit_c + pred_c:>10.4f} {(fit_c + pred_c) / a:>10.2f}")
+    print(f"{'ERBF full histories vs scipy Gaussian':<44} {erbf_full:>10.4f} {fit_g + pred_g:>10.4f} "
+          f"{(fit_g + pred_g) / erbf_full:>10.2f}")
+    print(f"held-out relative error: scipy cubic (full) {err_c:.3e}; ours: "
+          + ", ".join(f"{k.replace('_', ' ')} {ours[prefix + k + '_held_out']:.3e}"
+                      for k in ["shapes_cubic", "shapes_erbf", "full_cubic", "full_erbf"]))
+    for k in ["shapes_cubic", "shapes_erbf"]:
+        print(f"  {k.replace('_', ' ')}: fit {ours[prefix + k + '_fit'] * 1e3:.2f} ms, 1000 predictions "
+              f"{ours[prefix + k + '_predict_1000'] * 1e3:.2f} ms, training residual "
+              f"{ours[prefix + k + '_training_residual']:.1e}")
+
+xh = np.fromfile(f"{work}/held_points.bin", dtype="<f8").reshape(-1, M)
+fh = np.fromfile(f"{work}/held_values.bin", dtype="<f8").reshape(-1, T)
+shapes_table("impact-like family (same data as above), fit + 1000 predictions of whole histories:",
+             "", fit_c, pred_c, held_out(ci(xh), fh), fit_g, pred_g,
+             ours["erbf_fit"] + ours["erbf_predict_1000"])
+
+n, m, t = (int(v) for v in open(f"{airframe}/airframe_shape.txt").read().split())
+ax = np.fromfile(f"{airframe}/airframe_points.bin", dtype="<f8").reshape(n, m)
+af = np.fromfile(f"{airframe}/airframe_values.bin", dtype="<f8").reshape(n, t)
+aq = np.fromfile(f"{airframe}/airframe_queries.bin", dtype="<f8").reshape(-1, m)
+nf = n - 8
+x, f = ax[:nf], af[:nf]
+a_fit_g, agi = timed(lambda: RBFInterpolator(x, f, kernel="gaussian", epsilon=eps, degree=-1))
+a_pred_g, _ = timed(lambda: agi(aq))
+a_fit_c, aci = timed(lambda: RBFInterpolator(x, f, kernel="cubic", degree=1))
+a_pred_c, _ = timed(lambda: aci(aq))
+shapes_table(f"airframe ensemble ({nf} runs fit, {n - nf} held out, {m} parameters, T = {t}), "
+             "fit + 1000 predictions:", "airframe_", a_fit_c, a_pred_c,
+             held_out(aci(ax[nf:]), af[nf:]), a_fit_g, a_pred_g,
+             ours["airframe_erbf_fit"] + ours["airframe_erbf_predict_1000"])
+print(f"  full cubic (ours): fit {ours['airframe_cubic_fit'] * 1e3:.2f} ms, 1000 predictions "
+      f"{ours['airframe_cubic_predict_1000'] * 1e3:.2f} ms; scipy cubic {a_fit_c * 1e3:.2f} + "
+      f"{a_pred_c * 1e3:.2f} ms")
 PY

@@ -4,7 +4,11 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
 use impactcal::core::{Samples, Table, TableOptions, read_samples, read_text};
-use impactcal::erbf::{ErbfError, ErrorSummary, LooMethod, ResponseSurrogate, SurrogateKind};
+use impactcal::erbf::{
+    ErbfError, FitOptions, LooMethod, OutputBasis, ResponseSurrogate, SurrogateKind, Tuning,
+};
+
+use impactcal::erbf::{ComponentOptions, RadialFunction, SurrogateModel};
 
 use crate::error::CliError;
 use crate::output::{write_json, writer};
@@ -39,11 +43,26 @@ enum Kind {
     ThinPlate,
     /// Multiquadric RBF (c = 0.15 in scaled inputs) with a constant tail.
     Multiquadric,
+    /// The classic RBF kind, shape parameter and smoothing with the smallest
+    /// leave-one-out error, chosen per output (or per shape coordinate).
+    Auto,
+}
+
+/// Output representations on the command line.
+#[derive(ValueEnum, Clone, Copy, Debug, Default)]
+enum Basis {
+    /// Every output column.
+    #[default]
+    Full,
+    /// Coordinates on the impact shapes of the training histories (one surrogate per
+    /// coordinate, histories rebuilt when predicted).
+    Shapes,
 }
 
 impl From<Kind> for SurrogateKind {
     fn from(k: Kind) -> Self {
         match k {
+            Kind::Auto => SurrogateKind::Cubic,
             Kind::Erbf => SurrogateKind::Erbf,
             Kind::Gaussian => SurrogateKind::Gaussian,
             Kind::Cubic => SurrogateKind::Cubic,
@@ -62,6 +81,17 @@ struct FitArgs {
     /// Surrogate kind.
     #[arg(long, value_enum, default_value = "erbf")]
     kind: Kind,
+    /// Fit every output column, or the coordinates of the histories on their impact shapes.
+    #[arg(long, value_enum, default_value = "full")]
+    basis: Basis,
+    /// Impact shapes to keep with `--basis shapes` (default: the fewest whose truncation
+    /// error stays below a quarter of the surrogate's leave-one-out error).
+    #[arg(long)]
+    shapes: Option<usize>,
+    /// Choose the shape parameter (Gaussian and multiquadric width, ERBF's r_c) and the
+    /// smoothing by leave-one-out, per output (or per shape coordinate).
+    #[arg(long)]
+    auto: bool,
     /// Where to write the model (JSON); stdout when absent.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -92,17 +122,35 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
 fn fit(a: FitArgs) -> Result<(), CliError> {
     let (space, params, outputs) = a.files.read()?;
-    let model = ResponseSurrogate::fit(
+    let basis = match (a.basis, a.shapes) {
+        (Basis::Full, None) => OutputBasis::Full,
+        (Basis::Full, Some(_)) => {
+            return Err(CliError::input("--shapes needs --basis shapes".to_string()));
+        }
+        (Basis::Shapes, count) => OutputBasis::Shapes { count },
+    };
+    let tuning = match (a.kind, a.auto) {
+        (Kind::Auto, _) => Tuning::Kinds,
+        (_, true) => Tuning::Parameters,
+        (_, false) => Tuning::Off,
+    };
+    let options = FitOptions {
+        kind: a.kind.into(),
+        basis,
+        tuning,
+    };
+    let model = ResponseSurrogate::fit_with(
         &space,
-        a.kind.into(),
         params.points.as_ref(),
         outputs.to_matrix().as_ref(),
         outputs.header().to_vec(),
+        &options,
     )
     .map_err(|e| fit_error(e, &params, &a.files.params))?;
     eprintln!(
-        "surrogate ({:?}): {} samples, {} parameters, {} outputs",
+        "surrogate ({:?}{}): {} samples, {} parameters, {} outputs",
         model.kind(),
+        describe(&model),
         model.n_samples(),
         space.dim(),
         outputs.header().len()
@@ -111,17 +159,113 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
         "training residual max|f(x_k) - F_k| / max|F| = {:.3e}",
         model.training_residual()
     );
-    match model.loo_errors(LooMethod::Auto) {
-        Ok(e) => {
-            let s = ErrorSummary::new(e.as_ref(), model.values());
+    report_loo(&model);
+    write_json(&model, a.out.as_deref())
+}
+
+/// What a component model chose, for the summary line.
+fn describe(model: &ResponseSurrogate) -> String {
+    let SurrogateModel::Components(c) = model.model() else {
+        return String::new();
+    };
+    let mut out = String::new();
+    if let Some(b) = c.basis() {
+        out += &format!(
+            ", {} impact shapes, truncation error {:.2e}",
+            b.len(),
+            b.truncation_error(b.len())
+        );
+    }
+    let options = c.column_options();
+    if options.len() <= MAX_LISTED {
+        let names: Vec<String> = options.iter().map(describe_options).collect();
+        out += &format!(
+            "; per {}: {}",
+            if c.basis().is_some() {
+                "shape"
+            } else {
+                "output"
+            },
+            names.join(", ")
+        );
+    }
+    out
+}
+
+fn describe_options(o: &ComponentOptions) -> String {
+    match o {
+        ComponentOptions::Erbf(e) => format!("erbf r_c={:.3}", e.rc),
+        ComponentOptions::Rbf(r) => {
+            let shape = match r.radial {
+                RadialFunction::Gaussian { width } => format!(" width={width:.3}"),
+                RadialFunction::Multiquadric { c } => format!(" c={c:.3}"),
+                _ => String::new(),
+            };
+            format!(
+                "{:?}{shape} smoothing={:.2e}",
+                SurrogateKind::of(o),
+                r.smoothing
+            )
+        }
+    }
+}
+
+/// Outputs listed one per line in the summaries (more are pooled).
+const MAX_LISTED: usize = 20;
+
+/// Prints the leave-one-out error, beside the linear trend's, and warns where the model
+/// is worse than the trend.
+fn report_loo(model: &ResponseSurrogate) {
+    let cmp = match model.loo_against_trend(LooMethod::Auto) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("leave-one-out error: not available ({e})");
+            return;
+        }
+    };
+    let s = cmp.summary;
+    eprintln!(
+        "leave-one-out error: rms {:.6e}, max {:.6e}, rms / std(F) {:.4}",
+        s.rms, s.max_abs, s.relative_rms
+    );
+    let names = model.output_names();
+    if names.len() <= MAX_LISTED {
+        for (c, name) in names.iter().enumerate() {
             eprintln!(
-                "leave-one-out error: rms {:.6e}, max {:.6e}, rms / std(F) {:.4}",
-                s.rms, s.max_abs, s.relative_rms
+                "  {name}: leave-one-out rms / std {:.4}, linear trend {:.4}",
+                cmp.model[c], cmp.trend[c]
             );
         }
-        Err(e) => eprintln!("leave-one-out error: not available ({e})"),
+    } else {
+        eprintln!(
+            "linear trend leave-one-out rms / std(F) {:.4} (pooled over {} outputs)",
+            cmp.pooled_trend,
+            names.len()
+        );
     }
-    write_json(&model, a.out.as_deref())
+    let worse = cmp.worse_than_trend();
+    if names.len() <= MAX_LISTED {
+        for c in worse {
+            eprintln!(
+                "warning: {}: the leave-one-out error ({:.4} of std) is {:.2}x that of a \
+                 linear trend ({:.4}): the surrogate fits noise or its width does not suit \
+                 the samples; try --auto, --kind auto, or a linear model",
+                names[c],
+                cmp.model[c],
+                cmp.model[c] / cmp.trend[c],
+                cmp.trend[c]
+            );
+        }
+    } else if !worse.is_empty() || cmp.pooled_model > cmp.pooled_trend {
+        eprintln!(
+            "warning: the leave-one-out error is worse than a linear trend's on {} of {} \
+             outputs (pooled {:.4} against {:.4} of std); try --auto or --kind auto",
+            worse.len(),
+            names.len(),
+            cmp.pooled_model,
+            cmp.pooled_trend
+        );
+    }
 }
 
 fn predict(a: PredictArgs) -> Result<(), CliError> {

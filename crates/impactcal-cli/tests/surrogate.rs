@@ -211,3 +211,123 @@ fn bad_input_exits_with_code_2_and_says_where() {
     assert_eq!(code, 2);
     assert!(err.contains("not a surrogate model"), "{err}");
 }
+
+/// `impactcal surrogate fit` on `bounds.csv`, `P.csv` and `Y.csv` of `dir`, writing
+/// `m.json`, with `extra` arguments.
+fn fit_in(dir: &Path, extra: &[&str]) -> (i32, String, String) {
+    let d = |f: &str| dir.join(f).display().to_string();
+    let (b, p, y, m) = (d("bounds.csv"), d("P.csv"), d("Y.csv"), d("m.json"));
+    let mut args = vec![
+        "surrogate",
+        "fit",
+        "--bounds",
+        &b,
+        "--params",
+        &p,
+        "--outputs",
+        &y,
+        "--out",
+        &m,
+    ];
+    args.extend_from_slice(extra);
+    impactcal(&args)
+}
+
+/// `--basis shapes --shapes K`: the training histories come back to within the truncation
+/// of K shapes, the summary names the shapes, and the saved model predicts the same.
+#[test]
+fn shape_basis_fit_reproduces_the_training_runs_within_its_truncation() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, ys) = write_case(dir.path(), 23);
+    let d = |f: &str| dir.path().join(f).display().to_string();
+    let (code, _, err) = impactcal(&[
+        "surrogate",
+        "fit",
+        "--bounds",
+        &d("bounds.csv"),
+        "--params",
+        &d("P.csv"),
+        "--outputs",
+        &d("Y.csv"),
+        "--kind",
+        "cubic",
+        "--basis",
+        "shapes",
+        "--shapes",
+        "14",
+        "--out",
+        &d("m.json"),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("14 impact shapes"), "{err}");
+    assert!(err.contains("linear trend"), "{err}");
+    let (code, _, err) = impactcal(&[
+        "surrogate",
+        "predict",
+        "--model",
+        &d("m.json"),
+        "--params",
+        &d("P.csv"),
+        "--out",
+        &d("Yhat.csv"),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (_, rows) = read_csv(&dir.path().join("Yhat.csv"));
+    // The 14 shapes are the numerical rank of the centred runs: exact reproduction.
+    for (r, y) in rows.iter().zip(&ys) {
+        for (a, b) in r.iter().zip(y) {
+            assert!((a - b).abs() < 1e-8 * (1.0 + b.abs()), "{a} vs {b}");
+        }
+    }
+    // A count without the basis, and a count above the rank, are bad input.
+    for extra in [
+        &["--shapes", "3"][..],
+        &["--basis", "shapes", "--shapes", "40"][..],
+    ] {
+        let (code, _, err) = fit_in(dir.path(), extra);
+        assert_eq!(code, 2, "{extra:?}: {err}");
+        assert!(err.contains("shape"), "{err}");
+    }
+}
+
+/// Noisy data around a plane: the interpolating cubic's leave-one-out error is worse than
+/// the linear trend's and `fit` says so; with `--auto` the smoothing it chooses brings the
+/// error down to the trend's (no worse than 5 % above it).
+#[test]
+fn fit_warns_when_worse_than_a_linear_trend() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("bounds.csv"),
+        "name,lower,upper,nominal\na,0,1,0.5\nb,0,1,0.5\n",
+    )
+    .unwrap();
+    let n = 60;
+    let mut p = String::from("a,b\n");
+    let mut y = String::from("y\n");
+    for i in 0..n {
+        let a = (i as f64 + 0.5) / n as f64;
+        let b = (((17 * i + 5) % n) as f64 + 0.5) / n as f64;
+        // Deterministic "noise" of amplitude 0.5 on a plane of range 3.
+        let noise = 0.5 * ((i * 7919 % 101) as f64 / 50.0 - 1.0);
+        p.push_str(&format!("{a},{b}\n"));
+        y.push_str(&format!("{}\n", 1.0 + 2.0 * a + b + noise));
+    }
+    std::fs::write(dir.path().join("P.csv"), p).unwrap();
+    std::fs::write(dir.path().join("Y.csv"), y).unwrap();
+    let fit = |extra: &[&str]| fit_in(dir.path(), extra);
+    let (code, _, err) = fit(&["--kind", "cubic"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("warning: y: the leave-one-out error"), "{err}");
+    let (code, _, err) = fit(&["--kind", "cubic", "--auto"]);
+    assert_eq!(code, 0, "{err}");
+    let line = err
+        .lines()
+        .find(|l| l.contains("y: leave-one-out rms / std"))
+        .unwrap();
+    let nums: Vec<f64> = line
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    let (model, trend) = (nums[nums.len() - 2], nums[nums.len() - 1]);
+    assert!(model <= 1.05 * trend, "{line}");
+}

@@ -216,6 +216,21 @@ impl Erbf {
         }
     }
 
+    /// Keeps only the first `k` outputs (`k` capped at `T`): the model of those columns,
+    /// without refitting (every output column is solved independently with the same
+    /// factorisation).
+    pub(crate) fn keep_outputs(&mut self, k: usize) {
+        let k = k.min(self.n_outputs());
+        self.values = self.values.subcols(0, k).to_owned();
+        self.mean.truncate(k);
+        if let Some(c) = &mut self.centred {
+            *c = c.subcols(0, k).to_owned();
+        }
+        if let Some(c) = &mut self.coef {
+            *c = c.subcols(0, k).to_owned();
+        }
+    }
+
     /// `Z = R^{-T} F` (`N x T`), formed on demand.
     fn z(&self) -> Mat<f64> {
         let mut z = self.responses().to_owned();

@@ -54,6 +54,10 @@ pub enum ErbfError {
         /// Why.
         message: String,
     },
+    /// The impact-shape decomposition of the training outputs failed (an output basis of
+    /// [`crate::shape_basis`]).
+    #[error(transparent)]
+    Shapes(#[from] impactcal_shapes::ShapesError),
     /// Serialised model data that does not describe a valid model.
     #[error("invalid model data: {0}")]
     InvalidModel(String),
@@ -69,6 +73,7 @@ impl ErbfError {
     pub fn kind(&self) -> ErrorKind {
         match self {
             ErbfError::Core(e) => e.kind(),
+            ErbfError::Shapes(e) => e.kind(),
             ErbfError::Singular { .. } | ErbfError::LooUndefined { .. } => ErrorKind::Numerical,
             _ => ErrorKind::BadInput,
         }

@@ -65,6 +65,7 @@
 
 mod basis;
 pub mod buffer;
+pub mod components;
 mod data;
 pub mod erbf;
 pub mod error;
@@ -75,9 +76,13 @@ pub mod options;
 mod projection;
 pub mod radial;
 pub mod rbf;
+pub mod shape_basis;
 pub mod surrogate;
 mod thin_qr;
+pub mod trend;
+pub mod tuning;
 
+pub use components::{Components, OutputBasis, Tuning};
 pub use erbf::Erbf;
 pub use error::{ErbfError, Result};
 pub use loo::{ErrorSummary, LooMethod};
@@ -85,4 +90,7 @@ pub use metrics::Accuracy;
 pub use options::{ErbfOptions, FamilyWeights, ValidErbfOptions};
 pub use radial::{PolyDegree, RadialFunction};
 pub use rbf::{RbfInterpolant, RbfOptions, ValidRbfOptions};
-pub use surrogate::{ResponseSurrogate, SurrogateKind, SurrogateModel};
+pub use shape_basis::ShapeBasis;
+pub use surrogate::{FitOptions, LooComparison, ResponseSurrogate, SurrogateKind, SurrogateModel};
+pub use trend::linear_trend_loo;
+pub use tuning::ComponentOptions;

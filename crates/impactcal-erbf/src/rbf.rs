@@ -672,6 +672,17 @@ impl RbfInterpolant {
         }
     }
 
+    /// Keeps only the first `k` outputs (`k` capped at `T`), without refitting: every
+    /// output column is solved independently with the same factorisation.
+    pub(crate) fn keep_outputs(&mut self, k: usize) {
+        let k = k.min(self.n_outputs());
+        self.values = self.values.subcols(0, k).to_owned();
+        let coef = self.coef.take().map(|c| c.subcols(0, k).to_owned());
+        if let Some(c) = coef {
+            let _ = self.coef.set(c);
+        }
+    }
+
     /// The coefficients `[c; a]`, solving for them on first use.
     fn coef(&self) -> &Mat<f64> {
         self.coef

@@ -10,16 +10,18 @@ use faer::{Mat, MatRef};
 use impactcal_core::ParameterSpace;
 use serde::{Deserialize, Serialize};
 
+use crate::components::{Components, OutputBasis, Tuning};
 use crate::erbf::Erbf;
 use crate::error::Result;
-use crate::loo::LooMethod;
+use crate::loo::{ErrorSummary, LooMethod};
 use crate::options::ValidErbfOptions;
 use crate::radial::RadialFunction;
 use crate::rbf::{RbfInterpolant, RbfOptions};
+use crate::tuning::ComponentOptions;
 use impactcal_core::error::dimension_mismatch;
 
 /// The kinds of surrogate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SurrogateKind {
     /// ERBF with the default options ([`ErbfOptions::default`](crate::ErbfOptions)).
@@ -51,6 +53,76 @@ impl SurrogateKind {
     }
 }
 
+impl SurrogateKind {
+    /// The options of this kind's model with its defaults.
+    pub fn component_options(self) -> ComponentOptions {
+        match self.rbf_options() {
+            None => ComponentOptions::Erbf(crate::ErbfOptions::default()),
+            Some(o) => ComponentOptions::Rbf(o),
+        }
+    }
+
+    /// The kind of a model with these options.
+    pub fn of(options: &ComponentOptions) -> Self {
+        match options {
+            ComponentOptions::Erbf(_) => SurrogateKind::Erbf,
+            ComponentOptions::Rbf(o) => match o.radial {
+                RadialFunction::Cubic => SurrogateKind::Cubic,
+                RadialFunction::ThinPlate => SurrogateKind::ThinPlate,
+                RadialFunction::Gaussian { .. } => SurrogateKind::Gaussian,
+                RadialFunction::Multiquadric { .. } => SurrogateKind::Multiquadric,
+            },
+        }
+    }
+}
+
+/// How [`ResponseSurrogate::fit_with`] builds a surrogate: its kind, the representation of
+/// the outputs and what leave-one-out cross-validation chooses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct FitOptions {
+    /// The kind (the family whose defaults are used or tuned; with [`Tuning::Kinds`] only
+    /// the fall-back when no candidate fits).
+    pub kind: SurrogateKind,
+    /// Full outputs or impact-shape coordinates.
+    pub basis: OutputBasis,
+    /// What is chosen by leave-one-out.
+    pub tuning: Tuning,
+}
+
+impl Default for SurrogateKind {
+    /// ERBF, the source paper's surrogate.
+    fn default() -> Self {
+        SurrogateKind::Erbf
+    }
+}
+
+/// Leave-one-out errors of a surrogate and of the linear trend, as `rms / std` of the
+/// training values (see [`ResponseSurrogate::loo_against_trend`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LooComparison {
+    /// The surrogate's, per output.
+    pub model: Vec<f64>,
+    /// The linear trend's, per output (`NaN` when undefined).
+    pub trend: Vec<f64>,
+    /// The surrogate's, pooled over outputs ([`ErrorSummary::relative_rms`]).
+    pub pooled_model: f64,
+    /// The linear trend's, pooled.
+    pub pooled_trend: f64,
+    /// The surrogate's errors summarised (pooled).
+    pub summary: ErrorSummary,
+}
+
+impl LooComparison {
+    /// The outputs whose leave-one-out error exceeds the linear trend's: where the
+    /// surrogate, by its own cross-validation, does worse than a straight line (fitting
+    /// noise, or a shape parameter unsuited to the sample spacing).
+    pub fn worse_than_trend(&self) -> Vec<usize> {
+        (0..self.model.len())
+            .filter(|&c| self.model[c] > self.trend[c])
+            .collect()
+    }
+}
+
 /// The fitted model inside a [`ResponseSurrogate`].
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
@@ -66,6 +138,9 @@ pub enum SurrogateModel {
         /// The interpolant in scaled inputs.
         interpolant: RbfInterpolant,
     },
+    /// Surrogates of output components (impact-shape coordinates or single outputs), each
+    /// group with its own options ([`crate::components`]).
+    Components(Components),
 }
 
 /// A fitted surrogate of named responses over a parameter space: any [`SurrogateKind`],
@@ -122,11 +197,46 @@ impl ResponseSurrogate {
         })
     }
 
-    /// The kind of the model.
+    /// Fits a surrogate as `options` say: [`fit`](Self::fit) for the full outputs without
+    /// tuning, else a [`Components`] model (impact-shape coordinates and/or options chosen
+    /// by leave-one-out).
+    ///
+    /// # Errors
+    /// As [`fit`](Self::fit) and [`Components::fit`].
+    pub fn fit_with(
+        space: &ParameterSpace,
+        points: MatRef<'_, f64>,
+        values: MatRef<'_, f64>,
+        output_names: Vec<String>,
+        options: &FitOptions,
+    ) -> Result<Self> {
+        if options.basis == OutputBasis::Full && options.tuning == Tuning::Off {
+            return Self::fit(space, options.kind, points, values, output_names);
+        }
+        crate::components::check_names(&output_names, values.ncols())?;
+        let model = Components::fit(
+            space,
+            points,
+            values,
+            options.kind.component_options(),
+            options.basis,
+            options.tuning,
+        )?;
+        Ok(ResponseSurrogate {
+            output_names,
+            model: SurrogateModel::Components(model),
+        })
+    }
+
+    /// The kind of the model (for component models, that of the first component).
     pub fn kind(&self) -> SurrogateKind {
         match &self.model {
             SurrogateModel::Erbf(_) => SurrogateKind::Erbf,
             SurrogateModel::Rbf { rbf_kind, .. } => *rbf_kind,
+            SurrogateModel::Components(c) => c
+                .column_options()
+                .first()
+                .map_or(SurrogateKind::Erbf, SurrogateKind::of),
         }
     }
 
@@ -140,6 +250,7 @@ impl ResponseSurrogate {
         match &self.model {
             SurrogateModel::Erbf(e) => e.space(),
             SurrogateModel::Rbf { space, .. } => space,
+            SurrogateModel::Components(c) => c.space(),
         }
     }
 
@@ -153,6 +264,7 @@ impl ResponseSurrogate {
         match &self.model {
             SurrogateModel::Erbf(e) => e.n_samples(),
             SurrogateModel::Rbf { interpolant, .. } => interpolant.n_samples(),
+            SurrogateModel::Components(c) => c.n_samples(),
         }
     }
 
@@ -167,6 +279,7 @@ impl ResponseSurrogate {
             SurrogateModel::Rbf {
                 space, interpolant, ..
             } => interpolant.predict_batch(space.to_unit_matrix(points)?.as_ref()),
+            SurrogateModel::Components(c) => c.predict_batch(points),
         }
     }
 
@@ -187,6 +300,7 @@ impl ResponseSurrogate {
                     g[(t, j)] / p[j].width()
                 }))
             }
+            SurrogateModel::Components(c) => c.predict_gradient(x),
         }
     }
 
@@ -201,6 +315,7 @@ impl ResponseSurrogate {
         match &self.model {
             SurrogateModel::Erbf(e) => e.training_residual(),
             SurrogateModel::Rbf { interpolant, .. } => interpolant.training_residual(),
+            SurrogateModel::Components(c) => c.training_residual(),
         }
     }
 
@@ -213,7 +328,54 @@ impl ResponseSurrogate {
         match &self.model {
             SurrogateModel::Erbf(e) => e.loo_errors(method),
             SurrogateModel::Rbf { interpolant, .. } => interpolant.loo_errors(method),
+            SurrogateModel::Components(c) => c.loo_errors(method),
         }
+    }
+
+    /// The training points in unit-scaled inputs, `N x m`.
+    ///
+    /// # Errors
+    /// Only if the stored points fell outside what the space can scale, which a fitted
+    /// model excludes.
+    pub fn unit_points(&self) -> Result<Mat<f64>> {
+        Ok(match &self.model {
+            SurrogateModel::Erbf(e) => e.space().to_unit_matrix(e.points())?,
+            SurrogateModel::Rbf { interpolant, .. } => interpolant.points().to_owned(),
+            SurrogateModel::Components(c) => c.unit_points().to_owned(),
+        })
+    }
+
+    /// The leave-one-out errors of the model beside those of the linear trend (plain
+    /// linear regression, [`linear_trend_loo`](crate::linear_trend_loo)), per output and
+    /// pooled, each as `rms / std` of the training values.
+    ///
+    /// # Errors
+    /// [`ErbfError::LooUndefined`](crate::ErbfError::LooUndefined) when the model's
+    /// leave-one-out errors are undefined; the trend's being undefined (too few samples)
+    /// leaves its entries `NaN` instead.
+    pub fn loo_against_trend(&self, method: LooMethod) -> Result<LooComparison> {
+        let values = self.values();
+        let model = self.loo_errors(method)?;
+        let unit = self.unit_points()?;
+        let trend = crate::trend::linear_trend_loo(unit.as_ref(), values).ok();
+        let per = |e: MatRef<'_, f64>| -> Vec<f64> {
+            (0..e.ncols())
+                .map(|c| ErrorSummary::new(e.subcols(c, 1), values.subcols(c, 1)).relative_rms)
+                .collect()
+        };
+        let t = values.ncols();
+        let summary = ErrorSummary::new(model.as_ref(), values);
+        Ok(LooComparison {
+            summary,
+            model: per(model.as_ref()),
+            trend: trend
+                .as_ref()
+                .map_or(vec![f64::NAN; t], |e| per(e.as_ref())),
+            pooled_model: summary.relative_rms,
+            pooled_trend: trend.as_ref().map_or(f64::NAN, |e| {
+                ErrorSummary::new(e.as_ref(), values).relative_rms
+            }),
+        })
     }
 
     /// The training responses, `N x T`.
@@ -221,6 +383,7 @@ impl ResponseSurrogate {
         match &self.model {
             SurrogateModel::Erbf(e) => e.values(),
             SurrogateModel::Rbf { interpolant, .. } => interpolant.values(),
+            SurrogateModel::Components(c) => c.values(),
         }
     }
 }

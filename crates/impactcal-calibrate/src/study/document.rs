@@ -391,6 +391,18 @@ fn surrogate_section(r: &StudyResult) -> Section {
             s.q.smoothing_lambda
                 .map_or("-".into(), |l| format!("{l:e}"))
         )));
+        let shapes = |c: &super::surrogates::SurrogateChoice| {
+            c.shape_count.map_or("full histories".to_string(), |k| {
+                format!("{k} impact shapes")
+            })
+        };
+        blocks.push(Block::Paragraph(format!(
+            "A `-shapes` surrogate predicts the coordinates of the histories on the \
+             ensemble's impact shapes and rebuilds the histories from them; it is used when \
+             its LOO error is within 1 % of the best. Q(t): {}; sensor histories: {}.",
+            shapes(&s.q),
+            shapes(&s.sensors)
+        )));
         blocks.push(table(
             "Leave-one-out errors by surrogate",
             &["surrogate", "Q(t)", "sensor histories"],

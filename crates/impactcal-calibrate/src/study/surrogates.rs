@@ -1,14 +1,18 @@
 //! Surrogates of whole histories from the ensemble: ERBF (the paper's) and the classic RBF
 //! kernels, each judged by its leave-one-out (LOO) error, plus a smoothing cubic RBF whose
 //! regularisation `lambda` is chosen by LOO over a grid (for ensembles that carry the model's
-//! own noise, which an interpolant would reproduce).
+//! own noise, which an interpolant would reproduce). Every kind is also fitted in the
+//! impact-shape basis of the ensemble (coordinates on its shapes, histories rebuilt; the
+//! shape count chosen by the truncation and LOO errors), and that cheaper form is chosen
+//! whenever its LOO error is within [`SHAPES_MARGIN`] of the best.
 
 use std::collections::BTreeMap;
 
 use faer::{Mat, MatRef};
 use impactcal_core::ParameterSpace;
 use impactcal_erbf::{
-    ErrorSummary, LooMethod, RbfInterpolant, RbfOptions, ResponseSurrogate, SurrogateKind,
+    ErrorSummary, FitOptions, LooMethod, OutputBasis, RbfInterpolant, RbfOptions,
+    ResponseSurrogate, SurrogateKind, SurrogateModel, Tuning,
 };
 use serde::{Deserialize, Serialize};
 
@@ -26,6 +30,13 @@ pub const KINDS: [SurrogateKind; 5] = [
 /// The smoothing values tried for the smoothing cubic RBF (added to the kernel diagonal of
 /// the system in unit-cube inputs; 0 interpolates).
 pub const LAMBDAS: [f64; 8] = [0.0, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1];
+
+/// Suffix of the shape-basis form of a kind in the tables (`cubic-shapes`, ...).
+pub const SHAPES_SUFFIX: &str = "-shapes";
+
+/// The shape-basis form of a kind is chosen when its LOO error is at most this factor times
+/// the best LOO error of all surrogates (1 %: as accurate, and cheaper to predict).
+pub const SHAPES_MARGIN: f64 = 1.01;
 
 /// Name of the smoothing surrogate in the tables.
 pub const SMOOTHING: &str = "cubic-smoothing";
@@ -45,6 +56,10 @@ pub struct SurrogateChoice {
     pub loo_rel_error: f64,
     /// The smoothing chosen by LOO for the smoothing surrogate.
     pub smoothing_lambda: Option<f64>,
+    /// Impact shapes kept when the chosen surrogate works in the shape basis (its name
+    /// ends in `-shapes`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape_count: Option<usize>,
 }
 
 /// A fitted surrogate: one of the kinds, or the smoothing cubic RBF.
@@ -107,16 +122,34 @@ pub fn choose(
         }
     };
     let names: Vec<String> = (0..values.ncols()).map(|c| format!("y{c}")).collect();
+    let mut shaped: Vec<(f64, String, Fitted)> = Vec::new();
     for kind in KINDS {
-        let outcome = (|| {
-            let s = ResponseSurrogate::fit(space, kind, points, values, names.clone())?;
-            let e = s.loo_errors(LooMethod::Auto)?;
-            Ok((
-                ErrorSummary::new(e.as_ref(), values).relative_rms,
-                Fitted::Response(s),
-            ))
-        })();
-        consider(name(kind), outcome);
+        for basis in [OutputBasis::Full, OutputBasis::Shapes { count: None }] {
+            let options = FitOptions {
+                kind,
+                basis,
+                tuning: Tuning::Off,
+            };
+            let outcome = (|| {
+                let s =
+                    ResponseSurrogate::fit_with(space, points, values, names.clone(), &options)?;
+                let e = s.loo_errors(LooMethod::Auto)?;
+                Ok((
+                    ErrorSummary::new(e.as_ref(), values).relative_rms,
+                    Fitted::Response(s),
+                ))
+            })();
+            let label = match basis {
+                OutputBasis::Full => name(kind),
+                OutputBasis::Shapes { .. } => format!("{}{SHAPES_SUFFIX}", name(kind)),
+            };
+            if let (OutputBasis::Shapes { .. }, Ok((e, f))) = (basis, &outcome)
+                && e.is_finite()
+            {
+                shaped.push((*e, label.clone(), f.clone()));
+            }
+            consider(label, outcome);
+        }
     }
     let unit = space.to_unit_matrix(points)?;
     let mut smooth: Option<(f64, f64, RbfInterpolant)> = None;
@@ -152,11 +185,26 @@ pub fn choose(
             )),
         ),
     }
-    let Some((loo_rel_error, chosen, fitted)) = best else {
+    let Some((mut loo_rel_error, mut chosen, mut fitted)) = best else {
         return Err(CalibrateError::study(
             "surrogates",
             format!("none could be fitted: {failed:?}"),
         ));
+    };
+    // The shape basis where it is as accurate: the best shape-basis form within the margin.
+    if let Some((e, label, f)) = shaped
+        .into_iter()
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .filter(|(e, _, _)| *e <= SHAPES_MARGIN * loo_rel_error)
+    {
+        (loo_rel_error, chosen, fitted) = (e, label, f);
+    }
+    let shape_count = match &fitted {
+        Fitted::Response(r) => match r.model() {
+            SurrogateModel::Components(c) => c.basis().map(|b| b.len()),
+            _ => None,
+        },
+        Fitted::Smoothing(..) => None,
     };
     Ok((
         SurrogateChoice {
@@ -165,6 +213,7 @@ pub fn choose(
             chosen,
             loo_rel_error,
             smoothing_lambda,
+            shape_count,
         },
         fitted,
     ))
