@@ -145,7 +145,11 @@ impl DropTower {
     pub fn with_appendage(mut self, mass: f64, frequency: f64) -> Result<Self> {
         for (name, v) in [("appendage mass", mass), ("appendage frequency", frequency)] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(CoreError::invalid_option(name, v, "must be finite and positive"));
+                return Err(CoreError::invalid_option(
+                    name,
+                    v,
+                    "must be finite and positive",
+                ));
             }
         }
         self.appendage = Some((mass, frequency));
@@ -160,7 +164,9 @@ impl DropTower {
     /// The value of held quantity `i` at point `p`: the point's when the quantity is in the
     /// space, else the held value.
     fn value(&self, i: usize, p: &[f64]) -> f64 {
-        self.space.index_of(HELD[i].0).map_or(self.held[i], |j| p[j])
+        self.space
+            .index_of(HELD[i].0)
+            .map_or(self.held[i], |j| p[j])
     }
 
     fn run(&self, p: &[f64]) -> Result<Histories> {
@@ -180,10 +186,7 @@ impl DropTower {
             self.value(3, p),
         );
         let m = [MASSES[0], MASSES[1], MASSES[2] + dm];
-        let k: Vec<f64> = SECTIONS
-            .iter()
-            .map(|a| modulus * 1e9 * a * scale)
-            .collect();
+        let k: Vec<f64> = SECTIONS.iter().map(|a| modulus * 1e9 * a * scale).collect();
         let c: Vec<f64> = (0..2)
             .map(|i| {
                 let mu = m[i] * m[i + 1] / (m[i] + m[i + 1]);
@@ -320,7 +323,10 @@ impl Enrichable for DropTower {
                 return Err(CoreError::invalid_option(
                     format!("condition {name}"),
                     value,
-                    format!("outside its admissible range [{}, {}]", HELD[i].1, HELD[i].2),
+                    format!(
+                        "outside its admissible range [{}, {}]",
+                        HELD[i].1, HELD[i].2
+                    ),
                 ));
             }
             out.held[i] = *value;

@@ -72,7 +72,11 @@ pub fn measured(y: &Histories, m: &Measurement) -> Result<Histories> {
         ));
     }
     if !(0.0..1.0).contains(&m.ar1) {
-        return Err(CoreError::invalid_option("ar1", m.ar1, "must lie in [0, 1)"));
+        return Err(CoreError::invalid_option(
+            "ar1",
+            m.ar1,
+            "must lie in [0, 1)",
+        ));
     }
     if let Some(s) = m.snr_db
         && !s.is_finite()

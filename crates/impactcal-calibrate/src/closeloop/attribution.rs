@@ -121,8 +121,13 @@ pub(crate) fn attribute<M: Enrichable>(
     let cands: Vec<Candidate> = model.candidates();
     let frame = &ctx.frame;
     let base = nuisance::apply(&fit.y, frame, &fit.terms);
-    let mut dirs: Vec<(String, String, String, Vec<f64>, Option<(f64, f64, f64, f64)>)> =
-        Vec::new();
+    let mut dirs: Vec<(
+        String,
+        String,
+        String,
+        Vec<f64>,
+        Option<(f64, f64, f64, f64)>,
+    )> = Vec::new();
     if !cands.is_empty() {
         let params: Vec<_> = cands.iter().map(|c| c.parameter.clone()).collect();
         let full = model.enrich(&params)?;
@@ -144,7 +149,10 @@ pub(crate) fn attribute<M: Enrichable>(
             .collect();
         let outs = ctx.stage(&full, &format!("{prefix}-candidates"), &points)?;
         for (k, o) in outs.iter().enumerate() {
-            let yk = ctx.y_of(&histories_of(o, &format!("candidate `{}`", params[k].name))?)?;
+            let yk = ctx.y_of(&histories_of(
+                o,
+                &format!("candidate `{}`", params[k].name),
+            )?)?;
             let mk = nuisance::apply(&yk, frame, &fit.terms);
             let g: Vec<f64> = mk
                 .iter()
@@ -175,13 +183,25 @@ pub(crate) fn attribute<M: Enrichable>(
             scale[s * t + k] = frame.weights[s * t + k] * fit.terms.gains[s] * tt * dy;
         }
     }
-    dirs.push(("time_scale".into(), "signature".into(), "signature".into(), scale, None));
+    dirs.push((
+        "time_scale".into(),
+        "signature".into(),
+        "signature".into(),
+        scale,
+        None,
+    ));
     for (s, l) in frame.labels.iter().enumerate() {
         let mut g = vec![0.0; ys.len()];
         for k in 0..t {
             g[s * t + k] = frame.weights[s * t + k] * (k as f64 - t0).max(0.0);
         }
-        dirs.push((format!("drift:{l}"), "signature".into(), "signature".into(), g, None));
+        dirs.push((
+            format!("drift:{l}"),
+            "signature".into(),
+            "signature".into(),
+            g,
+            None,
+        ));
     }
 
     let lsq = Lsq::new(&fit.jac)?;
@@ -193,7 +213,11 @@ pub(crate) fn attribute<M: Enrichable>(
     for (i, (name, kind, group, g, range)) in dirs.iter().enumerate() {
         let gg = dot(g, g);
         let pg = lsq.project(g);
-        let kappa = if gg > 0.0 { (dot(&pg, &pg) / gg).sqrt() } else { 1.0 };
+        let kappa = if gg > 0.0 {
+            (dot(&pg, &pg) / gg).sqrt()
+        } else {
+            1.0
+        };
         let gt: Vec<f64> = g.iter().zip(&pg).map(|(a, b)| a - b).collect();
         let gtt = dot(&gt, &gt);
         let identifiable = kappa <= KAPPA_MAX && gtt > 0.0;

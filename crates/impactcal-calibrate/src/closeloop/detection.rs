@@ -112,7 +112,10 @@ pub fn detect(
     let s = labels.len();
     let n = e.len();
     if n == 0 || s * samples != n {
-        return Err(CalibrateError::study("detection", "empty or mis-shaped residual"));
+        return Err(CalibrateError::study(
+            "detection",
+            "empty or mis-shaped residual",
+        ));
     }
     let rss: f64 = e.iter().map(|v| v * v).sum();
     let lag1 = autocorrelation(e, samples, 1).clamp(0.0, 0.999);
@@ -196,15 +199,17 @@ mod tests {
             alarms += usize::from(d.model_form_error);
         }
         assert!(alarms <= 1, "{alarms} false alarms in 20");
-        // A pulse on channel b, 0.5 sigma peak over 100 samples.
+        // A pulse on channel b, 3 sigma at its peak, about 100 samples wide.
         let mut e = white(3 * t, 99);
         for k in 0..t {
-            e[t + k] += 0.5 * (-((k as f64 - 200.0) / 50.0).powi(2)).exp() * 2.0;
+            e[t + k] += 3.0 * (-((k as f64 - 200.0) / 50.0).powi(2)).exp();
         }
         let d = detect(&labels, &e, t, 5, 0.0, 0.01).unwrap();
         assert!(d.model_form_error, "{d:?}");
         assert!(d.u1["b"].abs() > 0.9);
-        let peak = (0..t).max_by(|&i, &j| d.v1[i].abs().total_cmp(&d.v1[j].abs())).unwrap();
+        let peak = (0..t)
+            .max_by(|&i, &j| d.v1[i].abs().total_cmp(&d.v1[j].abs()))
+            .unwrap();
         assert!((peak as i64 - 200).abs() < 40, "{peak}");
     }
 }

@@ -59,7 +59,12 @@ impl Journaled<'_> {
     ///
     /// # Errors
     /// Journal errors.
-    pub fn stage<M: Model>(&self, model: &M, stage: &str, points: &[Vec<f64>]) -> Result<Vec<RunOutcome>> {
+    pub fn stage<M: Model>(
+        &self,
+        model: &M,
+        stage: &str,
+        points: &[Vec<f64>],
+    ) -> Result<Vec<RunOutcome>> {
         self.stage_from(model, stage, 0, points)
     }
 }
@@ -98,7 +103,12 @@ pub(crate) struct Fit {
 
 impl Ctx<'_> {
     /// The outcomes of `points` of `model` as journal stage `stage`.
-    pub fn stage<M: Model>(&self, model: &M, stage: &str, points: &[Vec<f64>]) -> Result<Vec<RunOutcome>> {
+    pub fn stage<M: Model>(
+        &self,
+        model: &M,
+        stage: &str,
+        points: &[Vec<f64>],
+    ) -> Result<Vec<RunOutcome>> {
         self.runner.stage(model, stage, points)
     }
 
@@ -164,7 +174,8 @@ pub(crate) fn calibrate<M: Model>(
         let mut run = |first: usize, pts: &[Vec<f64>]| -> Result<Vec<RunOutcome>> {
             ctx.runner.stage_from(model, &stage, first, pts)
         };
-        let best = reconcile::reconcile(space, &warm, budget, ctx.batch, ctx.seed, &mut run, &error)?;
+        let best =
+            reconcile::reconcile(space, &warm, budget, ctx.batch, ctx.seed, &mut run, &error)?;
         point = best.summary.calibrated_point;
         y = ctx.y_of(&best.histories)?;
     }

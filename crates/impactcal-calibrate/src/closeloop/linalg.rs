@@ -88,7 +88,11 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
 ///
 /// # Errors
 /// [`CalibrateError::Study`] when the SVD does not converge.
-pub(crate) fn svd_rows(m: &[f64], rows: usize, cols: usize) -> Result<(Vec<f64>, Mat<f64>, Mat<f64>)> {
+pub(crate) fn svd_rows(
+    m: &[f64],
+    rows: usize,
+    cols: usize,
+) -> Result<(Vec<f64>, Mat<f64>, Mat<f64>)> {
     let a = Mat::from_fn(rows, cols, |i, j| m[i * cols + j]);
     let svd = a
         .thin_svd()

@@ -166,10 +166,28 @@ pub fn run_loop<M: Enrichable>(
     let band = Cfc::from_class(options.noise_band_cfc)?;
 
     // The model's own noise and the noise floor.
-    let spread = model_spread(runner, model, &nominal, &nominal_raw, options, &labels, test.cfc, "noise")?;
+    let spread = model_spread(
+        runner,
+        model,
+        &nominal,
+        &nominal_raw,
+        options,
+        &labels,
+        test.cfc,
+        "noise",
+    )?;
     let y_nominal = prep(&nominal_raw)?;
     let (frame, floor) = frame_of(
-        &labels, test_m.data(), samples, dt, &y_nominal, &spread, max_shift, options, band, None,
+        &labels,
+        test_m.data(),
+        samples,
+        dt,
+        &y_nominal,
+        &spread,
+        max_shift,
+        options,
+        band,
+        None,
     )?;
     let ctx = Ctx {
         frame,
@@ -186,7 +204,14 @@ pub fn run_loop<M: Enrichable>(
 
     // Calibration and forward selection.
     observer.step("calibration");
-    let fit0 = fit::calibrate(&ctx, model, "r0", &[nominal.clone()], options.reconcile, options.polish)?;
+    let fit0 = fit::calibrate(
+        &ctx,
+        model,
+        "r0",
+        &[nominal.clone()],
+        options.reconcile,
+        options.polish,
+    )?;
     let outcome = selection::forward(
         &ctx,
         model,
@@ -256,9 +281,30 @@ pub fn run_loop<M: Enrichable>(
     let p_of = |d: usize| d + n_nuisance;
     let (terms_nominal, _) = ctx.profile(&y_nominal);
     let metrics_calibration = Stages {
-        nominal: errors_of(&ctx.frame, &y_nominal, &terms_nominal, p_of(d0), floor.lag1(), options.alpha)?,
-        calibrated: errors_of(&ctx.frame, &fit0.y, &fit0.terms, p_of(d0), floor.lag1(), options.alpha)?,
-        enriched: errors_of(&ctx.frame, &fit.y, &fit.terms, p_of(fit.point.len()), floor.lag1(), options.alpha)?,
+        nominal: errors_of(
+            &ctx.frame,
+            &y_nominal,
+            &terms_nominal,
+            p_of(d0),
+            floor.lag1(),
+            options.alpha,
+        )?,
+        calibrated: errors_of(
+            &ctx.frame,
+            &fit0.y,
+            &fit0.terms,
+            p_of(d0),
+            floor.lag1(),
+            options.alpha,
+        )?,
+        enriched: errors_of(
+            &ctx.frame,
+            &fit.y,
+            &fit.terms,
+            p_of(fit.point.len()),
+            floor.lag1(),
+            options.alpha,
+        )?,
     };
 
     // The holdout, never fitted.
@@ -269,32 +315,83 @@ pub fn run_loop<M: Enrichable>(
             let enriched_model = model.enrich(&outcome.added)?;
             let enriched_at = enriched_model.at_condition(h.set)?;
             let nominal_h = histories_of(
-                &runner.stage(&declared_at, "holdout-nominal", std::slice::from_ref(&nominal))?[0],
+                &runner.stage(
+                    &declared_at,
+                    "holdout-nominal",
+                    std::slice::from_ref(&nominal),
+                )?[0],
                 "the holdout's nominal run",
             )?;
             check_covered(h.histories, test.map, &nominal_h, "holdout")?;
             let test_h = test_on_model(h.histories, test.map, test.cfc, &nominal_h)?;
             let calibrated_h = histories_of(
-                &runner.stage(&declared_at, "holdout-calibrated", std::slice::from_ref(&fit0.point))?[0],
+                &runner.stage(
+                    &declared_at,
+                    "holdout-calibrated",
+                    std::slice::from_ref(&fit0.point),
+                )?[0],
                 "the holdout's calibrated run",
             )?;
             let enriched_h = histories_of(
-                &runner.stage(&enriched_at, "holdout-enriched", std::slice::from_ref(&fit.point))?[0],
+                &runner.stage(
+                    &enriched_at,
+                    "holdout-enriched",
+                    std::slice::from_ref(&fit.point),
+                )?[0],
                 "the holdout's enriched run",
             )?;
-            let spread_h = model_spread(runner, &declared_at, &nominal, &nominal_h, options, &labels, test.cfc, "holdout-noise")?;
+            let spread_h = model_spread(
+                runner,
+                &declared_at,
+                &nominal,
+                &nominal_h,
+                options,
+                &labels,
+                test.cfc,
+                "holdout-noise",
+            )?;
             let y_nom_h = prep(&nominal_h)?;
             let gains: Vec<f64> = fit.terms.gains.clone();
             let (frame_h, floor_h) = frame_of(
-                &labels, test_h.data(), test_h.samples(), dt, &y_nom_h, &spread_h, max_shift, options, band, Some(&gains),
+                &labels,
+                test_h.data(),
+                test_h.samples(),
+                dt,
+                &y_nom_h,
+                &spread_h,
+                max_shift,
+                options,
+                band,
+                Some(&gains),
             )?;
             let profile = |y: &[f64]| nuisance::profile(y, &frame_h, max_shift, Some(&gains)).0;
             let ys = [y_nom_h, prep(&calibrated_h)?, prep(&enriched_h)?];
             let lag = floor_h.lag1();
             Some(Stages {
-                nominal: errors_of(&frame_h, &ys[0], &profile(&ys[0]), p_of(0), lag, options.alpha)?,
-                calibrated: errors_of(&frame_h, &ys[1], &profile(&ys[1]), p_of(0), lag, options.alpha)?,
-                enriched: errors_of(&frame_h, &ys[2], &profile(&ys[2]), p_of(0), lag, options.alpha)?,
+                nominal: errors_of(
+                    &frame_h,
+                    &ys[0],
+                    &profile(&ys[0]),
+                    p_of(0),
+                    lag,
+                    options.alpha,
+                )?,
+                calibrated: errors_of(
+                    &frame_h,
+                    &ys[1],
+                    &profile(&ys[1]),
+                    p_of(0),
+                    lag,
+                    options.alpha,
+                )?,
+                enriched: errors_of(
+                    &frame_h,
+                    &ys[2],
+                    &profile(&ys[2]),
+                    p_of(0),
+                    lag,
+                    options.alpha,
+                )?,
             })
         }
     };
@@ -363,7 +460,8 @@ fn model_spread<M: Model>(
             None => h.select(labels)?,
         })
     };
-    let runs: Vec<Histories> = runner.stage(model, name, &pts)?
+    let runs: Vec<Histories> = runner
+        .stage(model, name, &pts)?
         .iter()
         .filter_map(|o| o.as_ref().ok())
         .map(&prep)
@@ -402,13 +500,29 @@ fn frame_of(
     let (terms, _) = nuisance::profile(y_nominal, &frame, max_shift, fixed_gains);
     let onset = noise_floor::onset(y_nominal, samples) as f64 + terms.tau / dt;
     let pre = (onset - 3.0).floor().max(0.0) as usize;
-    let floor = noise_floor::estimate(labels, test, samples, dt, pre.min(samples), spread, options.sigma, band)?;
+    let floor = noise_floor::estimate(
+        labels,
+        test,
+        samples,
+        dt,
+        pre.min(samples),
+        spread,
+        options.sigma,
+        band,
+    )?;
     frame.weights = noise_floor::weights(&floor, spread, samples);
     Ok((frame, floor))
 }
 
 /// The errors of model response `y` under nuisance `terms` against the frame's test.
-fn errors_of(frame: &Frame, y: &[f64], terms: &Terms, p: usize, lag1: f64, alpha: f64) -> Result<Errors> {
+fn errors_of(
+    frame: &Frame,
+    y: &[f64],
+    terms: &Terms,
+    p: usize,
+    lag1: f64,
+    alpha: f64,
+) -> Result<Errors> {
     let corrected = nuisance::corrected_test(frame, terms);
     let num: f64 = corrected.iter().zip(y).map(|(a, b)| (a - b).powi(2)).sum();
     let den: f64 = corrected.iter().map(|a| a * a).sum();
@@ -418,14 +532,23 @@ fn errors_of(frame: &Frame, y: &[f64], terms: &Terms, p: usize, lag1: f64, alpha
     let t = frame.samples;
     let (mut sg, mut r, mut k) = (0.0, 0.0, 0.0);
     for s in 0..frame.labels.len() {
-        if let Ok(m) = CurveMetrics::between(&corrected[s * t..(s + 1) * t], &y[s * t..(s + 1) * t], frame.dt, &iso) {
+        if let Ok(m) = CurveMetrics::between(
+            &corrected[s * t..(s + 1) * t],
+            &y[s * t..(s + 1) * t],
+            frame.dt,
+            &iso,
+        ) {
             sg += m.sprague_geers.comprehensive;
             r += m.iso18571.r;
             k += 1.0;
         }
     }
     Ok(Errors {
-        rel_l2: if den > 0.0 { (num / den).sqrt() } else { f64::NAN },
+        rel_l2: if den > 0.0 {
+            (num / den).sqrt()
+        } else {
+            f64::NAN
+        },
         chi2_red: det.chi2_red,
         sprague_geers_c: if k > 0.0 { sg / k } else { f64::NAN },
         iso18571_r: if k > 0.0 { r / k } else { f64::NAN },
@@ -433,7 +556,12 @@ fn errors_of(frame: &Frame, y: &[f64], terms: &Terms, p: usize, lag1: f64, alpha
 }
 
 /// Every test channel must pair with a model channel (through the map, or by label).
-fn check_covered(test: &Histories, map: Option<&ChannelMap>, model: &Histories, what: &str) -> Result<()> {
+fn check_covered(
+    test: &Histories,
+    map: Option<&ChannelMap>,
+    model: &Histories,
+    what: &str,
+) -> Result<()> {
     let missing: Vec<&str> = test
         .labels()
         .iter()
@@ -451,7 +579,11 @@ fn check_covered(test: &Histories, map: Option<&ChannelMap>, model: &Histories, 
             format!(
                 "{} not covered by {} (model channels: {}); map them or drop them from the test",
                 missing.join(", "),
-                if map.is_some() { "the channel map" } else { "the model's labels" },
+                if map.is_some() {
+                    "the channel map"
+                } else {
+                    "the model's labels"
+                },
                 model.labels().join(", ")
             ),
         ))

@@ -222,7 +222,8 @@ mod tests {
                 let u1: f64 = rng.random_range(1e-12..1.0);
                 let u2: f64 = rng.random();
                 let e = (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos();
-                (k as f64 * 1e-4 * 20.0).sin() + 0.3 * e
+                let quiet = if k < 1000 { 0.0 } else { 1.0 };
+                quiet * (k as f64 * 1e-4 * 20.0).sin() + 0.3 * e
             })
             .collect();
         let zeros = vec![0.0; t];
@@ -230,11 +231,19 @@ mod tests {
         let labels = vec!["a".to_string()];
         let pre = estimate(&labels, &test, t, 1e-4, 1000, &zeros, None, cfc).unwrap();
         assert_eq!(pre.channels[0].source, NoiseSource::PreImpact);
-        assert!((pre.channels[0].sigma - 0.3).abs() < 0.02, "{}", pre.channels[0].sigma);
+        assert!(
+            (pre.channels[0].sigma - 0.3).abs() < 0.02,
+            "{}",
+            pre.channels[0].sigma
+        );
         assert!(pre.channels[0].lag1.abs() < 0.1);
         let band = estimate(&labels, &test, t, 1e-4, 5, &zeros, None, cfc).unwrap();
         assert_eq!(band.channels[0].source, NoiseSource::HighBand);
-        assert!((band.channels[0].sigma - 0.3).abs() < 0.03, "{}", band.channels[0].sigma);
+        assert!(
+            (band.channels[0].sigma - 0.3).abs() < 0.03,
+            "{}",
+            band.channels[0].sigma
+        );
         let user = estimate(&labels, &test, t, 1e-4, 5, &zeros, Some(0.5), cfc).unwrap();
         assert_eq!(user.channels[0].sigma, 0.5);
         assert!(estimate(&labels, &zeros, t, 1e-4, 1000, &zeros, None, cfc).is_err());

@@ -89,8 +89,16 @@ impl Terms {
         }
         Nuisance {
             time_shift: self.tau,
-            gains: labels.iter().cloned().zip(self.gains.iter().copied()).collect(),
-            biases: labels.iter().cloned().zip(self.biases.iter().copied()).collect(),
+            gains: labels
+                .iter()
+                .cloned()
+                .zip(self.gains.iter().copied())
+                .collect(),
+            biases: labels
+                .iter()
+                .cloned()
+                .zip(self.biases.iter().copied())
+                .collect(),
             units_flags,
         }
     }
@@ -139,7 +147,11 @@ pub(crate) fn corrected_test(frame: &Frame, terms: &Terms) -> Vec<f64> {
     let d = terms.tau / frame.dt;
     let mut out = Vec::with_capacity(frame.test.len());
     for (s, ch) in frame.test.chunks(t).enumerate() {
-        let g = if terms.gains[s] != 0.0 { terms.gains[s] } else { 1.0 };
+        let g = if terms.gains[s] != 0.0 {
+            terms.gains[s]
+        } else {
+            1.0
+        };
         out.extend((0..t).map(|k| (at(ch, k as f64 + d) - terms.biases[s]) / g));
     }
     out
@@ -147,7 +159,11 @@ pub(crate) fn corrected_test(frame: &Frame, terms: &Terms) -> Vec<f64> {
 
 /// Per channel, the weighted fit of the test on `[ys, 1]` at the given shifted model:
 /// `(g, b, rss)`. `fixed_gains` keeps the gains and fits only the biases.
-fn channel_fits(ys: &[f64], frame: &Frame, fixed_gains: Option<&[f64]>) -> (Vec<f64>, Vec<f64>, f64) {
+fn channel_fits(
+    ys: &[f64],
+    frame: &Frame,
+    fixed_gains: Option<&[f64]>,
+) -> (Vec<f64>, Vec<f64>, f64) {
     let t = frame.samples;
     let (mut gains, mut biases, mut rss) = (Vec::new(), Vec::new(), 0.0);
     for s in 0..frame.labels.len() {

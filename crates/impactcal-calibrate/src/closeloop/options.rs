@@ -76,15 +76,22 @@ impl LoopOptions {
     /// [`CalibrateError::Study`] naming the first bad option, and for a budget too small
     /// to (re)calibrate, with the number of runs needed.
     pub fn check(&self, declared: usize) -> Result<()> {
-        let bad = |what: &str, why: String| Err(CalibrateError::study(format!("option `{what}`"), why));
+        let bad =
+            |what: &str, why: String| Err(CalibrateError::study(format!("option `{what}`"), why));
         if !(self.alpha > 0.0 && self.alpha < 0.5) {
             return bad("alpha", format!("{} must lie in (0, 0.5)", self.alpha));
         }
         if !(0.0..=1.0).contains(&self.min_explained) {
-            return bad("min_explained", format!("{} must lie in [0, 1]", self.min_explained));
+            return bad(
+                "min_explained",
+                format!("{} must lie in [0, 1]", self.min_explained),
+            );
         }
         if self.ensemble < 2 {
-            return bad("ensemble", format!("{} runs; the model's noise needs at least 2", self.ensemble));
+            return bad(
+                "ensemble",
+                format!("{} runs; the model's noise needs at least 2", self.ensemble),
+            );
         }
         if !(self.jitter > 0.0 && self.jitter < 0.1) {
             return bad("jitter", format!("{} must lie in (0, 0.1)", self.jitter));
@@ -93,10 +100,16 @@ impl LoopOptions {
             return bad("batch", "must be at least 1".into());
         }
         if !(self.candidate_step > 0.0 && self.candidate_step <= 0.5) {
-            return bad("candidate_step", format!("{} must lie in (0, 0.5]", self.candidate_step));
+            return bad(
+                "candidate_step",
+                format!("{} must lie in (0, 0.5]", self.candidate_step),
+            );
         }
         if !(self.units_tolerance >= 0.0 && self.units_tolerance < 0.5) {
-            return bad("units_tolerance", format!("{} must lie in [0, 0.5)", self.units_tolerance));
+            return bad(
+                "units_tolerance",
+                format!("{} must lie in [0, 0.5)", self.units_tolerance),
+            );
         }
         if let Some(s) = self.sigma
             && !(s.is_finite() && s > 0.0)
@@ -106,7 +119,10 @@ impl LoopOptions {
         if let Some(s) = self.max_time_shift
             && !(s.is_finite() && s >= 0.0)
         {
-            return bad("max_time_shift", format!("{s} must be finite and non-negative"));
+            return bad(
+                "max_time_shift",
+                format!("{s} must be finite and non-negative"),
+            );
         }
         let need = Self::cors_runs_needed(declared);
         if self.reconcile < need {

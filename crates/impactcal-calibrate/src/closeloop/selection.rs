@@ -50,7 +50,13 @@ pub fn akaike_weights(aic: &[f64]) -> Vec<f64> {
     w.iter().map(|x| x / s).collect()
 }
 
-fn score(fit: &Fit, added: &[Parameter], n_nuisance: usize, inflation: f64, kept: bool) -> ModelScore {
+fn score(
+    fit: &Fit,
+    added: &[Parameter],
+    n_nuisance: usize,
+    inflation: f64,
+    kept: bool,
+) -> ModelScore {
     let k = fit.point.len() + n_nuisance;
     let (aic, bic) = criteria(fit.rss, fit.residual.len(), k, inflation);
     ModelScore {
@@ -182,7 +188,9 @@ pub(crate) fn forward<M: Enrichable>(
             models.push(ModelScore { kept: false, ..s });
             stopped = format!(
                 "adding `{}` did not lower BIC by more than 2 ({:.1} -> {:.1})",
-                p.name, prev_bic, models.last().map_or(f64::NAN, |m| m.bic)
+                p.name,
+                prev_bic,
+                models.last().map_or(f64::NAN, |m| m.bic)
             );
             break;
         }
