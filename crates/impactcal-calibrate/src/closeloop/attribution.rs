@@ -101,6 +101,16 @@ impl Attribution {
     }
 }
 
+/// A direction to score: name, kind, group, whitened direction, and for a candidate its
+/// held value, admissible range and finite step.
+type Direction = (
+    String,
+    String,
+    String,
+    Vec<f64>,
+    Option<(f64, f64, f64, f64)>,
+);
+
 /// Scores the candidates of `model` (and the signature directions) against the residual of
 /// `fit` (see the module docs). `step` is the finite step as a fraction of each range.
 ///
@@ -121,13 +131,7 @@ pub(crate) fn attribute<M: Enrichable>(
     let cands: Vec<Candidate> = model.candidates();
     let frame = &ctx.frame;
     let base = nuisance::apply(&fit.y, frame, &fit.terms);
-    let mut dirs: Vec<(
-        String,
-        String,
-        String,
-        Vec<f64>,
-        Option<(f64, f64, f64, f64)>,
-    )> = Vec::new();
+    let mut dirs: Vec<Direction> = Vec::new();
     if !cands.is_empty() {
         let params: Vec<_> = cands.iter().map(|c| c.parameter.clone()).collect();
         let full = model.enrich(&params)?;

@@ -208,7 +208,7 @@ pub fn run_loop<M: Enrichable>(
         &ctx,
         model,
         "r0",
-        &[nominal.clone()],
+        std::slice::from_ref(&nominal),
         options.reconcile,
         options.polish,
     )?;

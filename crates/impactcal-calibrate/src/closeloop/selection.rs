@@ -17,7 +17,7 @@
 //! (identifiable, admissible, significant, explaining at least `min_explained`), when BIC
 //! does not fall by more than 2, or after `max_added` additions.
 
-use impactcal_core::{Enrichable, Model as _, Parameter};
+use impactcal_core::{Enrichable, Parameter};
 
 use super::attribution::attribute;
 use super::detection::{Detection, detect};
@@ -168,7 +168,7 @@ pub(crate) fn forward<M: Enrichable>(
         let mut at_estimate = fit.point.clone();
         at_estimate.push(estimate);
         let mut start = vec![at_held];
-        if estimate != p.nominal {
+        if (estimate - p.nominal).abs() > 1e-12 * p.width() {
             start.push(at_estimate);
         }
         ctx.runner
