@@ -2,6 +2,8 @@
 //! truth is the model with a hidden effect, measured with a trigger offset, a wrong gain on
 //! one channel and white noise at 40 dB.
 
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
+
 use std::path::Path;
 
 use impactcal_calibrate::closeloop::{Holdout, LoopOptions, LoopResult, Verdict, run_loop};
