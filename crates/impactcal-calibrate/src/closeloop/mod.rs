@@ -54,6 +54,7 @@
 pub mod attribution;
 pub mod detection;
 pub mod discrepancy;
+pub mod document;
 mod fit;
 mod linalg;
 pub mod noise_floor;
