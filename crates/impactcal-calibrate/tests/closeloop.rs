@@ -107,7 +107,7 @@ fn hidden_damping_is_found_added_and_the_error_falls_on_calibration_and_holdout(
     let e = r.errors.holdout.as_ref().unwrap();
     assert!(e.enriched < e.calibrated && e.calibrated < e.nominal);
     // The report renders, residual signature figures included.
-    let doc = impactcal_calibrate::closeloop::document::report(&r, 1e-4, 0.0);
+    let doc = impactcal_calibrate::closeloop::document::report(&r);
     let files = impactcal_calibrate::report::write(&doc, dir.path()).unwrap();
     let html = std::fs::read_to_string(&files.html).unwrap();
     assert!(html.contains("damping") && html.contains("Unattributed") == r.unattributed.is_some());

@@ -127,8 +127,13 @@ pub(crate) fn attribute<M: Enrichable>(
     min_explained: f64,
     inflation: f64,
     onset: usize,
+    allowed: &dyn Fn(&str) -> bool,
 ) -> Result<Attribution> {
-    let cands: Vec<Candidate> = model.candidates();
+    let cands: Vec<Candidate> = model
+        .candidates()
+        .into_iter()
+        .filter(|c| allowed(c.name()))
+        .collect();
     let frame = &ctx.frame;
     let base = nuisance::apply(&fit.y, frame, &fit.terms);
     let mut dirs: Vec<Direction> = Vec::new();

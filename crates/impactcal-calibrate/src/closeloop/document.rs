@@ -26,8 +26,9 @@ fn table(caption: &str, header: &[&str], rows: Vec<Vec<String>>) -> Block {
     })
 }
 
-/// The report document of `r`; `dt` and `start` give the time axis of the patterns.
-pub fn report(r: &LoopResult, dt: f64, start: f64) -> Report {
+/// The report document of `r`.
+pub fn report(r: &LoopResult) -> Report {
+    let (dt, start) = (r.time_step, r.start);
     let mut lead = vec![match r.verdict {
         Verdict::NoModelFormError => format!(
             "No model-form error: the calibrated model explains the test to its noise floor \

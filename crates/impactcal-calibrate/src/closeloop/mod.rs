@@ -118,11 +118,28 @@ pub fn run_loop<M: Enrichable>(
     let space = model.space().clone();
     let d0 = space.dim();
     options.check(d0)?;
-    if model.candidates().is_empty() {
+    let listed = model.candidates();
+    if let Some(names) = &options.candidates {
+        for n in names {
+            if !listed.iter().any(|c| c.name() == n) {
+                return Err(CalibrateError::study(
+                    format!("candidate `{n}`"),
+                    format!(
+                        "not a candidate of the model (it lists: {})",
+                        listed
+                            .iter()
+                            .map(|c| c.name())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                ));
+            }
+        }
+    }
+    if !listed.iter().any(|c| options.allows(c.name())) {
         return Err(CalibrateError::study(
             "candidate list",
-            "the model lists no candidate effects: the loop has nothing to attribute a \
-             residual to",
+            "empty: the loop has no candidate effect to attribute a residual to",
         ));
     }
     let holdout_models = match holdout {
@@ -438,6 +455,8 @@ pub fn run_loop<M: Enrichable>(
         metrics_holdout,
         rounds: outcome.rounds,
         runs: used.get(),
+        time_step: dt,
+        start: test_m.start(),
     })
 }
 

@@ -36,6 +36,9 @@ pub struct LoopOptions {
     pub units_tolerance: f64,
     /// Measurement noise standard deviation for every channel, when known.
     pub sigma: Option<f64>,
+    /// The candidates the loop may consider, by name; `None`: every candidate the model
+    /// lists.
+    pub candidates: Option<Vec<String>>,
     /// CFC class whose residual measures the noise when the pre-impact window is too short
     /// [1000].
     pub noise_band_cfc: u32,
@@ -59,11 +62,19 @@ impl Default for LoopOptions {
             units_tolerance: 0.05,
             sigma: None,
             noise_band_cfc: 1000,
+            candidates: None,
         }
     }
 }
 
 impl LoopOptions {
+    /// Whether the candidate `name` is among those the loop may consider.
+    pub fn allows(&self, name: &str) -> bool {
+        self.candidates
+            .as_ref()
+            .is_none_or(|c| c.iter().any(|n| n == name))
+    }
+
     /// CORS runs a (re)calibration of a `d`-parameter space needs: its initial design of
     /// `2 (d + 1)` points and two optimiser steps.
     pub fn cors_runs_needed(d: usize) -> usize {

@@ -144,4 +144,8 @@ pub struct LoopResult {
     pub rounds: Vec<Round>,
     /// True-model runs used (journaled runs read back count too).
     pub runs: usize,
+    /// Sampling step of the compared histories (s): the time axis of the patterns.
+    pub time_step: f64,
+    /// Time of their first sample (s).
+    pub start: f64,
 }

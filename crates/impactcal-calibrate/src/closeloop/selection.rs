@@ -119,6 +119,7 @@ pub(crate) fn forward<M: Enrichable>(
                 options.min_explained,
                 inflation,
                 onset,
+                &|n| options.allows(n),
             )?)
         } else {
             None
