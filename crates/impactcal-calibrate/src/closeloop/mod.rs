@@ -9,7 +9,7 @@
 //! 2. **Noise floor** ([`noise_floor`]): measurement noise per channel (given, pre-impact
 //!    window, or the band above the model's bandwidth) and the model's own simulation noise
 //!    from a jitter ensemble, combined in quadrature into the whitening weights.
-//! 3. **Calibration** ([`fit`]): CORS-RBF then a Gauss-Newton polish to a least-squares
+//! 3. **Calibration**: CORS-RBF then a Gauss-Newton polish to a least-squares
 //!    optimum.
 //! 4. **Detection** ([`detection`]): reduced chi-square in effective samples, whiteness,
 //!    the residual SVD against the noise edge; model-form error when chi-square exceeds its

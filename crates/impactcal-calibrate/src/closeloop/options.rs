@@ -4,35 +4,35 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{CalibrateError, Result};
 
-/// Options of the closed loop. Defaults in brackets.
+/// Options of the closed loop. Defaults in parentheses.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LoopOptions {
-    /// Level of every test (detection, whiteness, score) [0.01].
+    /// Level of every test (detection, whiteness, score) (default 0.01).
     pub alpha: f64,
-    /// Smallest explained fraction for a candidate to be added [0.5].
+    /// Smallest explained fraction for a candidate to be added (default 0.5).
     pub min_explained: f64,
-    /// Most candidates added [3].
+    /// Most candidates added (default 3).
     pub max_added: usize,
-    /// Runs of the jitter ensemble measuring the model's own noise [8].
+    /// Runs of the jitter ensemble measuring the model's own noise (default 8).
     pub ensemble: usize,
-    /// Relative jitter of the ensemble [1e-4].
+    /// Relative jitter of the ensemble (default 1e-4).
     pub jitter: f64,
-    /// CORS runs of the first calibration [24].
+    /// CORS runs of the first calibration (default 24).
     pub reconcile: usize,
-    /// CORS runs of each recalibration after adding a candidate [24].
+    /// CORS runs of each recalibration after adding a candidate (default 24).
     pub recalibrate: usize,
-    /// Gauss-Newton polish iterations after each CORS search [8].
+    /// Gauss-Newton polish iterations after each CORS search (default 8).
     pub polish: usize,
-    /// Points CORS proposes at a time [4].
+    /// Points CORS proposes at a time (default 4).
     pub batch: usize,
-    /// Seed of everything random [0].
+    /// Seed of everything random (default 0).
     pub seed: u64,
     /// Largest trigger offset searched, in seconds; `None`: a tenth of the record.
     pub max_time_shift: Option<f64>,
-    /// Finite step of the candidate runs, as a fraction of each admissible range [0.05].
+    /// Finite step of the candidate runs, as a fraction of each admissible range (default 0.05).
     pub candidate_step: f64,
-    /// Relative tolerance of the units flags [0.05].
+    /// Relative tolerance of the units flags (default 0.05).
     pub units_tolerance: f64,
     /// Measurement noise standard deviation for every channel, when known.
     pub sigma: Option<f64>,
@@ -40,7 +40,7 @@ pub struct LoopOptions {
     /// lists.
     pub candidates: Option<Vec<String>>,
     /// CFC class whose residual measures the noise when the pre-impact window is too short
-    /// [1000].
+    /// (default 1000).
     pub noise_band_cfc: u32,
 }
 
