@@ -24,6 +24,7 @@
 //! # Ok::<(), impactcal_calibrate::CalibrateError>(())
 //! ```
 
+pub mod closeloop;
 pub mod error;
 pub mod metrics;
 pub mod report;

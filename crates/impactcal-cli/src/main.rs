@@ -5,6 +5,7 @@
 
 mod airframe;
 mod batch;
+mod close_loop;
 mod compare;
 mod convert;
 mod demo;
@@ -86,6 +87,10 @@ enum Command {
     /// Run a batch of parameter points through a solver (in process, a local process pool
     /// or Slurm) from a TOML configuration; journaled, and resumed by running it again.
     Batch(batch::Args),
+    /// The closed loop from a TOML file: nuisance terms, noise floor, detection of
+    /// model-form error, attribution to the model's candidate effects, enrichment and
+    /// recalibration, errors before and after on the test and a holdout; runs are journaled.
+    CloseLoop(close_loop::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -108,6 +113,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::StudyPoint(a) => study::run_point(a),
         Command::Demo(a) => demo::run(a),
         Command::Batch(a) => batch::run(a),
+        Command::CloseLoop(a) => close_loop::run(a),
     }
 }
 

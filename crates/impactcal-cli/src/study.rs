@@ -388,7 +388,7 @@ fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
-fn resolve(base: &Path, p: &Path) -> PathBuf {
+pub(crate) fn resolve(base: &Path, p: &Path) -> PathBuf {
     if p.is_absolute() {
         p.to_path_buf()
     } else {
@@ -469,7 +469,7 @@ fn external(
 }
 
 /// A test file: an ISO-MME data set (a folder, an `.mme` file or a zip) or wide CSV.
-fn read_test(path: &Path) -> Result<Histories, CliError> {
+pub(crate) fn read_test(path: &Path) -> Result<Histories, CliError> {
     let is_mme = path.is_dir()
         || path
             .extension()

@@ -20,6 +20,9 @@
 //! - [`CoreError`]: the typed error of all of the above, and the kinds of fault shared by
 //!   every crate ([`ErrorKind`]); [`ParamGuard`], how options are checked into a valid form.
 //! - [`test_functions`]: standard test functions with their published constants.
+//! - [`drop_tower`]: a fast impact model (three masses dropped on a contact spring) with its
+//!   candidate effects, and [`synthetic`]: "measured" data made from model histories with a
+//!   trigger offset, channel gains and biases, and noise at a given SNR.
 //!
 //! ```
 //! use impactcal_core::{Histories, Parameter, ParameterSpace};
@@ -36,6 +39,7 @@
 //! # Ok::<(), impactcal_core::CoreError>(())
 //! ```
 
+pub mod drop_tower;
 pub mod enrich;
 pub mod error;
 pub mod histories;
@@ -46,6 +50,7 @@ pub mod samples;
 pub mod sampling;
 pub mod signal;
 pub mod space;
+pub mod synthetic;
 pub mod table;
 pub mod test_functions;
 pub mod testdata;

@@ -142,6 +142,11 @@ impl ParameterSpace {
         Ok(ParameterSpace { parameters })
     }
 
+    /// A space of parameters known to be valid with unique names (built-in models only).
+    pub(crate) fn from_valid(parameters: Vec<Parameter>) -> Self {
+        ParameterSpace { parameters }
+    }
+
     /// Number of parameters `d`.
     pub fn dim(&self) -> usize {
         self.parameters.len()

@@ -1,0 +1,286 @@
+//! Calibration inside the loop: CORS-RBF over the model's space (warm-started, its own run
+//! budget) minimising the weighted residual with the nuisance terms profiled out, then a
+//! Gauss-Newton polish with finite-difference Jacobians so that the residual the loop
+//! analyses is a least-squares optimum (`J^T W r ~ 0`, calibration.md step 3) and not an
+//! optimiser's stopping point.
+//!
+//! Polish iteration at `theta`: one run per parameter at `theta + h_i e_i`
+//! (`h_i = 1e-3 (upper_i - lower_i)`, stepping inwards at an upper bound) gives the
+//! whitened columns `w (N(y(theta + h_i e_i)) - N(y(theta))) / h_i` under the current
+//! nuisance terms `N`; with the nuisance columns (`tau`, gains, biases) beside them, the
+//! minimum-norm least-squares step of the linearised problem moves `theta` (clipped to the
+//! bounds). The step is tried at full, quarter and sixteenth length and kept when the
+//! profiled residual falls; the polish stops when no step helps, when the predicted fall is
+//! below `1e-3` (in units of the noise variance), or after its iteration budget.
+
+use std::cell::Cell;
+use std::path::Path;
+
+use impactcal_core::{Cfc, Histories, Model, ParameterSpace};
+
+use super::linalg::{Lsq, dot};
+use super::nuisance::{self, Frame, Terms};
+use crate::error::{CalibrateError, Result};
+use crate::study::execute::{InProcess, Observer, RunOutcome, Runs, histories_of};
+use crate::study::reconcile;
+
+/// The journaled runner of one loop (its output folder and fingerprint), counting the runs
+/// it is asked for.
+#[derive(Clone, Copy)]
+pub(crate) struct Journaled<'a> {
+    pub dir: &'a Path,
+    pub fingerprint: &'a str,
+    pub observer: &'a dyn Observer,
+    pub used: &'a Cell<usize>,
+}
+
+impl Journaled<'_> {
+    /// Runs `points` of `model` as runs `first..` of journal stage `stage` (finished runs are
+    /// read back).
+    ///
+    /// # Errors
+    /// Journal errors.
+    pub fn stage_from<M: Model>(
+        &self,
+        model: &M,
+        stage: &str,
+        first: usize,
+        points: &[Vec<f64>],
+    ) -> Result<Vec<RunOutcome>> {
+        let exec = InProcess(model);
+        self.used.set(self.used.get() + points.len());
+        Runs::open(&exec, self.dir, self.fingerprint, self.observer)?.stage_from(
+            stage,
+            first,
+            points,
+            first == 0,
+        )
+    }
+
+    /// [`stage_from`](Self::stage_from) for a whole stage.
+    ///
+    /// # Errors
+    /// Journal errors.
+    pub fn stage<M: Model>(
+        &self,
+        model: &M,
+        stage: &str,
+        points: &[Vec<f64>],
+    ) -> Result<Vec<RunOutcome>> {
+        self.stage_from(model, stage, 0, points)
+    }
+}
+
+/// What every fit of one loop shares: the test frame, the filter, the journal.
+pub(crate) struct Ctx<'a> {
+    pub frame: Frame,
+    pub cfc: Option<Cfc>,
+    pub max_shift: f64,
+    pub fixed_gains: Option<Vec<f64>>,
+    pub runner: Journaled<'a>,
+    pub seed: u64,
+    pub batch: usize,
+}
+
+/// A calibrated point with everything the loop reads from it.
+#[derive(Debug, Clone)]
+pub(crate) struct Fit {
+    /// The point, in the model's space order.
+    pub point: Vec<f64>,
+    /// The model's channels at the point (filtered), `S x T`.
+    pub y: Vec<f64>,
+    /// The nuisance terms profiled at the point.
+    pub terms: Terms,
+    /// Whitened residual.
+    pub residual: Vec<f64>,
+    /// `sum residual^2`.
+    pub rss: f64,
+    /// Whitened Jacobian columns: the parameters', then the nuisance terms'.
+    pub jac: Vec<Vec<f64>>,
+    /// Standard errors of the parameters for unit white noise.
+    pub se: Vec<f64>,
+    /// Runs this fit used.
+    pub runs: usize,
+}
+
+impl Ctx<'_> {
+    /// The outcomes of `points` of `model` as journal stage `stage`.
+    pub fn stage<M: Model>(
+        &self,
+        model: &M,
+        stage: &str,
+        points: &[Vec<f64>],
+    ) -> Result<Vec<RunOutcome>> {
+        self.runner.stage(model, stage, points)
+    }
+
+    /// The frame's channels of a run (filtered with the loop's CFC class), `S x T`.
+    pub fn y_of(&self, h: &Histories) -> Result<Vec<f64>> {
+        let h = match self.cfc {
+            Some(c) => h.filtered(c)?,
+            None => h.clone(),
+        };
+        let sel = h.select(&self.frame.labels)?;
+        if sel.samples() != self.frame.samples {
+            return Err(CalibrateError::study(
+                "model run",
+                format!(
+                    "{} samples, the loop compares {}; a model must keep its time base",
+                    sel.samples(),
+                    self.frame.samples
+                ),
+            ));
+        }
+        Ok(sel.data().to_vec())
+    }
+
+    /// Nuisance terms and weighted RSS of a model response.
+    pub fn profile(&self, y: &[f64]) -> (Terms, f64) {
+        nuisance::profile(y, &self.frame, self.max_shift, self.fixed_gains.as_deref())
+    }
+
+    fn run_one<M: Model>(&self, model: &M, stage: &str, point: &[f64]) -> Result<Vec<f64>> {
+        let o = self.stage(model, stage, std::slice::from_ref(&point.to_vec()))?;
+        let h = histories_of(&o[0], stage)?;
+        self.y_of(&h)
+    }
+}
+
+/// Calibrates `model` from `start` (the first point is the incumbent) with `budget` CORS
+/// runs and at most `polish` Gauss-Newton iterations; journal stages are named
+/// `<prefix>-...`.
+///
+/// # Errors
+/// Run failures of the incumbent, CORS errors, journal errors.
+pub(crate) fn calibrate<M: Model>(
+    ctx: &Ctx<'_>,
+    model: &M,
+    prefix: &str,
+    start: &[Vec<f64>],
+    budget: usize,
+    polish: usize,
+) -> Result<Fit> {
+    let before = ctx.runner.used.get();
+    let space = model.space();
+    let outcomes = ctx.stage(model, &format!("{prefix}-start"), start)?;
+    let mut point = start
+        .first()
+        .cloned()
+        .ok_or_else(|| CalibrateError::study(prefix, "no starting point"))?;
+    let mut y = ctx.y_of(&histories_of(&outcomes[0], "the starting point")?)?;
+    if budget > 0 {
+        let warm: Vec<(Vec<f64>, RunOutcome)> = start.iter().cloned().zip(outcomes).collect();
+        let n = ctx.frame.test.len() as f64;
+        let error = |h: &Histories| -> Result<f64> { Ok(ctx.profile(&ctx.y_of(h)?).1 / n) };
+        let stage = format!("{prefix}-cors");
+        let mut run = |first: usize, pts: &[Vec<f64>]| -> Result<Vec<RunOutcome>> {
+            ctx.runner.stage_from(model, &stage, first, pts)
+        };
+        let best =
+            reconcile::reconcile(space, &warm, budget, ctx.batch, ctx.seed, &mut run, &error)?;
+        point = best.summary.calibrated_point;
+        y = ctx.y_of(&best.histories)?;
+    }
+    let mut fit = polish_from(ctx, model, prefix, point, y, polish)?;
+    fit.runs = ctx.runner.used.get() - before;
+    Ok(fit)
+}
+
+fn steps(space: &ParameterSpace, point: &[f64]) -> Vec<f64> {
+    space
+        .parameters()
+        .iter()
+        .zip(point)
+        .map(|(p, &x)| {
+            let h = 1e-3 * p.width();
+            if x + h > p.upper { -h } else { h }
+        })
+        .collect()
+}
+
+fn clip(space: &ParameterSpace, x: &mut [f64]) {
+    for (v, p) in x.iter_mut().zip(space.parameters()) {
+        *v = v.clamp(p.lower, p.upper);
+    }
+}
+
+fn polish_from<M: Model>(
+    ctx: &Ctx<'_>,
+    model: &M,
+    prefix: &str,
+    mut point: Vec<f64>,
+    mut y: Vec<f64>,
+    iterations: usize,
+) -> Result<Fit> {
+    let space = model.space();
+    let p = space.dim();
+    let mut it = 0;
+    loop {
+        let (terms, rss) = ctx.profile(&y);
+        let residual = nuisance::residual(&y, &ctx.frame, &terms);
+        let h = steps(space, &point);
+        let pts: Vec<Vec<f64>> = (0..p)
+            .map(|i| {
+                let mut x = point.clone();
+                x[i] += h[i];
+                x
+            })
+            .collect();
+        let outs = ctx.stage(model, &format!("{prefix}-gn{it}-jac"), &pts)?;
+        let base = nuisance::apply(&y, &ctx.frame, &terms);
+        let mut jac = Vec::with_capacity(p + 1 + 2 * ctx.frame.labels.len());
+        for (i, o) in outs.iter().enumerate() {
+            let yi = ctx.y_of(&histories_of(o, "a finite-difference run")?)?;
+            let mi = nuisance::apply(&yi, &ctx.frame, &terms);
+            jac.push(
+                mi.iter()
+                    .zip(&base)
+                    .zip(&ctx.frame.weights)
+                    .map(|((a, b), w)| w * (a - b) / h[i])
+                    .collect::<Vec<f64>>(),
+            );
+        }
+        jac.extend(nuisance::columns(&y, &ctx.frame, &terms));
+        let lsq = Lsq::new(&jac)?;
+        let se: Vec<f64> = lsq.variances()[..p].iter().map(|v| v.sqrt()).collect();
+        let step = lsq.solve(&residual);
+        let fitted = lsq.project(&residual);
+        let predicted = dot(&fitted, &fitted);
+        let here = Fit {
+            point: point.clone(),
+            y: y.clone(),
+            terms,
+            residual,
+            rss,
+            jac,
+            se,
+            runs: 0,
+        };
+        if it >= iterations || predicted < 1e-3 {
+            return Ok(here);
+        }
+        let mut moved = false;
+        for (attempt, scale) in [1.0, 0.25, 0.0625].iter().enumerate() {
+            let mut trial: Vec<f64> = point
+                .iter()
+                .zip(&step)
+                .map(|(x, d)| x + scale * d)
+                .collect();
+            clip(space, &mut trial);
+            if trial == point {
+                break;
+            }
+            let yt = ctx.run_one(model, &format!("{prefix}-gn{it}-try{attempt}"), &trial)?;
+            if ctx.profile(&yt).1 < rss {
+                point = trial;
+                y = yt;
+                moved = true;
+                break;
+            }
+        }
+        if !moved {
+            return Ok(here);
+        }
+        it += 1;
+    }
+}

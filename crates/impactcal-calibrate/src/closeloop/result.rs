@@ -1,0 +1,151 @@
+//! The loop's result, written as `loop.json`.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use super::attribution::{Attribution, Score};
+use super::detection::Detection;
+use super::discrepancy::Discrepancy;
+use super::noise_floor::NoiseFloor;
+use super::nuisance::Nuisance;
+
+/// The loop's conclusion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Verdict {
+    /// The calibrated model explains the test to its noise floor.
+    #[serde(rename = "no-model-form-error")]
+    NoModelFormError,
+    /// Candidates were added and the enriched model explains the test to its noise floor.
+    #[serde(rename = "attributed")]
+    Attributed,
+    /// Model-form error remains that no candidate explains (after any additions).
+    #[serde(rename = "unattributed")]
+    Unattributed,
+}
+
+/// A candidate added to the model, with its recalibrated value and 95 % interval.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Added {
+    /// The candidate.
+    pub name: String,
+    /// Its calibrated value.
+    pub value: f64,
+    /// Lower end of the interval.
+    pub lower: f64,
+    /// Upper end of the interval.
+    pub upper: f64,
+}
+
+/// Information criteria of one model of the sequence (known-noise forms, in effective
+/// samples: `AIC = RSS/c + 2k`, `BIC = RSS/c + k ln n_eff`, `c` the noise's inflation).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelScore {
+    /// The candidates added in this model.
+    pub added: Vec<String>,
+    /// Fitted quantities (parameters and nuisance terms).
+    pub k: usize,
+    /// Weighted residual sum of squares.
+    pub rss: f64,
+    /// Akaike's criterion.
+    pub aic: f64,
+    /// Schwarz's criterion.
+    pub bic: f64,
+    /// Akaike weight among the models of the sequence.
+    pub akaike_weight: f64,
+    /// Whether the loop kept this model.
+    pub kept: bool,
+}
+
+/// Errors of one model against one test (nuisance terms taken out, after filtering).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Errors {
+    /// Relative L2 over the compared channels, `||test - model||_F / ||test||_F`.
+    pub rel_l2: f64,
+    /// Reduced chi-square of the residual.
+    pub chi2_red: f64,
+    /// Mean Sprague-Geers comprehensive error over the channels.
+    pub sprague_geers_c: f64,
+    /// Mean ISO/TS 18571 rating over the channels.
+    pub iso18571_r: f64,
+}
+
+/// Errors of the three models against one test.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Stages<T> {
+    /// The model at its nominal point.
+    pub nominal: T,
+    /// The declared model calibrated.
+    pub calibrated: T,
+    /// The enriched model recalibrated (the calibrated one when nothing was added).
+    pub enriched: T,
+}
+
+/// Relative L2 before and after, on the calibration test and the holdout.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ErrorSummary {
+    /// On the calibration test.
+    pub calibration: Stages<f64>,
+    /// On the holdout test (never fitted), when one was given.
+    pub holdout: Option<Stages<f64>>,
+}
+
+/// One round of forward selection.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Round {
+    /// Candidates in the model of this round.
+    pub added: Vec<String>,
+    /// Its calibrated point (name -> value).
+    pub calibrated: BTreeMap<String, f64>,
+    /// Detection on its residual.
+    pub detection: Detection,
+    /// Attribution of its residual (none when the loop stopped before attributing).
+    pub attribution: Option<Attribution>,
+    /// Runs of its (re)calibration.
+    pub runs: usize,
+}
+
+/// Everything the closed loop found.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LoopResult {
+    /// What the model was.
+    pub model: String,
+    /// The conclusion.
+    pub verdict: Verdict,
+    /// Detection on the calibrated declared model's residual.
+    pub detection: Detection,
+    /// The nuisance terms of the calibration test (final model).
+    pub nuisance: Nuisance,
+    /// The noise floor of the calibration test.
+    pub noise_floor: NoiseFloor,
+    /// The first attribution's ranking.
+    pub candidates: Vec<Score>,
+    /// Candidate pairs these sensors cannot tell apart (first attribution).
+    pub indistinguishable: Vec<(String, String, f64)>,
+    /// Candidates added, in order.
+    pub added: Vec<Added>,
+    /// The final calibrated point, declared and added parameters.
+    pub calibrated: BTreeMap<String, f64>,
+    /// The models of the sequence with their information criteria.
+    pub models: Vec<ModelScore>,
+    /// Why forward selection stopped.
+    pub stopped: String,
+    /// Detection on the final model's residual.
+    pub detection_final: Detection,
+    /// The unattributed model-form error, when the verdict says so.
+    pub unattributed: Option<Discrepancy>,
+    /// Relative L2 before and after.
+    pub errors: ErrorSummary,
+    /// The full before/after metrics on the calibration test.
+    pub metrics_calibration: Stages<Errors>,
+    /// The same on the holdout.
+    pub metrics_holdout: Option<Stages<Errors>>,
+    /// Every round of selection.
+    pub rounds: Vec<Round>,
+    /// True-model runs used (journaled runs read back count too).
+    pub runs: usize,
+    /// Sampling step of the compared histories (s): the time axis of the patterns.
+    pub time_step: f64,
+    /// Time of their first sample (s).
+    pub start: f64,
+}

@@ -1,0 +1,232 @@
+//! Forward selection (orthogonal matching pursuit with full nonlinear refits) and the
+//! information criteria that decide when to stop.
+//!
+//! Round `r` holds the declared model with the candidates added so far, calibrated. When its
+//! residual shows model-form error, the best eligible candidate of its attribution is added
+//! (its range the candidate's admissible range, its nominal the held value) and the model
+//! is recalibrated: CORS warm-started from the previous optimum (with the candidate at its
+//! held value and at its linear estimate), its own budget, then the Gauss-Newton polish. The
+//! addition is kept when the Bayesian information criterion falls by more than 2.
+//!
+//! With known noise (the whitening), in effective samples (`c = (1 + rho_0) / (1 - rho_0)`,
+//! `n_eff = n / c`), for `k` fitted quantities: `AIC = RSS / c + 2 k`,
+//! `BIC = RSS / c + k ln n_eff`; Akaike weights
+//! `w_m = exp(-(AIC_m - AIC_min) / 2) / sum_j exp(-(AIC_j - AIC_min) / 2)`.
+//!
+//! Selection stops when no model-form error remains, when no candidate is eligible
+//! (identifiable, admissible, significant, explaining at least `min_explained`), when BIC
+//! does not fall by more than 2, or after `max_added` additions.
+
+use impactcal_core::{Enrichable, Parameter};
+
+use super::attribution::attribute;
+use super::detection::{Detection, detect};
+use super::fit::{Ctx, Fit, calibrate};
+use super::options::LoopOptions;
+use super::result::{ModelScore, Round};
+use crate::error::Result;
+
+/// What forward selection ends with.
+pub(crate) struct Outcome {
+    pub fit: Fit,
+    pub added: Vec<Parameter>,
+    pub rounds: Vec<Round>,
+    pub models: Vec<ModelScore>,
+    pub stopped: String,
+}
+
+/// The information criteria of a fit with `k` quantities (see the module docs).
+pub fn criteria(rss: f64, n: usize, k: usize, inflation: f64) -> (f64, f64) {
+    let n_eff = n as f64 / inflation;
+    let e = rss / inflation;
+    (e + 2.0 * k as f64, e + k as f64 * n_eff.ln())
+}
+
+/// Akaike weights of a list of AIC values.
+pub fn akaike_weights(aic: &[f64]) -> Vec<f64> {
+    let min = aic.iter().copied().fold(f64::INFINITY, f64::min);
+    let w: Vec<f64> = aic.iter().map(|a| (-(a - min) / 2.0).exp()).collect();
+    let s: f64 = w.iter().sum();
+    w.iter().map(|x| x / s).collect()
+}
+
+fn score(
+    fit: &Fit,
+    added: &[Parameter],
+    n_nuisance: usize,
+    inflation: f64,
+    kept: bool,
+) -> ModelScore {
+    let k = fit.point.len() + n_nuisance;
+    let (aic, bic) = criteria(fit.rss, fit.residual.len(), k, inflation);
+    ModelScore {
+        added: added.iter().map(|p| p.name.clone()).collect(),
+        k,
+        rss: fit.rss,
+        aic,
+        bic,
+        akaike_weight: 0.0,
+        kept,
+    }
+}
+
+/// Runs forward selection from the calibrated declared model `fit0`.
+///
+/// # Errors
+/// Run, journal and numerical errors of the fits and attributions.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn forward<M: Enrichable>(
+    ctx: &Ctx<'_>,
+    model: &M,
+    fit0: Fit,
+    options: &LoopOptions,
+    inflation: f64,
+    onset: usize,
+    noise_lag1: f64,
+    n_nuisance: usize,
+) -> Result<Outcome> {
+    let labels = ctx.frame.labels.clone();
+    let t = ctx.frame.samples;
+    let detect_fit = |fit: &Fit| -> Result<Detection> {
+        detect(
+            &labels,
+            &fit.residual,
+            t,
+            fit.point.len() + n_nuisance,
+            noise_lag1,
+            options.alpha,
+        )
+    };
+    let mut fit = fit0;
+    let mut det = detect_fit(&fit)?;
+    let mut runs = fit.runs;
+    let mut cur = model.enrich(&[])?;
+    let mut added: Vec<Parameter> = Vec::new();
+    let mut rounds = Vec::new();
+    let mut models = vec![score(&fit, &added, n_nuisance, inflation, true)];
+    let stopped;
+    loop {
+        let r = rounds.len();
+        let attribution = if r == 0 || det.model_form_error {
+            ctx.runner.observer.step("attribution");
+            Some(attribute(
+                ctx,
+                &cur,
+                &fit,
+                &format!("r{r}"),
+                options.candidate_step,
+                options.alpha,
+                options.min_explained,
+                inflation,
+                onset,
+                &|n| options.allows(n),
+            )?)
+        } else {
+            None
+        };
+        let names = cur.space().names();
+        rounds.push(Round {
+            added: added.iter().map(|p| p.name.clone()).collect(),
+            calibrated: names
+                .iter()
+                .zip(&fit.point)
+                .map(|(n, v)| (n.to_string(), *v))
+                .collect(),
+            detection: det.clone(),
+            attribution: attribution.clone(),
+            runs,
+        });
+        if !det.model_form_error {
+            stopped = "no model-form error remains (chi-square at the noise floor or no \
+                       coherent residual)"
+                .to_string();
+            break;
+        }
+        if added.len() >= options.max_added {
+            stopped = format!("max_added ({}) reached", options.max_added);
+            break;
+        }
+        let Some(best) = attribution.as_ref().and_then(|a| a.best()) else {
+            stopped = "no candidate is identifiable, admissible, significant and explains \
+                       enough of the residual"
+                .to_string();
+            break;
+        };
+        let Some(cand) = cur.candidates().into_iter().find(|c| c.name() == best.name) else {
+            stopped = format!("candidate `{}` vanished from the model's list", best.name);
+            break;
+        };
+        let p = cand.parameter.clone();
+        let mut trial_added = added.clone();
+        trial_added.push(p.clone());
+        let next = model.enrich(&trial_added)?;
+        let estimate = best
+            .amplitude
+            .as_ref()
+            .map_or(p.nominal, |a| a.value.clamp(p.lower, p.upper));
+        let mut at_held = fit.point.clone();
+        at_held.push(p.nominal);
+        let mut at_estimate = fit.point.clone();
+        at_estimate.push(estimate);
+        let mut start = vec![at_held];
+        if (estimate - p.nominal).abs() > 1e-12 * p.width() {
+            start.push(at_estimate);
+        }
+        ctx.runner
+            .observer
+            .step(&format!("recalibration with `{}`", p.name));
+        let fit_n = calibrate(
+            ctx,
+            &next,
+            &format!("r{}", r + 1),
+            &start,
+            options.recalibrate,
+            options.polish,
+        )?;
+        let s = score(&fit_n, &trial_added, n_nuisance, inflation, true);
+        let prev_bic = models.last().map_or(f64::INFINITY, |m| m.bic);
+        if s.bic > prev_bic - 2.0 {
+            models.push(ModelScore { kept: false, ..s });
+            stopped = format!(
+                "adding `{}` did not lower BIC by more than 2 ({:.1} -> {:.1})",
+                p.name,
+                prev_bic,
+                models.last().map_or(f64::NAN, |m| m.bic)
+            );
+            break;
+        }
+        models.push(s);
+        runs = fit_n.runs;
+        det = detect_fit(&fit_n)?;
+        fit = fit_n;
+        cur = next;
+        added = trial_added;
+    }
+    let weights = akaike_weights(&models.iter().map(|m| m.aic).collect::<Vec<_>>());
+    for (m, w) in models.iter_mut().zip(weights) {
+        m.akaike_weight = w;
+    }
+    Ok(Outcome {
+        fit,
+        added,
+        rounds,
+        models,
+        stopped,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_sum_to_one_and_favour_the_smallest() {
+        let w = akaike_weights(&[10.0, 12.0, 30.0]);
+        assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        // exp(-1) relative weight for a difference of 2.
+        assert!((w[1] / w[0] - (-1.0f64).exp()).abs() < 1e-12);
+        let (aic, bic) = criteria(100.0, 1000, 3, 1.0);
+        assert!((aic - 106.0).abs() < 1e-12);
+        assert!((bic - (100.0 + 3.0 * 1000f64.ln())).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,262 @@
+//! `impactcal close-loop`: the closed loop of a model against a test, from a TOML file.
+//!
+//! ```toml
+//! [model]
+//! kind = "drop-tower"            # the built-in fast impact model
+//! set = { v0 = 4.0 }             # held quantities at the calibration test's condition
+//!
+//! [test]
+//! data = "test.csv"              # wide CSV, or an ISO-MME data set
+//! map = "map.csv"                # optional
+//! cfc = 1000                     # optional
+//! sigma = 0.5                    # optional: measurement noise, every channel
+//!
+//! [holdout]                      # optional: a test at another condition, never fitted
+//! data = "holdout.csv"
+//! set = { v0 = 5.5 }
+//!
+//! [budget]
+//! ensemble = 8                   # jitter runs measuring the model's own noise
+//! reconcile = 24                 # CORS runs of the first calibration
+//! recalibrate = 24               # CORS runs of each recalibration
+//! seed = 1
+//!
+//! [loop]                         # optional: the other loop options
+//! candidates = ["damping", "added_mass"]
+//! alpha = 0.01
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use clap::Args as ClapArgs;
+use impactcal::calibrate::closeloop::document::report;
+use impactcal::calibrate::closeloop::{Holdout, LoopOptions, LoopResult, Verdict, run_loop};
+use impactcal::calibrate::study::TestData;
+use impactcal::core::drop_tower::DropTower;
+use impactcal::core::{Cfc, ChannelMap, Enrichable, Histories};
+use serde::Deserialize;
+
+use crate::error::CliError;
+use crate::output::write_text;
+use crate::simulate::thread_pool;
+use crate::study::{Progress, read_test, resolve};
+
+/// Arguments of `impactcal close-loop`.
+#[derive(ClapArgs, Debug)]
+pub struct Args {
+    /// The loop file (TOML: `[model]`, `[test]`, `[holdout]`, `[budget]`, `[loop]`).
+    #[arg(long)]
+    pub config: PathBuf,
+    /// Output folder: the run journal, `loop.json`, `report.html`, `report.md`. Running the
+    /// same loop again in the same folder reuses the runs that finished.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Number of threads (runs go in parallel; results do not depend on it).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+/// The loop file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    /// The model.
+    pub model: ModelConfig,
+    /// The calibration test.
+    pub test: TestConfig,
+    /// The holdout test.
+    pub holdout: Option<HoldoutConfig>,
+    /// Run budgets and seed.
+    #[serde(default)]
+    pub budget: Budget,
+    /// The other options of the loop.
+    #[serde(default, rename = "loop")]
+    pub options: LoopOptions,
+}
+
+/// `[model]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelConfig {
+    /// The built-in model: `drop-tower`.
+    pub kind: Option<String>,
+    /// The airframe's mesh density (not yet a model the loop can enrich).
+    pub airframe: Option<String>,
+    /// A keyword deck (not yet a model the loop can enrich).
+    pub deck: Option<PathBuf>,
+    /// Held quantities at the calibration test's condition.
+    #[serde(default)]
+    pub set: BTreeMap<String, f64>,
+}
+
+/// `[test]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TestConfig {
+    /// Wide CSV or an ISO-MME data set.
+    pub data: PathBuf,
+    /// Channel map `test_label,model_label[,gain]`.
+    pub map: Option<PathBuf>,
+    /// CFC class applied to test and runs.
+    pub cfc: Option<u32>,
+    /// Measurement noise standard deviation of every channel.
+    pub sigma: Option<f64>,
+}
+
+/// `[holdout]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HoldoutConfig {
+    /// The holdout test's data.
+    pub data: PathBuf,
+    /// Its condition, as held quantities of the model.
+    pub set: BTreeMap<String, f64>,
+}
+
+/// `[budget]`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Budget {
+    /// Jitter runs.
+    pub ensemble: Option<usize>,
+    /// CORS runs of the first calibration.
+    pub reconcile: Option<usize>,
+    /// CORS runs of each recalibration.
+    pub recalibrate: Option<usize>,
+    /// Seed.
+    pub seed: Option<u64>,
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let text = std::fs::read_to_string(&args.config)
+        .map_err(|e| CliError::io(format!("{}: {e}", args.config.display())))?;
+    let name = args.config.display().to_string();
+    let config: Config = toml::from_str(&text).map_err(|e| {
+        CliError::input(format!(
+            "{name}: {}",
+            e.to_string()
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" ")
+        ))
+    })?;
+    let base = args.config.parent().unwrap_or(Path::new("."));
+    let mut options = config.options.clone();
+    let b = &config.budget;
+    options.ensemble = b.ensemble.unwrap_or(options.ensemble);
+    options.reconcile = b.reconcile.unwrap_or(options.reconcile);
+    options.recalibrate = b.recalibrate.unwrap_or(options.recalibrate);
+    options.seed = b.seed.unwrap_or(options.seed);
+    options.sigma = config.test.sigma.or(options.sigma);
+    let set: Vec<(String, f64)> = config.model.set.clone().into_iter().collect();
+    let model = match (
+        &config.model.kind,
+        &config.model.airframe,
+        &config.model.deck,
+    ) {
+        (Some(k), None, None) if k == "drop-tower" => DropTower::new()
+            .at_condition(&set)
+            .map_err(|e| CliError::from(e).context(format!("{name}: [model] set")))?,
+        (Some(k), None, None) => {
+            return Err(CliError::input(format!(
+                "{name}: [model] kind = \"{k}\": unknown (the built-in model is \"drop-tower\")"
+            )));
+        }
+        (None, Some(_), None) | (None, None, Some(_)) => {
+            return Err(CliError::input(format!(
+                "{name}: [model]: the closed loop needs a model that lists its candidate \
+                 effects; in this version that is kind = \"drop-tower\""
+            )));
+        }
+        _ => {
+            return Err(CliError::input(format!(
+                "{name}: [model]: give one of kind = \"drop-tower\", airframe or deck"
+            )));
+        }
+    };
+    let test = read_test(&resolve(base, &config.test.data))?;
+    let map = config
+        .test
+        .map
+        .as_ref()
+        .map(|m| ChannelMap::read(resolve(base, m)))
+        .transpose()?;
+    let cfc = config.test.cfc.map(Cfc::from_class).transpose()?;
+    let holdout = match &config.holdout {
+        Some(h) => Some((
+            read_test(&resolve(base, &h.data))?,
+            h.set.clone().into_iter().collect::<Vec<_>>(),
+        )),
+        None => None,
+    };
+    let description = format!("drop-tower {set:?}");
+    let pool = thread_pool(args.threads)?;
+    let result = pool
+        .install(|| {
+            close(
+                &model,
+                &description,
+                &test,
+                map.as_ref(),
+                cfc,
+                holdout.as_ref(),
+                &options,
+                &args.out,
+            )
+        })
+        .map_err(|e| e.context(&name))?;
+    finish(&result, &args.out)
+}
+
+/// Runs the loop of any enrichable `model` in `out`.
+#[allow(clippy::too_many_arguments)]
+pub fn close<M: Enrichable>(
+    model: &M,
+    description: &str,
+    test: &Histories,
+    map: Option<&ChannelMap>,
+    cfc: Option<Cfc>,
+    holdout: Option<&(Histories, Vec<(String, f64)>)>,
+    options: &LoopOptions,
+    out: &Path,
+) -> Result<LoopResult, CliError> {
+    std::fs::create_dir_all(out).map_err(|e| CliError::io(format!("{}: {e}", out.display())))?;
+    let data = TestData {
+        histories: test,
+        map,
+        cfc,
+    };
+    let h = holdout.map(|(histories, set)| Holdout {
+        histories,
+        set: set.as_slice(),
+    });
+    let progress = Progress::new();
+    let result = run_loop(model, description, data, h, options, out, &progress);
+    progress.done();
+    Ok(result?)
+}
+
+/// Writes `loop.json` and the report, and prints the verdict.
+pub fn finish(result: &LoopResult, out: &Path) -> Result<(), CliError> {
+    let json = serde_json::to_string_pretty(result)
+        .map_err(|e| CliError::failure(format!("cannot encode the loop's result: {e}")))?;
+    write_text(&(json + "\n"), Some(&out.join("loop.json")))?;
+    let doc = report(result);
+    let files = impactcal::calibrate::report::write(&doc, out)?;
+    for line in &doc.lead {
+        eprintln!("{line}");
+    }
+    let verdict = match result.verdict {
+        Verdict::NoModelFormError => "no-model-form-error",
+        Verdict::Attributed => "attributed",
+        Verdict::Unattributed => "unattributed",
+    };
+    eprintln!(
+        "verdict: {verdict}; wrote {} and {}",
+        out.join("loop.json").display(),
+        files.html.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,149 @@
+//! `impactcal close-loop` end to end on the drop tower: a test with hidden damping, a
+//! trigger offset and one wrong gain, and a holdout at another impact speed (loop.json,
+//! report.html, report.md); and the bad inputs a user would produce (exit 2, one line).
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod common;
+
+use std::path::Path;
+
+use common::impactcal;
+use impactcal::core::drop_tower::DropTower;
+use impactcal::core::synthetic::{Measurement, measured};
+use impactcal::core::{Enrichable, Model};
+
+/// Writes `test.csv` and `holdout.csv` measured on the drop tower with hidden damping.
+fn write_tests(dir: &Path) {
+    let truth = DropTower::new()
+        .at_condition(&[("damping".into(), 0.03)])
+        .unwrap();
+    for (name, model, seed) in [
+        ("test.csv", truth.clone(), 1),
+        (
+            "holdout.csv",
+            truth.at_condition(&[("v0".into(), 5.5)]).unwrap(),
+            2,
+        ),
+    ] {
+        let y = model.simulate(&[75.0, 9e5]).unwrap();
+        let m = Measurement {
+            time_shift: 3e-4,
+            gains: vec![("a2".into(), 1.1)],
+            snr_db: Some(40.0),
+            seed,
+            ..Measurement::default()
+        };
+        measured(&y, &m).unwrap().write_csv(dir.join(name)).unwrap();
+    }
+}
+
+fn config(dir: &Path, text: &str) -> String {
+    let p = dir.join("loop.toml");
+    std::fs::write(&p, text).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+const GOOD: &str = "[model]\nkind = \"drop-tower\"\n\n[test]\ndata = \"test.csv\"\n\n\
+    [holdout]\ndata = \"holdout.csv\"\nset = { v0 = 5.5 }\n\n[budget]\nensemble = 8\n\
+    reconcile = 24\nrecalibrate = 24\nseed = 1\n";
+
+#[test]
+fn finds_the_hidden_damping_and_writes_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    write_tests(dir.path());
+    let cfg = config(dir.path(), GOOD);
+    let out = dir.path().join("out");
+    let o = impactcal(&[
+        "close-loop",
+        "--config",
+        &cfg,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("loop.json")).unwrap()).unwrap();
+    assert_eq!(v["verdict"], "attributed");
+    assert_eq!(v["added"][0]["name"], "damping");
+    let (lo, hi) = (
+        v["added"][0]["lower"].as_f64().unwrap(),
+        v["added"][0]["upper"].as_f64().unwrap(),
+    );
+    assert!(lo <= 0.03 && 0.03 <= hi);
+    assert_eq!(v["candidates"][0]["name"], "damping");
+    assert!(v["detection"]["model_form_error"].as_bool().unwrap());
+    assert!((v["nuisance"]["gains"]["a2"].as_f64().unwrap() - 1.1).abs() < 0.01);
+    for t in ["calibration", "holdout"] {
+        let e = &v["errors"][t];
+        assert!(e["enriched"].as_f64().unwrap() < e["calibrated"].as_f64().unwrap());
+    }
+    assert!(v["runs"].as_u64().unwrap() > 20);
+    assert!(out.join("report.html").exists() && out.join("report.md").exists());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("verdict: attributed"));
+}
+
+#[test]
+fn bad_input_exits_2_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    write_tests(dir.path());
+    let cases = [
+        (GOOD.replace("v0 = 5.5", "v0 = 30.0"), "[holdout] set"),
+        (
+            GOOD.replace("seed = 1", "seed = 1\n\n[loop]\ncandidates = []"),
+            "candidate list",
+        ),
+        (
+            GOOD.replace("recalibrate = 24", "recalibrate = 6"),
+            "at least 14",
+        ),
+        (
+            GOOD.replace(
+                "kind = \"drop-tower\"",
+                "kind = \"drop-tower\"\nset = { v0 = 99.0 }",
+            ),
+            "v0",
+        ),
+        (GOOD.replace("drop-tower", "pendulum"), "unknown"),
+    ];
+    for (text, needle) in cases {
+        let cfg = config(dir.path(), &text);
+        let out = dir.path().join("bad");
+        let o = impactcal(&[
+            "close-loop",
+            "--config",
+            &cfg,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{needle}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    // A test channel the model does not have.
+    let t = std::fs::read_to_string(dir.path().join("test.csv")).unwrap();
+    let extra: String = t
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 0 {
+                format!("{l},belt\n")
+            } else {
+                format!("{l},0\n")
+            }
+        })
+        .collect();
+    std::fs::write(dir.path().join("test.csv"), extra).unwrap();
+    let cfg = config(dir.path(), GOOD);
+    let o = impactcal(&[
+        "close-loop",
+        "--config",
+        &cfg,
+        "--out",
+        dir.path().join("bad2").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("belt"), "{err}");
+}
