@@ -155,6 +155,14 @@ pub trait Enrichable: Model + Sized {
     /// declared parameter, which a point sets instead) or the value is not admissible.
     fn at_condition(&self, set: &[(String, f64)]) -> Result<Self>;
 
+    /// The group and description of one of the model's declared parameters, where the model
+    /// knows them, so that a wrapper holding some of them (a subspace of the model) can list
+    /// them as candidates of the right kind. `None` unless a model says more.
+    fn describe(&self, name: &str) -> Option<(String, String)> {
+        let _ = name;
+        None
+    }
+
     /// Checks that `p` names one of [`candidates`](Enrichable::candidates) (a helper for
     /// implementations of [`enrich`](Enrichable::enrich)).
     ///

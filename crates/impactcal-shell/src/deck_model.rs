@@ -591,6 +591,12 @@ impl Enrichable for DeckModel {
             .collect()
     }
 
+    /// The group and description of a quantity of the model.
+    fn describe(&self, name: &str) -> Option<(String, String)> {
+        self.quantity_named(name)
+            .map(|q| (q.group.to_string(), q.description.clone()))
+    }
+
     /// The same model with `added` declared after the space; at their held values the runs
     /// are the same runs, bit for bit.
     ///

@@ -56,6 +56,14 @@ impl Enrichable for AirframeModel {
             .collect()
     }
 
+    /// The group and description of a catalogue quantity.
+    fn describe(&self, name: &str) -> Option<(String, String)> {
+        catalogue()
+            .into_iter()
+            .find(|a| a.name == name)
+            .map(|a| (a.group.to_string(), a.description))
+    }
+
     /// The same airframe and base values with `added` appended to the space: at the added
     /// parameters' held values a run is the same run, bit for bit (a point sets the values
     /// the base already holds).
