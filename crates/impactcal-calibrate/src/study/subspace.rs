@@ -361,6 +361,7 @@ impl<M: Model + Clone> Enrichable for Plain<M> {
 }
 
 #[cfg(test)]
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
     use impactcal_core::Parameter;
