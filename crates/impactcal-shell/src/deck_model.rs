@@ -62,7 +62,6 @@
 use impactcal_core::enrich::{Candidate, Enrichable};
 use impactcal_core::{CoreError, Histories, Model, Parameter, ParameterSpace};
 
-use crate::airframe::enrich::check_within;
 use crate::error::{Result, ShellError};
 use crate::keyword::Deck;
 use crate::model::{MaterialLaw, ShellModel};
@@ -456,7 +455,9 @@ impl DeckModel {
                      *PARAMETER)",
                 )
             })?;
-            check_within(&p.name, p, &q.parameter).map_err(ShellError::from)?;
+            Candidate::new(q.parameter.clone(), q.group, "")
+                .check_bounds(p)
+                .map_err(ShellError::from)?;
             targets.push(q.target);
         }
         let mut m = self.clone();
@@ -613,7 +614,7 @@ impl Enrichable for DeckModel {
                 return Err(CoreError::invalid_option("enrich", &p.name, "added twice"));
             }
             if let Some(c) = candidates.iter().find(|c| c.name() == p.name) {
-                check_within(&p.name, p, &c.parameter)?;
+                c.check_bounds(p)?;
             }
             params.push(p.clone());
         }
@@ -655,14 +656,7 @@ impl Enrichable for DeckModel {
                     "not a quantity the model holds",
                 ));
             };
-            let a = &c.parameter;
-            if !(value.is_finite() && (a.lower..=a.upper).contains(value)) {
-                return Err(CoreError::invalid_option(
-                    "condition",
-                    format!("{name} = {value}"),
-                    format!("outside the admissible range [{}, {}]", a.lower, a.upper),
-                ));
-            }
+            c.check_value(*value)?;
             q.target.set(&mut m.base, *value);
             if let Some(h) = m
                 .held

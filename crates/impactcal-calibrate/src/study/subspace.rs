@@ -216,13 +216,13 @@ impl<M: Enrichable + Clone> Enrichable for Subspace<M> {
             if params.iter().any(|q| q.name == p.name) {
                 return Err(CoreError::invalid_option("enrich", &p.name, "added twice"));
             }
-            let (admissible, slot) =
+            let (candidate, slot) =
                 if let Some((i, c)) = held.iter().find(|(_, c)| c.name() == p.name) {
-                    (&c.parameter, *i)
+                    (c, *i)
                 } else if let Some(c) = inner.iter().find(|c| c.name() == p.name) {
                     inner_added.push(p.clone());
                     inner_held.push(c.parameter.nominal);
-                    (&c.parameter, dim + inner_added.len() - 1)
+                    (c, dim + inner_added.len() - 1)
                 } else {
                     return Err(CoreError::invalid_option(
                         "enrich",
@@ -230,16 +230,7 @@ impl<M: Enrichable + Clone> Enrichable for Subspace<M> {
                         "not a candidate of the model",
                     ));
                 };
-            if p.lower < admissible.lower || p.upper > admissible.upper {
-                return Err(CoreError::invalid_option(
-                    "enrich",
-                    &p.name,
-                    format!(
-                        "bounds [{}, {}] leave the admissible range [{}, {}]",
-                        p.lower, p.upper, admissible.lower, admissible.upper
-                    ),
-                ));
-            }
+            candidate.check_bounds(p)?;
             params.push(p.clone());
             slots.push(slot);
         }
@@ -285,14 +276,7 @@ impl<M: Enrichable + Clone> Enrichable for Subspace<M> {
             }
             match held.iter().find(|(_, c)| c.name() == name) {
                 Some((i, c)) => {
-                    let a = &c.parameter;
-                    if !(value.is_finite() && (a.lower..=a.upper).contains(value)) {
-                        return Err(CoreError::invalid_option(
-                            "condition",
-                            format!("{name} = {value}"),
-                            format!("outside the admissible range [{}, {}]", a.lower, a.upper),
-                        ));
-                    }
+                    c.check_value(*value)?;
                     base[*i] = *value;
                 }
                 None => rest.push((name.clone(), *value)),

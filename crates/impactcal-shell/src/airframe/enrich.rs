@@ -81,7 +81,7 @@ impl Enrichable for AirframeModel {
                 return Err(CoreError::invalid_option("enrich", &p.name, "added twice"));
             }
             if let Some(c) = self.candidate(&p.name) {
-                check_within(&p.name, p, &c.parameter)?;
+                c.check_bounds(p)?;
             }
             params.push(p.clone());
         }
@@ -115,14 +115,7 @@ impl Enrichable for AirframeModel {
                     "not a quantity of the airframe (`impactcal airframe --list` prints them)",
                 ));
             };
-            let q = &c.parameter;
-            if !(value.is_finite() && (q.lower..=q.upper).contains(value)) {
-                return Err(CoreError::invalid_option(
-                    "condition",
-                    format!("{name} = {value}"),
-                    format!("outside the admissible range [{}, {}]", q.lower, q.upper),
-                ));
-            }
+            c.check_value(*value)?;
             base.set(name, *value)
                 .map_err(|e| CoreError::invalid_option("condition", name, e.to_string()))?;
         }
@@ -134,23 +127,4 @@ impl Enrichable for AirframeModel {
             space: self.space.clone(),
         })
     }
-}
-
-/// Checks that the caller's bounds for `name` lie within the admissible range `admissible`.
-pub(crate) fn check_within(
-    name: &str,
-    p: &Parameter,
-    admissible: &Parameter,
-) -> impactcal_core::Result<()> {
-    if p.lower < admissible.lower || p.upper > admissible.upper {
-        return Err(CoreError::invalid_option(
-            "enrich",
-            name,
-            format!(
-                "bounds [{}, {}] leave the admissible range [{}, {}]",
-                p.lower, p.upper, admissible.lower, admissible.upper
-            ),
-        ));
-    }
-    Ok(())
 }
