@@ -2,10 +2,10 @@
 //! The measurements behind docs/airframe.md ("Undeclared effects").
 //!
 //! ```text
-//! cargo run --release --example airframe_effects [-- --declared table2|small] [--jitter J]
+//! cargo run --release --example airframe_effects [-- --declared table2|small] [--jitter J] [--end T]
 //! ```
 //!
-//! The coarse airframe over the calibration window of the study (0 to 0.025 s), every run
+//! The coarse airframe over the calibration window of the study (0 to 0.025 s, or `T`), every run
 //! filtered with CFC 60, all 1,215 sensor velocities. The declared space is the source
 //! paper's Table 2 (six thicknesses), or `small` (`belly_panel.t`, `keel_beam_web.t`).
 //!
@@ -113,13 +113,14 @@ fn main() {
         _ => Preset::Table2.names().to_vec(),
     };
     let jitter: usize = opt("--jitter").map_or(8, |j| j.parse().unwrap());
+    let end: f64 = opt("--end").map_or(0.025, |t| t.parse().unwrap());
     rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build_global()
         .unwrap();
 
     let mut o = AirframeOptions::new(MeshDensity::Coarse);
-    o.end_time = 0.025;
+    o.end_time = end;
     let airframe = Airframe::new(o).unwrap();
     let cfc = Cfc::from_class(60).unwrap();
     let started = Instant::now();
@@ -176,7 +177,7 @@ fn main() {
     let q = orthonormal(&jcols);
 
     println!(
-        "coarse airframe, 0-0.025 s, CFC 60, {} channels x {} samples; declared: {}",
+        "coarse airframe, 0-{end} s, CFC 60, {} channels x {} samples; declared: {}",
         noise.channels(),
         noise.samples(),
         declared.join(", ")
@@ -184,6 +185,16 @@ fn main() {
     println!(
         "simulation noise: {jitter}-run jitter ensemble (eps 1e-4), ||sigma|| / ||y0|| = {:.2e}",
         sigma / signal
+    );
+    let rms = |c: usize| norm(&noise.nominal[c]) / (noise.samples() as f64).sqrt();
+    let loudest = (0..noise.channels())
+        .filter(|&c| noise.labels[c].ends_with(".z"))
+        .max_by(|&a, &b| rms(a).total_cmp(&rms(b)))
+        .unwrap();
+    println!(
+        "largest vertical channel: {} (RMS {:.1} in/s)",
+        noise.labels[loudest],
+        rms(loudest)
     );
     println!(
         "runs: {} ({} jitter + nominal, {n_decl} declared directions, {} effects, {} holdouts) in {elapsed:.0} s",
