@@ -24,20 +24,29 @@
 //! 4. **Holdout conditions**: one run per condition (another impact speed, a pitch
 //!    attitude): whether the airframe takes it, and how far it moves the response.
 //!
-//! Runs go two at a time (the machine is shared); about 26 runs of 0.025 s.
+//! Runs go two at a time (the machine is shared); about 26 runs of 0.025 s. Every run goes
+//! through the model's `Enrichable` interface: an effect is the model enriched with that
+//! candidate and run at the amplitude, a holdout is `at_condition`.
+//!
+//! With `--deck FILE` the same on a keyword deck (`DeckModel`): the declared quantities are
+//! `--declared a,b,...` (the first section's thickness by default), the effects every
+//! candidate of the deck moved from its held value by a quarter of its admissible range
+//! (upward where there is room), no filter unless `--cfc N`, and no holdouts.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::time::Instant;
 
+use impactcal::core::enrich::Enrichable;
 use impactcal::core::noise::{JitterOptions, SimulationNoise};
-use impactcal::core::{Cfc, Histories, Model};
+use impactcal::core::{Cfc, Model, Parameter, ParameterSpace};
+use impactcal::shell::DeckModel;
 use impactcal::shell::airframe::{
-    Airframe, AirframeModel, AirframeOptions, AirframeValues, MeshDensity, Preset, structural_space,
+    Airframe, AirframeModel, AirframeOptions, MeshDensity, Preset, space_of, structural_space,
 };
+use impactcal::shell::keyword::read_deck;
 use rayon::prelude::*;
 
-/// The undeclared effects, each as (name, value) changes of the nominal airframe, with a
-/// label.
+/// The undeclared effects of the airframe: label, candidate, value.
 const EFFECTS: [(&str, &str, f64); 8] = [
     ("ground friction 0.3 -> 0.5", "ground.friction", 0.5),
     ("damping 0 -> 10 1/s", "damping", 10.0),
@@ -53,7 +62,7 @@ const EFFECTS: [(&str, &str, f64); 8] = [
     ("Cowper-Symonds C 6500 -> 65000", "rate.c", 65000.0),
 ];
 
-/// The holdout conditions.
+/// The holdout conditions of the airframe: label, held quantity, value.
 const HOLDOUTS: [(&str, &str, f64); 3] = [
     ("impact.vertical = 280 in/s", "impact.vertical", 280.0),
     ("impact.vertical = 340 in/s", "impact.vertical", 340.0),
@@ -101,6 +110,131 @@ fn residual(q: &[Vec<f64>], v: &[f64]) -> Vec<f64> {
     r
 }
 
+/// What to measure: the model declaring its space, a model over its structure for the
+/// jitter ensemble, the effects and the holdouts (label, name, value), the filter.
+struct Case<M, N> {
+    model: M,
+    structure: N,
+    effects: Vec<(String, String, f64)>,
+    holdouts: Vec<(String, String, f64)>,
+    cfc: Option<Cfc>,
+    jitter: usize,
+}
+
+/// The airframe case: coarse mesh, `declared` thicknesses, 0 to `end` s, CFC 60.
+fn airframe_case(declared: &[&str], end: f64, jitter: usize) -> Case<AirframeModel, AirframeModel> {
+    let mut o = AirframeOptions::new(MeshDensity::Coarse);
+    o.end_time = end;
+    let airframe = Airframe::new(o).unwrap();
+    let own = |v: &[(&str, &str, f64)]| {
+        v.iter()
+            .map(|(l, n, x)| (l.to_string(), n.to_string(), *x))
+            .collect()
+    };
+    Case {
+        model: AirframeModel::new(airframe.clone(), space_of(declared).unwrap()).unwrap(),
+        structure: AirframeModel::new(airframe, structural_space().unwrap()).unwrap(),
+        effects: own(&EFFECTS),
+        holdouts: own(&HOLDOUTS),
+        cfc: Some(Cfc::from_class(60).unwrap()),
+        jitter,
+    }
+}
+
+/// The deck case: `declared` quantities (the first one by default) and every candidate a
+/// quarter of its admissible range away from its held value.
+fn deck_case(
+    path: &str,
+    declared: Option<&str>,
+    cfc: Option<Cfc>,
+    jitter: usize,
+) -> Case<DeckModel, DeckModel> {
+    let full = DeckModel::new(read_deck(path).unwrap().model).unwrap();
+    let names: Vec<String> = match declared {
+        Some(d) => d.split(',').map(str::to_string).collect(),
+        None => vec![full.space().names()[0].to_string()],
+    };
+    let params = names
+        .iter()
+        .map(|n| {
+            let i = full
+                .space()
+                .index_of(n)
+                .unwrap_or_else(|| panic!("no quantity {n}"));
+            full.space().parameters()[i].clone()
+        })
+        .collect();
+    let model = full.declare(&ParameterSpace::new(params).unwrap()).unwrap();
+    let effects = model
+        .candidates()
+        .iter()
+        .map(|c| {
+            let p = &c.parameter;
+            let v = if p.upper > p.nominal {
+                p.nominal + 0.25 * (p.upper - p.nominal)
+            } else {
+                p.nominal - 0.25 * (p.nominal - p.lower)
+            };
+            (
+                format!("{} {} -> {v:.4e}", c.name(), p.nominal),
+                c.name().to_string(),
+                v,
+            )
+        })
+        .collect();
+    Case {
+        model,
+        structure: full,
+        effects,
+        holdouts: Vec::new(),
+        cfc,
+        jitter,
+    }
+}
+
+/// One run's filtered histories, flattened (channels x samples).
+fn run<M: Model>(m: &M, x: &[f64], cfc: Option<Cfc>) -> Result<Vec<f64>, String> {
+    let h = m.simulate(x).map_err(|e| e.to_string())?;
+    let h = match cfc {
+        Some(c) => h.filtered(c).map_err(|e| e.to_string())?,
+        None => h,
+    };
+    Ok(h.data().to_vec())
+}
+
+/// A run of `model` enriched with the candidate `name` at `value`.
+fn effect_run<M: Enrichable>(
+    model: &M,
+    name: &str,
+    value: f64,
+    cfc: Option<Cfc>,
+) -> Result<Vec<f64>, String> {
+    let c = model
+        .candidates()
+        .into_iter()
+        .find(|c| c.name() == name)
+        .ok_or(format!("{name} is not a candidate"))?;
+    let e = model
+        .enrich(std::slice::from_ref(&c.parameter))
+        .map_err(|e| e.to_string())?;
+    let mut x = model.space().nominal();
+    x.push(value);
+    run(&e, &x, cfc)
+}
+
+/// A run of `model` at the condition `name = value`.
+fn holdout_run<M: Enrichable>(
+    model: &M,
+    name: &str,
+    value: f64,
+    cfc: Option<Cfc>,
+) -> Result<Vec<f64>, String> {
+    let m = model
+        .at_condition(&[(name.to_string(), value)])
+        .map_err(|e| e.to_string())?;
+    run(&m, &model.space().nominal(), cfc)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let opt = |name: &str| {
@@ -108,63 +242,75 @@ fn main() {
             .position(|a| a == name)
             .and_then(|i| args.get(i + 1).cloned())
     };
-    let declared: Vec<&str> = match opt("--declared").as_deref() {
-        Some("small") => vec!["belly_panel.t", "keel_beam_web.t"],
-        _ => Preset::Table2.names().to_vec(),
-    };
     let jitter: usize = opt("--jitter").map_or(8, |j| j.parse().unwrap());
-    let end: f64 = opt("--end").map_or(0.025, |t| t.parse().unwrap());
     rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build_global()
         .unwrap();
+    match opt("--deck") {
+        Some(path) => {
+            let cfc = opt("--cfc").map(|c| Cfc::from_class(c.parse().unwrap()).unwrap());
+            measure(
+                &deck_case(&path, opt("--declared").as_deref(), cfc, jitter),
+                &path,
+            );
+        }
+        None => {
+            let declared: Vec<&str> = match opt("--declared").as_deref() {
+                Some("small") => vec!["belly_panel.t", "keel_beam_web.t"],
+                _ => Preset::Table2.names().to_vec(),
+            };
+            let end: f64 = opt("--end").map_or(0.025, |t| t.parse().unwrap());
+            let what = format!("coarse airframe, 0-{end} s");
+            measure(&airframe_case(&declared, end, jitter), &what);
+        }
+    }
+}
 
-    let mut o = AirframeOptions::new(MeshDensity::Coarse);
-    o.end_time = end;
-    let airframe = Airframe::new(o).unwrap();
-    let cfc = Cfc::from_class(60).unwrap();
+/// Runs a case and prints its tables.
+fn measure<M, N>(case: &Case<M, N>, what: &str)
+where
+    M: Enrichable + Sync,
+    N: Model + Sync,
+{
     let started = Instant::now();
-
+    let model = &case.model;
+    let cfc = case.cfc;
     // 1. The noise: the nominal run and a jitter ensemble about it.
-    let structure = AirframeModel::new(airframe.clone(), structural_space().unwrap()).unwrap();
-    let noise = SimulationNoise::measure(
-        &structure,
-        &structure.space().nominal(),
-        &JitterOptions::new(jitter, 1e-4, 1).with_cfc(cfc),
-    )
-    .unwrap();
+    let mut options = JitterOptions::new(case.jitter, 1e-4, 1);
+    options.cfc = cfc;
+    let noise =
+        SimulationNoise::measure(&case.structure, &case.structure.space().nominal(), &options)
+            .unwrap();
     let y0: Vec<f64> = noise.nominal.concat();
     let sigma = norm(&noise.spread.concat());
     let signal = norm(&y0);
 
     // 2-4. Every other run, two at a time.
-    let table2 = Preset::Table2.space().unwrap();
-    let mut changes: Vec<(String, String, f64)> = Vec::new();
-    let mut steps = Vec::new();
-    for name in &declared {
-        let p = &table2.parameters()[table2.index_of(name).unwrap()];
-        let h = 0.1 * p.width();
-        steps.push(h);
-        changes.push((format!("{name} +{h}"), name.to_string(), p.nominal + h));
-    }
-    for (label, name, v) in EFFECTS.iter().chain(&HOLDOUTS) {
-        changes.push((label.to_string(), name.to_string(), *v));
-    }
-    let runs: Vec<Result<Vec<f64>, String>> = changes
+    let declared: Vec<&Parameter> = model.space().parameters().iter().collect();
+    let steps: Vec<f64> = declared.iter().map(|p| 0.1 * p.width()).collect();
+    let nd = declared.len();
+    let ne = case.effects.len();
+    let jobs: Vec<usize> = (0..nd + ne + case.holdouts.len()).collect();
+    let runs: Vec<Result<Vec<f64>, String>> = jobs
         .par_iter()
-        .map(|(_, name, v)| {
-            let mut values = AirframeValues::nominal();
-            values.set(name, *v).map_err(|e| e.to_string())?;
-            let r = airframe.run(&values).map_err(|e| e.to_string())?;
-            let h: Histories = r.velocity.ok_or("no histories")?;
-            let f = h.filtered(cfc).map_err(|e| e.to_string())?;
-            Ok(f.data().to_vec())
+        .map(|&k| {
+            if k < nd {
+                let mut x = model.space().nominal();
+                x[k] += steps[k];
+                run(model, &x, cfc)
+            } else if k < nd + ne {
+                let (_, name, v) = &case.effects[k - nd];
+                effect_run(model, name, *v, cfc)
+            } else {
+                let (_, name, v) = &case.holdouts[k - nd - ne];
+                holdout_run(model, name, *v, cfc)
+            }
         })
         .collect();
     let elapsed = started.elapsed().as_secs_f64();
 
-    let n_decl = declared.len();
-    let jcols: Vec<Vec<f64>> = runs[..n_decl]
+    let jcols: Vec<Vec<f64>> = runs[..nd]
         .iter()
         .zip(&steps)
         .map(|(r, h)| {
@@ -176,32 +322,34 @@ fn main() {
         .collect();
     let q = orthonormal(&jcols);
 
+    let filter = cfc.map_or("unfiltered".to_string(), |c| format!("{c:?}"));
     println!(
-        "coarse airframe, 0-{end} s, CFC 60, {} channels x {} samples; declared: {}",
+        "{what}, {filter}, {} channels x {} samples; declared: {}",
         noise.channels(),
         noise.samples(),
-        declared.join(", ")
+        model.space().names().join(", ")
     );
     println!(
-        "simulation noise: {jitter}-run jitter ensemble (eps 1e-4), ||sigma|| / ||y0|| = {:.2e}",
+        "simulation noise: {}-run jitter ensemble (eps 1e-4), ||sigma|| / ||y0|| = {:.2e}",
+        case.jitter,
         sigma / signal
     );
     let rms = |c: usize| norm(&noise.nominal[c]) / (noise.samples() as f64).sqrt();
-    let loudest = (0..noise.channels())
+    if let Some(loudest) = (0..noise.channels())
         .filter(|&c| noise.labels[c].ends_with(".z"))
         .max_by(|&a, &b| rms(a).total_cmp(&rms(b)))
-        .unwrap();
+    {
+        println!(
+            "largest vertical channel: {} (RMS {:.4})",
+            noise.labels[loudest],
+            rms(loudest)
+        );
+    }
     println!(
-        "largest vertical channel: {} (RMS {:.1} in/s)",
-        noise.labels[loudest],
-        rms(loudest)
-    );
-    println!(
-        "runs: {} ({} jitter + nominal, {n_decl} declared directions, {} effects, {} holdouts) in {elapsed:.0} s",
-        jitter + 1 + changes.len(),
-        jitter,
-        EFFECTS.len(),
-        HOLDOUTS.len()
+        "runs: {} ({} jitter + nominal, {nd} declared directions, {ne} effects, {} holdouts) in {elapsed:.0} s",
+        case.jitter + 1 + jobs.len(),
+        case.jitter,
+        case.holdouts.len()
     );
     println!();
     println!(
@@ -209,8 +357,8 @@ fn main() {
     );
     println!("|---|---|---|---|---|");
     let mut projected = Vec::new();
-    for (k, (label, _, _)) in EFFECTS.iter().enumerate() {
-        match &runs[n_decl + k] {
+    for (k, (label, _, _)) in case.effects.iter().enumerate() {
+        match &runs[nd + k] {
             Ok(y) => {
                 let r = minus(y, &y0);
                 let rt = residual(&q, &r);
@@ -243,12 +391,14 @@ fn main() {
     if !any {
         println!("  none");
     }
+    if case.holdouts.is_empty() {
+        return;
+    }
     println!();
     println!("| holdout | runs | ||y - y0|| / ||y0|| |");
     println!("|---|---|---|");
-    let base = n_decl + EFFECTS.len();
-    for (k, (label, _, _)) in HOLDOUTS.iter().enumerate() {
-        match &runs[base + k] {
+    for (k, (label, _, _)) in case.holdouts.iter().enumerate() {
+        match &runs[nd + ne + k] {
             Ok(y) => println!("| {label} | yes | {:.3} |", norm(&minus(y, &y0)) / signal),
             Err(e) => println!("| {label} | no: {e} | |"),
         }
