@@ -322,7 +322,7 @@ where
         .collect();
     let q = orthonormal(&jcols);
 
-    let filter = cfc.map_or("unfiltered".to_string(), |c| format!("{c:?}"));
+    let filter = cfc.map_or("unfiltered".to_string(), |c| c.to_string());
     println!(
         "{what}, {filter}, {} channels x {} samples; declared: {}",
         noise.channels(),
