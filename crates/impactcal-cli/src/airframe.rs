@@ -21,8 +21,9 @@ pub struct Args {
     /// Write the airframe as an LS-DYNA keyword deck here.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Print the catalogue of adjustable quantities (name, nominal, lower, upper, unit,
-    /// presets, meaning) as CSV.
+    /// Print the catalogue of adjustable quantities (name, group, nominal, lower, upper,
+    /// unit, presets, meaning) as CSV; `lower..upper` is the study range, which is also the
+    /// admissible range of the quantity as a candidate effect of the closed loop.
     #[arg(long)]
     pub list: bool,
     /// Print the names of a preset's parameters (`table1` or `table2`) as a bounds file
@@ -87,7 +88,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
 }
 
 fn catalogue_csv() -> String {
-    let mut s = String::from("name,nominal,lower,upper,unit,preset,description\n");
+    let mut s = String::from("name,group,nominal,lower,upper,unit,preset,description\n");
     for a in catalogue() {
         let preset = [Preset::Table1, Preset::Table2]
             .iter()
@@ -97,8 +98,8 @@ fn catalogue_csv() -> String {
             .join(" ");
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},\"{}\"",
-            a.name, a.nominal, a.lower, a.upper, a.unit, preset, a.description
+            "{},{},{},{},{},{},{},\"{}\"",
+            a.name, a.group, a.nominal, a.lower, a.upper, a.unit, preset, a.description
         );
     }
     s

@@ -15,12 +15,17 @@ fn list_and_presets() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "name,nominal,lower,upper,unit,preset,description"
+        "name,group,nominal,lower,upper,unit,preset,description"
     );
     // 8 globals, 5 masses, 14 parts x 4 fields.
     assert_eq!(lines.count(), 8 + 5 + 14 * 4);
-    assert!(text.contains("belly_panel.t,0.09,0.08,0.135,in,table2,"));
-    assert!(text.contains("keel_beam_web.E,9880000,7904000,11856000,lbf/in^2,table1,"));
+    assert!(text.contains("belly_panel.t,thickness,0.09,0.08,0.135,in,table2,"));
+    assert!(text.contains("keel_beam_web.E,material,9880000,7904000,11856000,lbf/in^2,table1,"));
+    assert!(text.contains("ground.friction,friction,0.3,0,0.8,,,"));
+    assert!(text.contains("damping,damping,0,0,50,1/s,,"));
+    assert!(text.contains("attitude.pitch,condition,0,-10,10,deg,,"));
+    assert!(text.contains("mass.tail,mass,0.07,"));
+    assert!(text.contains("rate.p,strain-rate,4,2,8,,,"));
 
     let out = impactcal(&["airframe", "--preset", "table1"]);
     assert!(out.status.success());

@@ -1,7 +1,7 @@
 //! Models that can grow: the quantities a model holds fixed today and could free, so that a
 //! calibration that leaves a residual can look for the effect the model lacks.
 //!
-//! A [`Model`] declares a [`ParameterSpace`](crate::space::ParameterSpace); everything else it needs (a damping
+//! A [`Model`] declares a [`ParameterSpace`](crate::ParameterSpace); everything else it needs (a damping
 //! coefficient, a friction coefficient, a concentrated mass, the impact velocity) it holds at
 //! one value. An [`Enrichable`] model lists those held quantities as [`Candidate`]s, builds
 //! itself with some of them freed ([`Enrichable::enrich`]), and builds itself at another test
@@ -123,6 +123,43 @@ impl Candidate {
     pub fn name(&self) -> &str {
         &self.parameter.name
     }
+
+    /// Checks that the bounds of `p` (a caller's parameter for this candidate) lie within
+    /// the admissible range (a helper for [`Enrichable::enrich`]).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] naming the candidate and both ranges.
+    pub fn check_bounds(&self, p: &Parameter) -> Result<()> {
+        let a = &self.parameter;
+        if p.lower < a.lower || p.upper > a.upper {
+            return Err(CoreError::invalid_option(
+                "enrich",
+                &p.name,
+                format!(
+                    "bounds [{}, {}] leave the admissible range [{}, {}]",
+                    p.lower, p.upper, a.lower, a.upper
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks that `value` is finite and admissible (a helper for
+    /// [`Enrichable::at_condition`]).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] naming the candidate, the value and the range.
+    pub fn check_value(&self, value: f64) -> Result<()> {
+        let a = &self.parameter;
+        if !(value.is_finite() && (a.lower..=a.upper).contains(&value)) {
+            return Err(CoreError::invalid_option(
+                "condition",
+                format!("{} = {value}", a.name),
+                format!("outside the admissible range [{}, {}]", a.lower, a.upper),
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// A [`Model`] that lists the quantities it holds fixed and can free them.
@@ -155,6 +192,14 @@ pub trait Enrichable: Model + Sized {
     /// declared parameter, which a point sets instead) or the value is not admissible.
     fn at_condition(&self, set: &[(String, f64)]) -> Result<Self>;
 
+    /// The group and description of one of the model's declared parameters, where the model
+    /// knows them, so that a wrapper holding some of them (a subspace of the model) can list
+    /// them as candidates of the right kind. `None` unless a model says more.
+    fn describe(&self, name: &str) -> Option<(String, String)> {
+        let _ = name;
+        None
+    }
+
     /// Checks that `p` names one of [`candidates`](Enrichable::candidates) (a helper for
     /// implementations of [`enrich`](Enrichable::enrich)).
     ///
@@ -175,6 +220,31 @@ pub trait Enrichable: Model + Sized {
                 &p.name,
                 "not a candidate of the model (held quantities only)",
             ))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds_and_values_outside_the_admissible_range_are_refused() {
+        let c = Candidate::new(
+            Parameter::new("damping", 0.0, 50.0, 0.0).unwrap(),
+            "damping",
+            "mass-proportional damping",
+        );
+        let p = |l: f64, u: f64| Parameter::new("damping", l, u, l.max(0.0)).unwrap();
+        assert!(c.check_bounds(&p(0.0, 50.0)).is_ok());
+        assert!(c.check_bounds(&p(5.0, 10.0)).is_ok());
+        let e = c.check_bounds(&p(-1.0, 10.0)).unwrap_err().to_string();
+        assert!(e.contains("[-1, 10]") && e.contains("[0, 50]"), "{e}");
+        assert!(c.check_bounds(&p(0.0, 60.0)).is_err());
+        assert!(c.check_value(0.0).is_ok() && c.check_value(50.0).is_ok());
+        for v in [-0.1, 50.1, f64::NAN, f64::INFINITY] {
+            let e = c.check_value(v).unwrap_err();
+            assert!(matches!(e, CoreError::InvalidOption { .. }), "{e}");
         }
     }
 }

@@ -484,3 +484,43 @@ fn a_number_wider_than_its_field_is_warned_with_the_fields_as_read() {
     // LS-PrePost's touching ENDENG / ENDMAS pair (0.0 then 1.000000E8) is not such a case.
     assert!(parse_deck(PLAIN, "plain.k").unwrap().warnings.is_empty());
 }
+
+#[test]
+fn a_parameterised_deck_holds_the_parameters_it_does_not_declare() {
+    use impactcal_core::enrich::Enrichable;
+    use impactcal_core::{Parameter, ParameterSpace};
+    let deck = parse_deck(&parameterised(), "param.k").unwrap();
+    let bounds = ParameterSpace::new(vec![
+        Parameter::new("THICK", 0.0018, 0.0022, 0.002).unwrap(),
+    ])
+    .unwrap();
+    let model = DeckModel::from_deck(deck, Some(&bounds)).unwrap();
+    let c = model.candidates();
+    let names: Vec<(&str, &str, f64)> = c
+        .iter()
+        .map(|c| (c.name(), c.group.as_str(), c.parameter.nominal))
+        .collect();
+    assert_eq!(
+        names,
+        [("sigy", "parameter", 2.5e8), ("speed", "parameter", -5.0)]
+    );
+    assert_eq!((c[1].parameter.lower, c[1].parameter.upper), (-6.0, -4.0));
+    // Freed at the held value: the same run; at another speed: the deck read with it.
+    let enriched = model.enrich(&[c[0].parameter.clone()]).unwrap();
+    assert_eq!(enriched.space().names(), ["THICK", "sigy"]);
+    let a = model.simulate(&[0.002]).unwrap();
+    let b = enriched.simulate(&[0.002, 2.5e8]).unwrap();
+    assert!(
+        a.data()
+            .iter()
+            .zip(b.data())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    );
+    let slow = enriched.at_condition(&[("speed".into(), -4.5)]).unwrap();
+    let m = slow.model_at(&[0.002, 2.5e8]).unwrap();
+    assert_eq!(m.initial_velocities[0].translation[2], 4.5);
+    assert_eq!(slow.candidates()[0].parameter.nominal, -4.5);
+    assert!(slow.at_condition(&[("sigy".into(), 3e8)]).is_err());
+    assert!(slow.at_condition(&[("speed".into(), -7.0)]).is_err());
+    assert!(slow.at_condition(&[("nips".into(), 3.0)]).is_err());
+}

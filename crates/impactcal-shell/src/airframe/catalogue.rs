@@ -22,6 +22,10 @@ pub struct Adjustable {
     pub unit: &'static str,
     /// What it is.
     pub description: String,
+    /// Its kind: `condition` (impact speeds, attitude), `friction`, `damping`,
+    /// `strain-rate` (Cowper-Symonds constants), `mass`, `thickness` or `material` (a part's
+    /// `E`, `Et`, `sigy`).
+    pub group: &'static str,
 }
 
 impl Adjustable {
@@ -152,6 +156,7 @@ pub fn catalogue() -> Vec<Adjustable> {
             upper,
             unit,
             description: d,
+            group: group_of(name),
         });
     };
     add(
@@ -266,6 +271,19 @@ pub fn catalogue() -> Vec<Adjustable> {
         );
     }
     c
+}
+
+/// The group of a catalogue name (see [`Adjustable::group`]).
+fn group_of(name: &str) -> &'static str {
+    match name.split_once('.').map_or(name, |(head, _)| head) {
+        "impact" | "attitude" => "condition",
+        "ground" => "friction",
+        "damping" => "damping",
+        "rate" => "strain-rate",
+        "mass" => "mass",
+        _ if name.ends_with(".t") => "thickness",
+        _ => "material",
+    }
 }
 
 /// The thickness bounds of the source paper's Table 2, where it gives them.

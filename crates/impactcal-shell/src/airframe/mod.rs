@@ -34,6 +34,7 @@
 //! ```
 
 mod catalogue;
+pub(crate) mod enrich;
 mod mesh;
 mod svg;
 
