@@ -196,7 +196,7 @@ fn a_killed_loop_resumes_to_the_same_result() {
     let holdout = holdout_of(&t, 5);
     let first = run(&t, 5, dir.path(), Some(&holdout));
     // Kill after the first round: the recalibration's and the holdout's runs are gone.
-    let journal = dir.path().join("journal");
+    let journal = dir.path().join("runs");
     let mut removed = 0;
     for e in std::fs::read_dir(&journal).unwrap() {
         let p = e.unwrap().path();
@@ -207,14 +207,18 @@ fn a_killed_loop_resumes_to_the_same_result() {
         }
     }
     assert!(removed > 10);
-    // Also a half-finished stage: drop the last run of the first calibration's CORS.
-    let cors = journal.join("r0-cors");
-    let mut files: Vec<_> = std::fs::read_dir(&cors)
+    // Also a half-finished stage: drop the last batch of the first calibration's CORS
+    // (`r0-cors-<first run>`), as if the loop died while it ran.
+    let last = std::fs::read_dir(&journal)
         .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    files.sort();
-    std::fs::remove_file(files.last().unwrap()).unwrap();
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter_map(|n| {
+            n.strip_prefix("r0-cors-")
+                .and_then(|k| k.parse::<usize>().ok())
+        })
+        .max()
+        .unwrap();
+    std::fs::remove_dir_all(journal.join(format!("r0-cors-{last}"))).unwrap();
     let again = run(&t, 5, dir.path(), Some(&holdout));
     assert_eq!(
         serde_json::to_string(&first).unwrap(),
@@ -236,7 +240,7 @@ fn bad_input_is_a_typed_error_before_any_run() {
         let e = r.unwrap_err();
         assert_eq!(e.kind(), impactcal_core::ErrorKind::BadInput, "{e}");
         assert!(e.to_string().contains(needle), "{e}");
-        assert!(!dir.join("journal").exists(), "{e}");
+        assert!(!dir.join("runs").exists(), "{e}");
     };
     // A holdout at a speed the model cannot take.
     let dir = tempfile::tempdir().unwrap();
@@ -294,7 +298,7 @@ fn bad_input_is_a_typed_error_before_any_run() {
     };
     let e = run_loop(&model, "m", bad, None, &opts, dir.path(), &Silent).unwrap_err();
     assert!(e.to_string().contains("belt"), "{e}");
-    assert!(dir.path().join("journal/nominal/00000.run").exists());
+    assert!(dir.path().join("runs/nominal/journal.jsonl").exists());
 }
 
 /// How often the hidden effect is ranked first over 20 noise seeds (docs/validation.md):

@@ -2,8 +2,13 @@
 //!
 //! ```toml
 //! [model]
-//! kind = "drop-tower"            # the built-in fast impact model
+//! kind = "drop-tower"            # the built-in fast impact model; or, as in a study file:
+//!                                # airframe = "coarse" (+ end_time) or deck = "model.k"
 //! set = { v0 = 4.0 }             # held quantities at the calibration test's condition
+//!
+//! [space]                        # airframe and decks, as in a study file: the declared
+//! preset = "table2"              # parameters (or bounds = "bounds.csv"); every other
+//!                                # quantity of the model is a candidate effect
 //!
 //! [test]
 //! data = "test.csv"              # wide CSV, or an ISO-MME data set
@@ -32,7 +37,7 @@ use std::path::{Path, PathBuf};
 use clap::Args as ClapArgs;
 use impactcal::calibrate::closeloop::document::report;
 use impactcal::calibrate::closeloop::{Holdout, LoopOptions, LoopResult, Verdict, run_loop};
-use impactcal::calibrate::study::TestData;
+use impactcal::calibrate::study::{StudyOptions, TestData};
 use impactcal::core::drop_tower::DropTower;
 use impactcal::core::{Cfc, ChannelMap, Enrichable, Histories};
 use serde::Deserialize;
@@ -40,7 +45,10 @@ use serde::Deserialize;
 use crate::error::CliError;
 use crate::output::write_text;
 use crate::simulate::thread_pool;
-use crate::study::{Progress, read_test, resolve};
+use crate::study::{
+    Built, Config as StudyConfig, ModelConfig as StudyModel, Progress, SpaceConfig,
+    TestConfig as StudyTest, read_test, resolve,
+};
 
 /// Arguments of `impactcal close-loop`.
 #[derive(ClapArgs, Debug)]
@@ -63,6 +71,12 @@ pub struct Args {
 pub struct Config {
     /// The model.
     pub model: ModelConfig,
+    /// Deck quantities under the loop's names (decks only, as in a study file).
+    #[serde(default)]
+    pub parameters: BTreeMap<String, String>,
+    /// The declared parameters (airframe and decks, as in a study file).
+    #[serde(default)]
+    pub space: SpaceConfig,
     /// The calibration test.
     pub test: TestConfig,
     /// The holdout test.
@@ -81,10 +95,12 @@ pub struct Config {
 pub struct ModelConfig {
     /// The built-in model: `drop-tower`.
     pub kind: Option<String>,
-    /// The airframe's mesh density (not yet a model the loop can enrich).
+    /// The built-in airframe's mesh density (`coarse`, `medium`, `fine`).
     pub airframe: Option<String>,
-    /// A keyword deck (not yet a model the loop can enrich).
+    /// A keyword deck.
     pub deck: Option<PathBuf>,
+    /// Simulated time of the airframe (s).
+    pub end_time: Option<f64>,
     /// Held quantities at the calibration test's condition.
     #[serde(default)]
     pub set: BTreeMap<String, f64>,
@@ -150,32 +166,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     options.recalibrate = b.recalibrate.unwrap_or(options.recalibrate);
     options.seed = b.seed.unwrap_or(options.seed);
     options.sigma = config.test.sigma.or(options.sigma);
-    let set: Vec<(String, f64)> = config.model.set.clone().into_iter().collect();
-    let model = match (
-        &config.model.kind,
-        &config.model.airframe,
-        &config.model.deck,
-    ) {
-        (Some(k), None, None) if k == "drop-tower" => DropTower::new()
-            .at_condition(&set)
-            .map_err(|e| CliError::from(e).context(format!("{name}: [model] set")))?,
-        (Some(k), None, None) => {
-            return Err(CliError::input(format!(
-                "{name}: [model] kind = \"{k}\": unknown (the built-in model is \"drop-tower\")"
-            )));
-        }
-        (None, Some(_), None) | (None, None, Some(_)) => {
-            return Err(CliError::input(format!(
-                "{name}: [model]: the closed loop needs a model that lists its candidate \
-                 effects; in this version that is kind = \"drop-tower\""
-            )));
-        }
-        _ => {
-            return Err(CliError::input(format!(
-                "{name}: [model]: give one of kind = \"drop-tower\", airframe or deck"
-            )));
-        }
-    };
+    let model = build_model(&config, base, &name)?;
     let test = read_test(&resolve(base, &config.test.data))?;
     let map = config
         .test
@@ -191,23 +182,93 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )),
         None => None,
     };
-    let description = format!("drop-tower {set:?}");
     let pool = thread_pool(args.threads)?;
     let result = pool
         .install(|| {
-            close(
-                &model,
-                &description,
-                &test,
-                map.as_ref(),
-                cfc,
-                holdout.as_ref(),
-                &options,
-                &args.out,
-            )
+            let (h, out) = (holdout.as_ref(), &args.out);
+            match &model {
+                LoopModel::DropTower(m, d) => {
+                    close(m, d, &test, map.as_ref(), cfc, h, &options, out)
+                }
+                LoopModel::Study(Built::Airframe(m, _), d) => {
+                    close(&**m, d, &test, map.as_ref(), cfc, h, &options, out)
+                }
+                LoopModel::Study(Built::Deck(m), d) => {
+                    close(&**m, d, &test, map.as_ref(), cfc, h, &options, out)
+                }
+                LoopModel::Study(Built::Solver, _) => Err(CliError::input(
+                    "[solver]: the closed loop needs a model that lists its candidate effects",
+                )),
+            }
         })
         .map_err(|e| e.context(&name))?;
     finish(&result, &args.out)
+}
+
+/// The model of a loop file, with its description (which enters the loop's fingerprint).
+enum LoopModel {
+    /// The built-in drop tower.
+    DropTower(DropTower, String),
+    /// The airframe or a deck, built as a study file builds it.
+    Study(Built, String),
+}
+
+/// Builds the model of a loop file: the drop tower from `kind`, the airframe or a deck as
+/// a study file does (`[model]`, `[space]`, `[parameters]`).
+fn build_model(config: &Config, base: &Path, name: &str) -> Result<LoopModel, CliError> {
+    let m = &config.model;
+    match (&m.kind, &m.airframe, &m.deck) {
+        (Some(k), None, None) if k == "drop-tower" => {
+            if config.space.preset.is_some()
+                || config.space.bounds.is_some()
+                || !config.parameters.is_empty()
+                || m.end_time.is_some()
+            {
+                return Err(CliError::input(format!(
+                    "{name}: [space], [parameters] and end_time apply to the airframe and \
+                     decks; the drop tower declares modulus and k_contact"
+                )));
+            }
+            let set: Vec<(String, f64)> = m.set.clone().into_iter().collect();
+            let model = DropTower::new()
+                .at_condition(&set)
+                .map_err(|e| CliError::from(e).context(format!("{name}: [model] set")))?;
+            Ok(LoopModel::DropTower(model, format!("drop-tower {set:?}")))
+        }
+        (Some(k), None, None) => Err(CliError::input(format!(
+            "{name}: [model] kind = \"{k}\": unknown (the built-in model is \"drop-tower\")"
+        ))),
+        (None, Some(_), None) | (None, None, Some(_)) => {
+            let study = StudyConfig {
+                model: Some(StudyModel {
+                    airframe: m.airframe.clone(),
+                    deck: m.deck.clone(),
+                    end_time: m.end_time,
+                    set: m.set.clone(),
+                }),
+                solver: None,
+                executor: None,
+                batch: None,
+                parameters: config.parameters.clone(),
+                space: SpaceConfig {
+                    preset: config.space.preset.clone(),
+                    bounds: config.space.bounds.clone(),
+                },
+                test: StudyTest {
+                    data: config.test.data.clone(),
+                    map: config.test.map.clone(),
+                    cfc: config.test.cfc,
+                },
+                study: StudyOptions::default(),
+            };
+            let (built, description) =
+                crate::study::build_model(&study, base).map_err(|e| e.context(name))?;
+            Ok(LoopModel::Study(built, description))
+        }
+        _ => Err(CliError::input(format!(
+            "{name}: [model]: give one of kind = \"drop-tower\", airframe or deck"
+        ))),
+    }
 }
 
 /// Runs the loop of any enrichable `model` in `out`.

@@ -423,7 +423,7 @@ pub fn setup(config: &Config, base: &Path) -> Result<Setup, CliError> {
 }
 
 /// The model of a study file and its description (which enters the study's fingerprint).
-fn build_model(config: &Config, base: &Path) -> Result<(Built, String), CliError> {
+pub(crate) fn build_model(config: &Config, base: &Path) -> Result<(Built, String), CliError> {
     let none = ModelConfig {
         airframe: None,
         deck: None,

@@ -147,3 +147,76 @@ fn bad_input_exits_2_with_one_line() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("belt"), "{err}");
 }
+
+/// The loop on a keyword deck, configured as a study file configures it: the strip drop
+/// declares its thickness; the test was measured on the deck itself at another thickness
+/// (0.0021), with a trigger offset and noise, and the holdout at another drop speed. Nothing
+/// is missing from the model, so the loop must calibrate the thickness and stay silent.
+#[test]
+fn stays_silent_on_a_deck_without_a_missing_effect() {
+    use impactcal::core::{Parameter, ParameterSpace};
+    use impactcal::shell::DeckModel;
+    use impactcal::shell::keyword::read_deck;
+
+    let dir = tempfile::tempdir().unwrap();
+    let deck_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/decks/strip_drop.k");
+    let deck = read_deck(&deck_path).unwrap();
+    let declared = ParameterSpace::new(vec![
+        Parameter::new("section.1.t", 0.0016, 0.0024, 0.002).unwrap(),
+    ])
+    .unwrap();
+    let truth = DeckModel::new(deck.model)
+        .unwrap()
+        .declare(&declared)
+        .unwrap();
+    for (name, m, seed) in [
+        ("test.csv", truth.clone(), 1),
+        (
+            "holdout.csv",
+            truth
+                .at_condition(&[("velocity.1.z".into(), -4.5)])
+                .unwrap(),
+            2,
+        ),
+    ] {
+        let y = m.simulate(&[0.0021]).unwrap();
+        let meas = Measurement {
+            time_shift: 2e-5,
+            snr_db: Some(40.0),
+            seed,
+            ..Measurement::default()
+        };
+        measured(&y, &meas)
+            .unwrap()
+            .write_csv(dir.path().join(name))
+            .unwrap();
+    }
+    std::fs::write(
+        dir.path().join("bounds.csv"),
+        "name,lower,upper,nominal\nthickness,0.0016,0.0024,0.002\n",
+    )
+    .unwrap();
+    let text = format!(
+        "[model]\ndeck = \"{}\"\n\n[parameters]\nthickness = \"section.1.t\"\n\n\
+         [space]\nbounds = \"bounds.csv\"\n\n[test]\ndata = \"test.csv\"\n\n\
+         [holdout]\ndata = \"holdout.csv\"\nset = {{ \"velocity.1.z\" = -4.5 }}\n\n\
+         [budget]\nensemble = 8\nreconcile = 24\nrecalibrate = 24\nseed = 1\n",
+        deck_path.display()
+    );
+    let cfg = config(dir.path(), &text);
+    let out = dir.path().join("out");
+    let o = impactcal(&[
+        "close-loop",
+        "--config",
+        &cfg,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("loop.json")).unwrap()).unwrap();
+    assert_eq!(v["verdict"], "no-model-form-error", "{v:#}");
+    assert_eq!(v["added"].as_array().unwrap().len(), 0);
+    let t = v["calibrated"]["thickness"].as_f64().unwrap();
+    assert!((t - 0.0021).abs() < 0.00005, "thickness {t}");
+}
