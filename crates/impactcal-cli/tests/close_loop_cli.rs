@@ -44,6 +44,17 @@ fn config(dir: &Path, text: &str) -> String {
     p.to_str().unwrap().to_string()
 }
 
+/// Runs `impactcal close-loop` on the loop file `cfg` into `out`, which must succeed, and
+/// returns its `loop.json` and what it printed on stderr.
+fn close_loop(cfg: &str, out: &Path) -> (serde_json::Value, String) {
+    let out = out.to_str().unwrap();
+    let o = impactcal(&["close-loop", "--config", cfg, "--out", out]);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(o.status.success(), "{err}");
+    let text = std::fs::read_to_string(Path::new(out).join("loop.json")).unwrap();
+    (serde_json::from_str(&text).unwrap(), err)
+}
+
 const GOOD: &str = "[model]\nkind = \"drop-tower\"\n\n[test]\ndata = \"test.csv\"\n\n\
     [holdout]\ndata = \"holdout.csv\"\nset = { v0 = 5.5 }\n\n[budget]\nensemble = 8\n\
     reconcile = 24\nrecalibrate = 24\nseed = 1\n";
@@ -52,18 +63,8 @@ const GOOD: &str = "[model]\nkind = \"drop-tower\"\n\n[test]\ndata = \"test.csv\
 fn finds_the_hidden_damping_and_writes_the_report() {
     let dir = tempfile::tempdir().unwrap();
     write_tests(dir.path());
-    let cfg = config(dir.path(), GOOD);
     let out = dir.path().join("out");
-    let o = impactcal(&[
-        "close-loop",
-        "--config",
-        &cfg,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("loop.json")).unwrap()).unwrap();
+    let (v, err) = close_loop(&config(dir.path(), GOOD), &out);
     assert_eq!(v["verdict"], "attributed");
     assert_eq!(v["added"][0]["name"], "damping");
     let (lo, hi) = (
@@ -80,7 +81,7 @@ fn finds_the_hidden_damping_and_writes_the_report() {
     }
     assert!(v["runs"].as_u64().unwrap() > 20);
     assert!(out.join("report.html").exists() && out.join("report.md").exists());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("verdict: attributed"));
+    assert!(err.contains("verdict: attributed"));
 }
 
 #[test]
@@ -203,18 +204,7 @@ fn stays_silent_on_a_deck_without_a_missing_effect() {
          [budget]\nensemble = 8\nreconcile = 24\nrecalibrate = 24\nseed = 1\n",
         deck_path.display()
     );
-    let cfg = config(dir.path(), &text);
-    let out = dir.path().join("out");
-    let o = impactcal(&[
-        "close-loop",
-        "--config",
-        &cfg,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("loop.json")).unwrap()).unwrap();
+    let (v, _) = close_loop(&config(dir.path(), &text), &dir.path().join("out"));
     assert_eq!(v["verdict"], "no-model-form-error", "{v:#}");
     assert_eq!(v["added"].as_array().unwrap().len(), 0);
     let t = v["calibrated"]["thickness"].as_f64().unwrap();

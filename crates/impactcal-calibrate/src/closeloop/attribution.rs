@@ -156,7 +156,9 @@ pub(crate) fn attribute<M: Enrichable>(
                 x
             })
             .collect();
-        let outs = ctx.stage(&full, &format!("{prefix}-candidates"), &points)?;
+        let outs = ctx
+            .runner
+            .stage(&full, &format!("{prefix}-candidates"), &points)?;
         for (k, o) in outs.iter().enumerate() {
             let yk = ctx.y_of(&histories_of(
                 o,

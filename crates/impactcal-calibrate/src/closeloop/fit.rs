@@ -104,16 +104,6 @@ pub(crate) struct Fit {
 }
 
 impl Ctx<'_> {
-    /// The outcomes of `points` of `model` as journal stage `stage`.
-    pub fn stage<M: Model>(
-        &self,
-        model: &M,
-        stage: &str,
-        points: &[Vec<f64>],
-    ) -> Result<Vec<RunOutcome>> {
-        self.runner.stage(model, stage, points)
-    }
-
     /// The frame's channels of a run (filtered with the loop's CFC class), `S x T`.
     pub fn y_of(&self, h: &Histories) -> Result<Vec<f64>> {
         let h = match self.cfc {
@@ -140,7 +130,9 @@ impl Ctx<'_> {
     }
 
     fn run_one<M: Model>(&self, model: &M, stage: &str, point: &[f64]) -> Result<Vec<f64>> {
-        let o = self.stage(model, stage, std::slice::from_ref(&point.to_vec()))?;
+        let o = self
+            .runner
+            .stage(model, stage, std::slice::from_ref(&point.to_vec()))?;
         let h = histories_of(&o[0], stage)?;
         self.y_of(&h)
     }
@@ -162,7 +154,7 @@ pub(crate) fn calibrate<M: Model>(
 ) -> Result<Fit> {
     let before = ctx.runner.used.get();
     let space = model.space();
-    let outcomes = ctx.stage(model, &format!("{prefix}-start"), start)?;
+    let outcomes = ctx.runner.stage(model, &format!("{prefix}-start"), start)?;
     let mut point = start
         .first()
         .cloned()
@@ -226,7 +218,9 @@ fn polish_from<M: Model>(
                 x
             })
             .collect();
-        let outs = ctx.stage(model, &format!("{prefix}-gn{it}-jac"), &pts)?;
+        let outs = ctx
+            .runner
+            .stage(model, &format!("{prefix}-gn{it}-jac"), &pts)?;
         let base = nuisance::apply(&y, &ctx.frame, &terms);
         let mut jac = Vec::with_capacity(p + 1 + 2 * ctx.frame.labels.len());
         for (i, o) in outs.iter().enumerate() {
