@@ -47,6 +47,7 @@ pub struct Batch {
     points: Vec<Vec<f64>>,
     retries: u32,
     identity: Option<String>,
+    set: BTreeMap<String, f64>,
 }
 
 impl Batch {
@@ -116,6 +117,7 @@ impl Batch {
             points: rows,
             retries: 2,
             identity: None,
+            set: BTreeMap::new(),
         })
     }
 
@@ -150,6 +152,39 @@ impl Batch {
     pub fn with_identity(mut self, identity: impl Into<String>) -> Self {
         self.identity = Some(identity.into());
         self
+    }
+
+    /// The same batch with quantities held at given values in every run (a test condition,
+    /// such as the impact speed of a holdout test): written to each run's `params.json`
+    /// under `set`, rendered into the templates beside the point's coordinates (so a
+    /// template names them like parameters), and part of the journal's batch line, so a
+    /// journal of the batch at another condition is not resumed.
+    ///
+    /// # Errors
+    /// [`RunnerError::Names`] when a name is also a coordinate of the points, is not a
+    /// plain identifier, or the templates and names (coordinates and set) do not match;
+    /// [`impactcal_core::CoreError`] for a non-finite value.
+    pub fn with_set(mut self, set: &[(String, f64)]) -> Result<Self> {
+        let mut map = BTreeMap::new();
+        for (name, value) in set {
+            if self.names.contains(name) || map.insert(name.clone(), *value).is_some() {
+                return Err(RunnerError::Names {
+                    file: "batch".into(),
+                    message: format!(
+                        "`{name}` is set twice (a coordinate of the points or repeated in the set)"
+                    ),
+                });
+            }
+            impactcal_core::check_finite(&format!("set `{name}`"), &[*value])?;
+        }
+        let templates: Vec<&Template> = self.solver.inputs.iter().map(|(t, _)| t).collect();
+        if !templates.is_empty() && !map.is_empty() {
+            let mut all = self.names.clone();
+            all.extend(map.keys().cloned());
+            check_names(&templates, &all)?;
+        }
+        self.set = map;
+        Ok(self)
     }
 
     /// `<out>/runs/<study>`: the runs' directories and the journal.
@@ -332,6 +367,7 @@ impl<'a> Driver<'a> {
                 .identity
                 .clone()
                 .unwrap_or_else(|| batch.solver.fingerprint()),
+            set: batch.set.clone(),
         };
         match entries.first() {
             None => journal.append(&header)?,
@@ -518,9 +554,13 @@ impl<'a> Driver<'a> {
         }
         let values = &self.batch.points[index];
         let mut written = values.clone();
+        let mut names = self.batch.names.clone();
+        names.extend(self.batch.set.keys().cloned());
+        let mut all = values.clone();
+        all.extend(self.batch.set.values());
         for (template, name) in &self.batch.solver.inputs {
-            let (text, w) = template.render(index, &self.batch.names, values)?;
-            for (k, v) in w.iter().enumerate() {
+            let (text, w) = template.render(index, &names, &all)?;
+            for (k, v) in w.iter().take(values.len()).enumerate() {
                 if v.to_bits() != values[k].to_bits() {
                     written[k] = *v;
                 }
@@ -534,6 +574,7 @@ impl<'a> Driver<'a> {
             names: self.batch.names.clone(),
             values: values.clone(),
             written,
+            set: self.batch.set.clone(),
             prepared_at: now(),
             finished_at: None,
             seconds: None,
