@@ -187,6 +187,7 @@ fn worker(config: &Config, path: &Path) -> Result<Option<Worker>, CliError> {
         None | Some(ExecutorSection::Local) => return Ok(None),
         Some(e) => e.executor(),
     };
+    executor.check()?;
     Ok(Some(Worker {
         solver: point_solver("loop-point", path, None)?,
         executor,

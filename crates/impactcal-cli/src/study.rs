@@ -298,10 +298,12 @@ fn runner(
             CliError::input("[space]: an external solver needs `bounds = \"bounds.csv\"`")
         })?,
     };
+    let executor = section.executor();
+    executor.check()?;
     Ok(Some(Runner {
         space,
         solver,
-        executor: section.executor(),
+        executor,
         retries,
         cancel: Cancel::new(),
     }))

@@ -304,4 +304,40 @@ mod tests {
             assert!(matches!(e, CoreError::InvalidOption { .. }), "{e}");
         }
     }
+
+    #[test]
+    fn rebuild_is_enrich_then_at_condition_and_refuses_unknown_names() {
+        use crate::drop_tower::DropTower;
+        let m = DropTower::new();
+        let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let damping = m
+            .candidates()
+            .into_iter()
+            .find(|c| c.name() == "damping")
+            .unwrap()
+            .parameter;
+        let set = [("v0".to_string(), 5.0)];
+        let direct = m.enrich(&[damping]).unwrap().at_condition(&set).unwrap();
+        let rebuilt = rebuild(&m, &names(&["modulus", "k_contact", "damping"]), &set).unwrap();
+        assert_eq!(rebuilt.space(), direct.space());
+        let p = [75.0, 9e5, 0.02];
+        assert_eq!(
+            rebuilt.simulate(&p).unwrap().data(),
+            direct.simulate(&p).unwrap().data()
+        );
+        // Without added names and condition: the model itself.
+        let same = rebuild(&m, &names(&["modulus", "k_contact"]), &[]).unwrap();
+        assert_eq!(same.space(), m.space());
+        for bad in [
+            names(&["modulus", "k_contact", "dampnig"]),
+            names(&["k_contact", "modulus"]),
+            names(&["modulus"]),
+        ] {
+            let e = rebuild(&m, &bad, &[]).unwrap_err();
+            assert!(matches!(e, CoreError::InvalidOption { .. }), "{e}");
+        }
+        let e = rebuild(&m, &names(&["modulus", "k_contact", "dampnig"]), &[]).unwrap_err();
+        assert!(e.to_string().contains("dampnig"), "{e}");
+        assert!(rebuild(&m, &names(&["modulus", "k_contact"]), &[("v9".into(), 1.0)]).is_err());
+    }
 }
