@@ -231,3 +231,66 @@ fn executors_and_tables_the_loop_cannot_use_are_refused() {
         assert!(err.contains(needle), "{needle}: {err}");
     }
 }
+
+/// A keyword deck's loop (the strip drop declaring its thickness, every other deck
+/// quantity a candidate, a holdout at another drop speed) on the process pool equals the
+/// same loop in process: the worker rebuilds the deck's subspace with every candidate of
+/// the attribution runs and the holdout's condition.
+#[test]
+fn a_deck_loop_on_a_process_pool_equals_the_loop_in_process() {
+    use impactcal::core::{Parameter, ParameterSpace};
+    use impactcal::shell::DeckModel;
+    use impactcal::shell::keyword::read_deck;
+
+    let dir = tempfile::tempdir().unwrap();
+    let deck_path = common::example_file("decks", "strip_drop.k");
+    let declared =
+        ParameterSpace::new(vec![Parameter::new("section.1.t", 0.0016, 0.0024, 0.002).unwrap()])
+            .unwrap();
+    let truth = DeckModel::new(read_deck(&deck_path).unwrap().model)
+        .unwrap()
+        .declare(&declared)
+        .unwrap();
+    let slower = truth
+        .at_condition(&[("velocity.1.z".into(), -4.5)])
+        .unwrap();
+    for (name, m, seed) in [("test.csv", &truth, 1), ("holdout.csv", &slower, 2)] {
+        let y = m.simulate(&[0.0021]).unwrap();
+        let meas = Measurement {
+            snr_db: Some(40.0),
+            seed,
+            ..Measurement::default()
+        };
+        let noisy = measured(&y, &meas).unwrap();
+        noisy.write_csv(dir.path().join(name)).unwrap();
+    }
+    std::fs::write(
+        dir.path().join("bounds.csv"),
+        "name,lower,upper,nominal\nthickness,0.0016,0.0024,0.002\n",
+    )
+    .unwrap();
+    let text = format!(
+        "[model]\ndeck = {deck_path:?}\n\n[parameters]\nthickness = \"section.1.t\"\n\n\
+         [space]\nbounds = \"bounds.csv\"\n\n[test]\ndata = \"test.csv\"\n\n\
+         [holdout]\ndata = \"holdout.csv\"\nset = {{ \"velocity.1.z\" = -4.5 }}\n\n\
+         [budget]\nensemble = 4\nreconcile = 12\nrecalibrate = 16\nseed = 1\n"
+    );
+    let outs = [dir.path().join("local"), dir.path().join("processes")];
+    for (out, executor) in outs
+        .iter()
+        .zip(["", "\n[executor]\nkind = \"processes\"\njobs = 2\n"])
+    {
+        let config = dir.path().join("loop.toml");
+        std::fs::write(&config, format!("{text}{executor}")).unwrap();
+        let o = close_loop(&config, out);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    assert_eq!(loop_json(&outs[0]), loop_json(&outs[1]));
+    // The attribution's runs named the thickness and every candidate of the deck.
+    let params = std::fs::read_to_string(outs[1].join("runs/r0-candidates/0/params.json")).unwrap();
+    let record: serde_json::Value = serde_json::from_str(&params).unwrap();
+    let names = record["names"].as_array().unwrap();
+    assert_eq!(names[0], "thickness");
+    assert!(names.len() > 5, "{names:?}");
+    assert!(outs[1].join("runs/r0-candidates/0/stdout.txt").is_file());
+}
