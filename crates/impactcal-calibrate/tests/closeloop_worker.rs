@@ -85,9 +85,27 @@ fn a_failing_worker_is_reported_with_its_exit_status_and_loses_nothing() {
 
     // Run again in the same folder, in process: the loop completes, as a loop that never
     // met the failing worker.
-    let resumed = run_loop(&model, "drop tower", data, None, &options, dir.path(), &Silent).unwrap();
+    let resumed = run_loop(
+        &model,
+        "drop tower",
+        data,
+        None,
+        &options,
+        dir.path(),
+        &Silent,
+    )
+    .unwrap();
     let fresh = tempfile::tempdir().unwrap();
-    let clean = run_loop(&model, "drop tower", data, None, &options, fresh.path(), &Silent).unwrap();
+    let clean = run_loop(
+        &model,
+        "drop tower",
+        data,
+        None,
+        &options,
+        fresh.path(),
+        &Silent,
+    )
+    .unwrap();
     assert_eq!(
         serde_json::to_string(&resumed).unwrap(),
         serde_json::to_string(&clean).unwrap()

@@ -344,16 +344,7 @@ pub fn close<M: Enrichable>(
         set: set.as_slice(),
     });
     let progress = Progress::new();
-    let result = run_loop_on(
-        model,
-        description,
-        data,
-        h,
-        options,
-        out,
-        &progress,
-        worker,
-    );
+    let result = run_loop_on(model, description, data, h, options, out, &progress, worker);
     progress.done();
     Ok(result?)
 }

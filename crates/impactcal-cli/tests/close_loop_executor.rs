@@ -72,7 +72,11 @@ fn the_shipped_example_runs_on_the_process_pool() {
     let v: serde_json::Value = serde_json::from_str(&loop_json(&dir.path().join("out"))).unwrap();
     assert_eq!(v["verdict"], "attributed");
     assert_eq!(v["added"][0]["name"], "contact_damping");
-    assert!(dir.path().join("out/runs/holdout-enriched/0/stdout.txt").is_file());
+    assert!(
+        dir.path()
+            .join("out/runs/holdout-enriched/0/stdout.txt")
+            .is_file()
+    );
 }
 
 fn close_loop(config: &Path, out: &Path) -> std::process::Output {
@@ -145,7 +149,10 @@ fn a_loop_on_a_process_pool_killed_mid_loop_resumes_to_the_same_result() {
     child.kill().unwrap(); // SIGKILL, mid-loop
     child.wait().unwrap();
     let done = results_in(&killed);
-    assert!((20..total).contains(&done), "killed after {done} of {total} runs");
+    assert!(
+        (20..total).contains(&done),
+        "killed after {done} of {total} runs"
+    );
     assert!(!killed.join("loop.json").exists());
 
     let o = close_loop(&config, &killed);
@@ -198,7 +205,11 @@ fn the_worker_rebuilds_each_run_and_refuses_names_it_does_not_know() {
     // A candidate, a parameter or a condition the model does not know: exit 2, one line
     // naming it.
     for (from, to, needle) in [
-        ("\"contact_damping\"", "\"contact_dumping\"", "contact_dumping"),
+        (
+            "\"contact_damping\"",
+            "\"contact_dumping\"",
+            "contact_dumping",
+        ),
         ("\"modulus\"", "\"stiffness\"", "own parameters"),
         ("\"v0\"", "\"v1\"", "v1"),
     ] {
@@ -215,7 +226,10 @@ fn executors_and_tables_the_loop_cannot_use_are_refused() {
     for (executor, needle) in [
         ("[executor]\nkind = \"cloud\"\n", "cloud"),
         ("[executor]\nkind = \"processes\"\njobs = 0\n", "jobs"),
-        ("[executor]\nkind = \"processes\"\njobs = 2\nthreads = 3\n", "threads"),
+        (
+            "[executor]\nkind = \"processes\"\njobs = 2\nthreads = 3\n",
+            "threads",
+        ),
         ("[batch]\nstudy = \"mine\"\n", "[batch] study"),
         (
             "[solver]\ntemplate = \"deck.k\"\ncommand = [\"ls-dyna\"]\n",
@@ -244,9 +258,10 @@ fn a_deck_loop_on_a_process_pool_equals_the_loop_in_process() {
 
     let dir = tempfile::tempdir().unwrap();
     let deck_path = common::example_file("decks", "strip_drop.k");
-    let declared =
-        ParameterSpace::new(vec![Parameter::new("section.1.t", 0.0016, 0.0024, 0.002).unwrap()])
-            .unwrap();
+    let declared = ParameterSpace::new(vec![
+        Parameter::new("section.1.t", 0.0016, 0.0024, 0.002).unwrap(),
+    ])
+    .unwrap();
     let truth = DeckModel::new(read_deck(&deck_path).unwrap().model)
         .unwrap()
         .declare(&declared)
