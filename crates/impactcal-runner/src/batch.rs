@@ -68,6 +68,27 @@ impl Batch {
         names: Vec<String>,
         points: impl Into<PointRows<'p>>,
     ) -> Result<Batch> {
+        Batch::new_at(out, study, solver, names, points, &[])
+    }
+
+    /// [`Batch::new`] with quantities held at given values in every run (a test condition,
+    /// such as the impact speed of a holdout test): `set` is written to each run's
+    /// `params.json` under `set`, rendered into the templates beside the point's
+    /// coordinates (a template names them like parameters), and part of the journal's batch
+    /// line, so a journal of the batch at another condition is not resumed.
+    ///
+    /// # Errors
+    /// As [`Batch::new`], the templates checked against the names and `set` together;
+    /// [`RunnerError::Names`] when a name of `set` is also a coordinate or is repeated;
+    /// [`impactcal_core::CoreError`] for a non-finite value.
+    pub fn new_at<'p>(
+        out: &Path,
+        study: &str,
+        solver: Solver,
+        names: Vec<String>,
+        points: impl Into<PointRows<'p>>,
+        set: &[(String, f64)],
+    ) -> Result<Batch> {
         let study_ok = !study.is_empty()
             && study != "."
             && study != ".."
@@ -83,10 +104,25 @@ impl Batch {
             });
         }
         solver.check("configuration")?;
+        let mut held = BTreeMap::new();
+        for (name, value) in set {
+            if names.contains(name) || held.insert(name.clone(), *value).is_some() {
+                return Err(RunnerError::Names {
+                    file: "batch".into(),
+                    message: format!(
+                        "`{name}` is set twice (a coordinate of the points, or repeated in the \
+                         condition)"
+                    ),
+                });
+            }
+            impactcal_core::check_finite(&format!("condition `{name}`"), &[*value])?;
+        }
         let templates: Vec<&Template> = solver.inputs.iter().map(|(t, _)| t).collect();
         // Without templates the names reach the solver only through `params.json`.
         if !templates.is_empty() {
-            check_names(&templates, &names)?;
+            let mut all = names.clone();
+            all.extend(held.keys().cloned());
+            check_names(&templates, &all)?;
         }
         let points = points.into();
         if points.is_empty() {
@@ -117,7 +153,7 @@ impl Batch {
             points: rows,
             retries: 2,
             identity: None,
-            set: BTreeMap::new(),
+            set: held,
         })
     }
 
@@ -133,8 +169,23 @@ impl Batch {
         space: &impactcal_core::ParameterSpace,
         points: impl Into<PointRows<'p>>,
     ) -> Result<Batch> {
+        Batch::for_space_at(out, study, solver, space, points, &[])
+    }
+
+    /// [`Batch::for_space`] at the condition `set` ([`Batch::new_at`]).
+    ///
+    /// # Errors
+    /// As [`Batch::new_at`].
+    pub fn for_space_at<'p>(
+        out: &Path,
+        study: &str,
+        solver: Solver,
+        space: &impactcal_core::ParameterSpace,
+        points: impl Into<PointRows<'p>>,
+        set: &[(String, f64)],
+    ) -> Result<Batch> {
         let names = space.names().iter().map(|s| s.to_string()).collect();
-        Batch::new(out, study, solver, names, points)
+        Batch::new_at(out, study, solver, names, points, set)
     }
 
     /// The same batch with at most `retries` further attempts per run.
@@ -152,39 +203,6 @@ impl Batch {
     pub fn with_identity(mut self, identity: impl Into<String>) -> Self {
         self.identity = Some(identity.into());
         self
-    }
-
-    /// The same batch with quantities held at given values in every run (a test condition,
-    /// such as the impact speed of a holdout test): written to each run's `params.json`
-    /// under `set`, rendered into the templates beside the point's coordinates (so a
-    /// template names them like parameters), and part of the journal's batch line, so a
-    /// journal of the batch at another condition is not resumed.
-    ///
-    /// # Errors
-    /// [`RunnerError::Names`] when a name is also a coordinate of the points, is not a
-    /// plain identifier, or the templates and names (coordinates and set) do not match;
-    /// [`impactcal_core::CoreError`] for a non-finite value.
-    pub fn with_set(mut self, set: &[(String, f64)]) -> Result<Self> {
-        let mut map = BTreeMap::new();
-        for (name, value) in set {
-            if self.names.contains(name) || map.insert(name.clone(), *value).is_some() {
-                return Err(RunnerError::Names {
-                    file: "batch".into(),
-                    message: format!(
-                        "`{name}` is set twice (a coordinate of the points or repeated in the set)"
-                    ),
-                });
-            }
-            impactcal_core::check_finite(&format!("set `{name}`"), &[*value])?;
-        }
-        let templates: Vec<&Template> = self.solver.inputs.iter().map(|(t, _)| t).collect();
-        if !templates.is_empty() && !map.is_empty() {
-            let mut all = self.names.clone();
-            all.extend(map.keys().cloned());
-            check_names(&templates, &all)?;
-        }
-        self.set = map;
-        Ok(self)
     }
 
     /// `<out>/runs/<study>`: the runs' directories and the journal.

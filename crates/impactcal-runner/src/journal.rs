@@ -32,7 +32,7 @@ pub enum Entry {
         /// Fingerprint of the solver configuration (hex).
         solver: String,
         /// Quantities held at given values in every run (a test condition), by name; absent
-        /// when there are none ([`Batch::with_set`](crate::Batch::with_set)).
+        /// when there are none ([`Batch::new_at`](crate::Batch::new_at)).
         #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
         set: BTreeMap<String, f64>,
     },

@@ -281,10 +281,16 @@ impl<'a> Runs<'a> {
         }
         let name = batch_name(stage, first, announce);
         let space = self.executor.space();
-        let batch = Batch::for_space(&self.root, &name, self.executor.solver(), space, points)?
-            .with_retries(self.executor.retries())
-            .with_identity(self.fingerprint.clone())
-            .with_set(self.executor.condition())?;
+        let batch = Batch::for_space_at(
+            &self.root,
+            &name,
+            self.executor.solver(),
+            space,
+            points,
+            self.executor.condition(),
+        )?
+        .with_retries(self.executor.retries())
+        .with_identity(self.fingerprint.clone());
         let outcomes: Mutex<Vec<Option<RunOutcome>>> = Mutex::new(vec![None; points.len()]);
         let opened = |reused: usize| {
             if announce {
