@@ -12,7 +12,10 @@
 #      queued or running and ends with the same histories as step 1;
 #   4. a small study (examples/study/slurm.toml) killed with SIGKILL mid-ensemble and
 #      resumed: it re-attaches to the ensemble's array and ends with the same study.json as
-#      the same study run uninterrupted on the local process pool.
+#      the same study run uninterrupted on the local process pool;
+#   5. a small closed loop (examples/loop/slurm.toml, the drop tower): every stage of the
+#      loop a job array of `impactcal loop-point` tasks, the holdout's runs at their
+#      condition; the same loop.json as the same loop in process.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 REPO=$(pwd)
@@ -155,6 +158,26 @@ echo "study killed with $(grep -c '"event":"result"' "$J") of 12 ensemble result
 grep 'ensemble: 12 runs' "$S/resume.err"
 grep -c '"event":"slurm_job"' "$J" | grep -qx 1 || fail "the ensemble was resubmitted instead of re-attached"
 cmp "$S/reference/study.json" "$S/slurm/study.json" || fail "the resumed study differs from the reference"
+
+echo "== 5. a closed loop on Slurm: the same loop.json as in process"
+L="$W/loop"
+mkdir -p "$L"
+cp examples/loop/test.csv examples/loop/holdout.csv "$L/"
+# A shorter Gauss-Newton polish keeps the number of arrays (one per stage) small.
+sed -e 's/^poll = .*/poll = 0.5/' examples/loop/slurm.toml > "$L/slurm.toml"
+printf '\n[loop]\npolish = 2\n' >> "$L/slurm.toml"
+sed -e '/^\[executor\]/,/^\[loop\]/{/^\[loop\]/!d}' "$L/slurm.toml" > "$L/local.toml"
+grep -q '^\[executor\]' "$L/local.toml" && fail "local.toml still has an executor"
+"$IMPACTCAL" close-loop --config "$L/local.toml" --out "$L/reference" 2> "$L/reference.err" \
+  || { cat "$L/reference.err"; fail "the reference loop"; }
+start=$(date +%s)
+"$IMPACTCAL" close-loop --config "$L/slurm.toml" --out "$L/slurm" 2> "$L/slurm.err" \
+  || { cat "$L/slurm.err"; fail "the loop on Slurm"; }
+arrays=$(cat "$L"/slurm/runs/*/journal.jsonl | grep -c '"event":"slurm_job"')
+echo "loop on Slurm: $arrays job arrays in $(( $(date +%s) - start )) s"
+grep -q '"v0": 5' "$L/slurm/runs/holdout-enriched/0/params.json" || fail "the holdout's condition"
+grep -q 'contact_damping' "$L/slurm/runs/holdout-enriched/0/params.json" || fail "the added candidate"
+cmp "$L/reference/loop.json" "$L/slurm/loop.json" || fail "the loop on Slurm differs from the loop in process"
 
 if [ "$OVERHEAD" -gt 0 ]; then
   echo "== overhead: $OVERHEAD trivial tasks"

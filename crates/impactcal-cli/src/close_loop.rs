@@ -29,25 +29,39 @@
 //! [loop]                         # optional: the other loop options
 //! candidates = ["damping", "added_mass"]
 //! alpha = 0.01
+//!
+//! [executor]                     # optional, as in a study file
+//! kind = "processes"             # "local" (default) | "processes" | "slurm"
+//! jobs = 2
+//!
+//! [batch]                        # optional
+//! retries = 2                    # further attempts of a failing run
 //! ```
+//!
+//! With `kind = "processes"` or `"slurm"`, each run is `impactcal loop-point --config <this
+//! file>` in its own directory: it rebuilds the model from this file and the run's
+//! `params.json` (the declared parameters, the candidates added, the holdout's condition).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use clap::Args as ClapArgs;
 use impactcal::calibrate::closeloop::document::report;
-use impactcal::calibrate::closeloop::{Holdout, LoopOptions, LoopResult, Verdict, run_loop};
-use impactcal::calibrate::study::{StudyOptions, TestData};
+use impactcal::calibrate::closeloop::{Holdout, LoopOptions, LoopResult, Verdict, run_loop_on};
+use impactcal::calibrate::study::{StudyOptions, TestData, Worker};
 use impactcal::core::drop_tower::DropTower;
+use impactcal::core::enrich::rebuild;
 use impactcal::core::{Cfc, ChannelMap, Enrichable, Histories};
+use impactcal::runner::Cancel;
+use impactcal::runner::config::{BatchSection, ExecutorSection};
 use serde::Deserialize;
 
 use crate::error::CliError;
 use crate::output::write_text;
 use crate::simulate::thread_pool;
 use crate::study::{
-    Built, Config as StudyConfig, ModelConfig as StudyModel, Progress, SpaceConfig,
-    TestConfig as StudyTest, read_test, resolve,
+    Built, Config as StudyConfig, ModelConfig as StudyModel, PointArgs, Progress, SpaceConfig,
+    TestConfig as StudyTest, point_solver, read_record, read_test, resolve, retries_of,
 };
 
 /// Arguments of `impactcal close-loop`.
@@ -87,6 +101,10 @@ pub struct Config {
     /// The other options of the loop.
     #[serde(default, rename = "loop")]
     pub options: LoopOptions,
+    /// Where the runs happen (default: in this process), as in a study file.
+    pub executor: Option<ExecutorSection>,
+    /// Retries, as in a study file.
+    pub batch: Option<BatchSection>,
 }
 
 /// `[model]`.
@@ -144,11 +162,11 @@ pub struct Budget {
     pub seed: Option<u64>,
 }
 
-/// Runs the subcommand.
-pub fn run(args: Args) -> Result<(), CliError> {
-    let text = std::fs::read_to_string(&args.config)
-        .map_err(|e| CliError::io(format!("{}: {e}", args.config.display())))?;
-    let name = args.config.display().to_string();
+/// Reads a loop file; returns it with its name for messages.
+fn read_config(path: &Path) -> Result<(Config, String), CliError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
+    let name = path.display().to_string();
     let config: Config = toml::from_str(&text).map_err(|e| {
         CliError::input(format!(
             "{name}: {}",
@@ -158,6 +176,29 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .join(" ")
         ))
     })?;
+    Ok((config, name))
+}
+
+/// The worker of a loop file whose `[executor]` runs processes: `impactcal loop-point` on
+/// this file in each run's directory. `None` in process.
+fn worker(config: &Config, path: &Path) -> Result<Option<Worker>, CliError> {
+    let retries = retries_of(config.batch.as_ref())?;
+    let executor = match &config.executor {
+        None | Some(ExecutorSection::Local) => return Ok(None),
+        Some(e) => e.executor(),
+    };
+    executor.check()?;
+    Ok(Some(Worker {
+        solver: point_solver("loop-point", path, None)?,
+        executor,
+        retries,
+        cancel: Cancel::new(),
+    }))
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let (config, name) = read_config(&args.config)?;
     let base = args.config.parent().unwrap_or(Path::new("."));
     let mut options = config.options.clone();
     let b = &config.budget;
@@ -182,19 +223,27 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )),
         None => None,
     };
+    let worker = worker(&config, &args.config).map_err(|e| e.context(&name))?;
+    if let Some(w) = &worker {
+        let handler = w.cancel.clone();
+        // A second handler cannot be installed (tests call `run` more than once): Ctrl-C
+        // then keeps its default action, which loses nothing either.
+        let _ = ctrlc::set_handler(move || handler.cancel());
+    }
     let pool = thread_pool(args.threads)?;
     let result = pool
         .install(|| {
             let (h, out) = (holdout.as_ref(), &args.out);
+            let w = worker.as_ref();
             match &model {
                 LoopModel::DropTower(m, d) => {
-                    close(m, d, &test, map.as_ref(), cfc, h, &options, out)
+                    close(m, d, &test, map.as_ref(), cfc, h, &options, out, w)
                 }
                 LoopModel::Study(Built::Airframe(m, _), d) => {
-                    close(&**m, d, &test, map.as_ref(), cfc, h, &options, out)
+                    close(&**m, d, &test, map.as_ref(), cfc, h, &options, out, w)
                 }
                 LoopModel::Study(Built::Deck(m), d) => {
-                    close(&**m, d, &test, map.as_ref(), cfc, h, &options, out)
+                    close(&**m, d, &test, map.as_ref(), cfc, h, &options, out, w)
                 }
                 LoopModel::Study(Built::Solver, _) => Err(CliError::input(
                     "[solver]: the closed loop needs a model that lists its candidate effects",
@@ -271,7 +320,7 @@ fn build_model(config: &Config, base: &Path, name: &str) -> Result<LoopModel, Cl
     }
 }
 
-/// Runs the loop of any enrichable `model` in `out`.
+/// Runs the loop of any enrichable `model` in `out` (its runs on `worker`, or in process).
 #[allow(clippy::too_many_arguments)]
 pub fn close<M: Enrichable>(
     model: &M,
@@ -282,6 +331,7 @@ pub fn close<M: Enrichable>(
     holdout: Option<&(Histories, Vec<(String, f64)>)>,
     options: &LoopOptions,
     out: &Path,
+    worker: Option<&Worker>,
 ) -> Result<LoopResult, CliError> {
     std::fs::create_dir_all(out).map_err(|e| CliError::io(format!("{}: {e}", out.display())))?;
     let data = TestData {
@@ -294,7 +344,7 @@ pub fn close<M: Enrichable>(
         set: set.as_slice(),
     });
     let progress = Progress::new();
-    let result = run_loop(model, description, data, h, options, out, &progress);
+    let result = run_loop_on(model, description, data, h, options, out, &progress, worker);
     progress.done();
     Ok(result?)
 }
@@ -320,4 +370,46 @@ pub fn finish(result: &LoopResult, out: &Path) -> Result<(), CliError> {
         files.html.display()
     );
     Ok(())
+}
+
+/// Runs the model of a loop file at the point of a run's `params.json` and writes its
+/// histories: what a process-pool or Slurm executor runs for each of the loop's runs. The
+/// model is rebuilt from the file as the loop builds it, then enriched with the candidates
+/// the run names and set to the run's condition ([`rebuild`]); a name the model does not
+/// know is refused (exit 2), so a loop file edited under a running loop cannot give runs of
+/// another model.
+pub fn run_point(args: PointArgs) -> Result<(), CliError> {
+    let (config, name) = read_config(&args.config)?;
+    let base = args.config.parent().unwrap_or(Path::new("."));
+    let model = build_model(&config, base, &name)?;
+    let record = read_record(&args.params)?;
+    let set: Vec<(String, f64)> = record.set.clone().into_iter().collect();
+    let params = args.params.display().to_string();
+    let (names, values) = (&record.names, &record.values);
+    let pool = thread_pool(args.threads)?;
+    let h = pool.install(|| match &model {
+        LoopModel::DropTower(m, _) => point(m, names, values, &set, &params),
+        LoopModel::Study(Built::Airframe(m, _), _) => point(&**m, names, values, &set, &params),
+        LoopModel::Study(Built::Deck(m), _) => point(&**m, names, values, &set, &params),
+        LoopModel::Study(Built::Solver, _) => Err(CliError::input(
+            "loop-point runs the built-in model of a loop file; this one names a [solver]",
+        )),
+    })?;
+    h.write_csv(&args.out)?;
+    Ok(())
+}
+
+/// The histories of `model` rebuilt with `names` at the condition `set`, at `values`.
+fn point<M: Enrichable>(
+    model: &M,
+    names: &[String],
+    values: &[f64],
+    set: &[(String, f64)],
+    params: &str,
+) -> Result<Histories, CliError> {
+    let m = rebuild(model, names, set).map_err(|e| CliError::from(e).context(params))?;
+    m.space()
+        .to_unit(values)
+        .map_err(|e| CliError::from(e).context(params))?;
+    Ok(m.simulate(values)?)
 }

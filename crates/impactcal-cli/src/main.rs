@@ -91,6 +91,10 @@ enum Command {
     /// model-form error, attribution to the model's candidate effects, enrichment and
     /// recalibration, errors before and after on the test and a holdout; runs are journaled.
     CloseLoop(close_loop::Args),
+    /// Runs the model of a loop file at a run's `params.json` (declared parameters, added
+    /// candidates, condition) and writes its histories (what the processes and slurm
+    /// executors run for each of the loop's runs).
+    LoopPoint(study::PointArgs),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -114,6 +118,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Demo(a) => demo::run(a),
         Command::Batch(a) => batch::run(a),
         Command::CloseLoop(a) => close_loop::run(a),
+        Command::LoopPoint(a) => close_loop::run_point(a),
     }
 }
 

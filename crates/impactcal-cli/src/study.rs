@@ -284,36 +284,12 @@ fn runner(
     setup: &Setup,
 ) -> Result<Option<Runner>, CliError> {
     let section = config.executor.clone().unwrap_or(ExecutorSection::Local);
-    let retries = match &config.batch {
-        Some(b) if b.study != BatchSection::default().study => {
-            return Err(CliError::input(
-                "[batch] study does not apply to a study file: its runs go to <out>/runs/<stage>/",
-            ));
-        }
-        Some(b) => b.retries,
-        None => BatchSection::default().retries,
-    };
-    let exe = std::env::current_exe()
-        .map_err(|e| CliError::failure(format!("cannot find the impactcal program: {e}")))?;
+    let retries = retries_of(config.batch.as_ref())?;
+    let exe = current_exe()?;
     let solver = match (&config.solver, &section) {
         (Some(s), _) => s.solver(base, path, &section, Some(&exe))?,
         (None, ExecutorSection::Local) => return Ok(None),
-        (None, _) => {
-            let config = std::fs::canonicalize(path)
-                .map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
-            let mut output = OutputSpec::csv("out.csv");
-            output.unit = Some("velocity".into());
-            Solver {
-                inputs: Vec::new(),
-                command: SolverCommand::Argv(vec![
-                    exe.display().to_string(),
-                    "study-point".into(),
-                    "--config".into(),
-                    config.display().to_string(),
-                ]),
-                output,
-            }
-        }
+        (None, _) => point_solver("study-point", path, Some("velocity"))?,
     };
     let space = match &setup.model {
         Built::Airframe(m, _) => m.space().clone(),
@@ -322,13 +298,71 @@ fn runner(
             CliError::input("[space]: an external solver needs `bounds = \"bounds.csv\"`")
         })?,
     };
+    let executor = section.executor();
+    executor.check()?;
     Ok(Some(Runner {
         space,
         solver,
-        executor: section.executor(),
+        executor,
         retries,
         cancel: Cancel::new(),
     }))
+}
+
+/// The further attempts of a failing run from a `[batch]` table (whose `study` does not
+/// apply to a study or loop file: its runs go to `<out>/runs/<stage>/`).
+///
+/// # Errors
+/// [`CliError::input`] when `[batch] study` is given.
+pub(crate) fn retries_of(batch: Option<&BatchSection>) -> Result<u32, CliError> {
+    match batch {
+        Some(b) if b.study != BatchSection::default().study => Err(CliError::input(
+            "[batch] study does not apply here: the runs go to <out>/runs/<stage>/",
+        )),
+        Some(b) => Ok(b.retries),
+        None => Ok(BatchSection::default().retries),
+    }
+}
+
+/// This `impactcal` program, which the process-pool and Slurm executors start.
+pub(crate) fn current_exe() -> Result<PathBuf, CliError> {
+    std::env::current_exe()
+        .map_err(|e| CliError::failure(format!("cannot find the impactcal program: {e}")))
+}
+
+/// The solver that runs `impactcal <subcommand> --config <file>` in each run's directory
+/// (reading the run's `params.json`, writing `out.csv`): how a built-in model of a study
+/// or loop file runs on a process pool or Slurm. `unit` is the histories' unit (our CSV
+/// does not carry it).
+pub(crate) fn point_solver(
+    subcommand: &str,
+    config: &Path,
+    unit: Option<&str>,
+) -> Result<Solver, CliError> {
+    let exe = current_exe()?;
+    let config = std::fs::canonicalize(config)
+        .map_err(|e| CliError::io(format!("{}: {e}", config.display())))?;
+    let mut output = OutputSpec::csv("out.csv");
+    output.unit = unit.map(str::to_string);
+    Ok(Solver {
+        inputs: Vec::new(),
+        command: SolverCommand::Argv(vec![
+            exe.display().to_string(),
+            subcommand.into(),
+            "--config".into(),
+            config.display().to_string(),
+        ]),
+        output,
+    })
+}
+
+/// Reads the record of a run (`params.json`).
+pub(crate) fn read_record(path: &Path) -> Result<RunRecord, CliError> {
+    serde_json::from_str(
+        &std::fs::read_to_string(path)
+            .map_err(|e| CliError::io(format!("{}: {e}", path.display())))?,
+    )
+    .map_err(|e| CliError::input(format!("{}: {e}", path.display())))
 }
 
 /// Arguments of `impactcal study-point`.
@@ -354,11 +388,14 @@ pub fn run_point(args: PointArgs) -> Result<(), CliError> {
     let (config, name) = read_config(&args.config)?;
     let base = args.config.parent().unwrap_or(Path::new("."));
     let (model, _) = build_model(&config, base).map_err(|e| e.context(&name))?;
-    let record: RunRecord = serde_json::from_str(
-        &std::fs::read_to_string(&args.params)
-            .map_err(|e| CliError::io(format!("{}: {e}", args.params.display())))?,
-    )
-    .map_err(|e| CliError::input(format!("{}: {e}", args.params.display())))?;
+    let record = read_record(&args.params)?;
+    if let Some((name, _)) = record.set.iter().next() {
+        return Err(CliError::input(format!(
+            "{}: `{name}` is set as a condition; a study's runs set none (a loop's runs go to \
+             `impactcal loop-point`)",
+            args.params.display()
+        )));
+    }
     let simulate = |m: &dyn Model| -> Result<Histories, CliError> {
         let names = m.space().names();
         if names != record.names {

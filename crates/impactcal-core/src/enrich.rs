@@ -224,6 +224,63 @@ pub trait Enrichable: Model + Sized {
     }
 }
 
+/// The model a run names: `model` with the parameters `names` (its own, in order, then
+/// candidates freed, in the order they were added) and held quantities set to `set` (a test
+/// condition), i.e. `model.enrich(named candidates).at_condition(set)`, each candidate with
+/// the parameter [`Enrichable::candidates`] lists for it. This is how the closed loop builds
+/// the model of each of its runs, so a worker process that reads a run's names from a file
+/// rebuilds exactly the model the loop ran.
+///
+/// # Errors
+/// [`CoreError::InvalidOption`] when `names` does not start with the model's parameters in
+/// their order, or names a quantity that is not one of its candidates (naming it and
+/// listing the candidates); the model's errors from `enrich` and `at_condition` (a repeated
+/// name, a condition the model cannot take).
+pub fn rebuild<M: Enrichable>(model: &M, names: &[String], set: &[(String, f64)]) -> Result<M> {
+    let own = model.space().names();
+    let d = own.len();
+    if names.len() < d || names[..d].iter().zip(&own).any(|(a, b)| a != b) {
+        return Err(CoreError::invalid_option(
+            "parameters",
+            names.join(", "),
+            format!(
+                "must start with the model's own parameters, in order: {}",
+                own.join(", ")
+            ),
+        ));
+    }
+    let candidates = model.candidates();
+    let added = names[d..]
+        .iter()
+        .map(|n| {
+            candidates
+                .iter()
+                .find(|c| c.name() == n)
+                .map(|c| c.parameter.clone())
+                .ok_or_else(|| {
+                    CoreError::invalid_option(
+                        "parameters",
+                        n,
+                        format!(
+                            "neither a parameter nor a candidate of the model (candidates: {})",
+                            candidates
+                                .iter()
+                                .map(Candidate::name)
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
+                    )
+                })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let enriched = model.enrich(&added)?;
+    if set.is_empty() {
+        Ok(enriched)
+    } else {
+        enriched.at_condition(set)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -246,5 +303,41 @@ mod tests {
             let e = c.check_value(v).unwrap_err();
             assert!(matches!(e, CoreError::InvalidOption { .. }), "{e}");
         }
+    }
+
+    #[test]
+    fn rebuild_is_enrich_then_at_condition_and_refuses_unknown_names() {
+        use crate::drop_tower::DropTower;
+        let m = DropTower::new();
+        let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let damping = m
+            .candidates()
+            .into_iter()
+            .find(|c| c.name() == "damping")
+            .unwrap()
+            .parameter;
+        let set = [("v0".to_string(), 5.0)];
+        let direct = m.enrich(&[damping]).unwrap().at_condition(&set).unwrap();
+        let rebuilt = rebuild(&m, &names(&["modulus", "k_contact", "damping"]), &set).unwrap();
+        assert_eq!(rebuilt.space(), direct.space());
+        let p = [75.0, 9e5, 0.02];
+        assert_eq!(
+            rebuilt.simulate(&p).unwrap().data(),
+            direct.simulate(&p).unwrap().data()
+        );
+        // Without added names and condition: the model itself.
+        let same = rebuild(&m, &names(&["modulus", "k_contact"]), &[]).unwrap();
+        assert_eq!(same.space(), m.space());
+        for bad in [
+            names(&["modulus", "k_contact", "dampnig"]),
+            names(&["k_contact", "modulus"]),
+            names(&["modulus"]),
+        ] {
+            let e = rebuild(&m, &bad, &[]).unwrap_err();
+            assert!(matches!(e, CoreError::InvalidOption { .. }), "{e}");
+        }
+        let e = rebuild(&m, &names(&["modulus", "k_contact", "dampnig"]), &[]).unwrap_err();
+        assert!(e.to_string().contains("dampnig"), "{e}");
+        assert!(rebuild(&m, &names(&["modulus", "k_contact"]), &[("v9".into(), 1.0)]).is_err());
     }
 }

@@ -47,6 +47,7 @@ pub struct Batch {
     points: Vec<Vec<f64>>,
     retries: u32,
     identity: Option<String>,
+    set: BTreeMap<String, f64>,
 }
 
 impl Batch {
@@ -67,6 +68,27 @@ impl Batch {
         names: Vec<String>,
         points: impl Into<PointRows<'p>>,
     ) -> Result<Batch> {
+        Batch::new_at(out, study, solver, names, points, &[])
+    }
+
+    /// [`Batch::new`] with quantities held at given values in every run (a test condition,
+    /// such as the impact speed of a holdout test): `set` is written to each run's
+    /// `params.json` under `set`, rendered into the templates beside the point's
+    /// coordinates (a template names them like parameters), and part of the journal's batch
+    /// line, so a journal of the batch at another condition is not resumed.
+    ///
+    /// # Errors
+    /// As [`Batch::new`], the templates checked against the names and `set` together;
+    /// [`RunnerError::Names`] when a name of `set` is also a coordinate or is repeated;
+    /// [`impactcal_core::CoreError`] for a non-finite value.
+    pub fn new_at<'p>(
+        out: &Path,
+        study: &str,
+        solver: Solver,
+        names: Vec<String>,
+        points: impl Into<PointRows<'p>>,
+        set: &[(String, f64)],
+    ) -> Result<Batch> {
         let study_ok = !study.is_empty()
             && study != "."
             && study != ".."
@@ -82,10 +104,25 @@ impl Batch {
             });
         }
         solver.check("configuration")?;
+        let mut held = BTreeMap::new();
+        for (name, value) in set {
+            if names.contains(name) || held.insert(name.clone(), *value).is_some() {
+                return Err(RunnerError::Names {
+                    file: "batch".into(),
+                    message: format!(
+                        "`{name}` is set twice (a coordinate of the points, or repeated in the \
+                         condition)"
+                    ),
+                });
+            }
+            impactcal_core::check_finite(&format!("condition `{name}`"), &[*value])?;
+        }
         let templates: Vec<&Template> = solver.inputs.iter().map(|(t, _)| t).collect();
         // Without templates the names reach the solver only through `params.json`.
         if !templates.is_empty() {
-            check_names(&templates, &names)?;
+            let mut all = names.clone();
+            all.extend(held.keys().cloned());
+            check_names(&templates, &all)?;
         }
         let points = points.into();
         if points.is_empty() {
@@ -116,6 +153,7 @@ impl Batch {
             points: rows,
             retries: 2,
             identity: None,
+            set: held,
         })
     }
 
@@ -131,8 +169,23 @@ impl Batch {
         space: &impactcal_core::ParameterSpace,
         points: impl Into<PointRows<'p>>,
     ) -> Result<Batch> {
+        Batch::for_space_at(out, study, solver, space, points, &[])
+    }
+
+    /// [`Batch::for_space`] at the condition `set` ([`Batch::new_at`]).
+    ///
+    /// # Errors
+    /// As [`Batch::new_at`].
+    pub fn for_space_at<'p>(
+        out: &Path,
+        study: &str,
+        solver: Solver,
+        space: &impactcal_core::ParameterSpace,
+        points: impl Into<PointRows<'p>>,
+        set: &[(String, f64)],
+    ) -> Result<Batch> {
         let names = space.names().iter().map(|s| s.to_string()).collect();
-        Batch::new(out, study, solver, names, points)
+        Batch::new_at(out, study, solver, names, points, set)
     }
 
     /// The same batch with at most `retries` further attempts per run.
@@ -332,6 +385,7 @@ impl<'a> Driver<'a> {
                 .identity
                 .clone()
                 .unwrap_or_else(|| batch.solver.fingerprint()),
+            set: batch.set.clone(),
         };
         match entries.first() {
             None => journal.append(&header)?,
@@ -518,9 +572,13 @@ impl<'a> Driver<'a> {
         }
         let values = &self.batch.points[index];
         let mut written = values.clone();
+        let mut names = self.batch.names.clone();
+        names.extend(self.batch.set.keys().cloned());
+        let mut all = values.clone();
+        all.extend(self.batch.set.values());
         for (template, name) in &self.batch.solver.inputs {
-            let (text, w) = template.render(index, &self.batch.names, values)?;
-            for (k, v) in w.iter().enumerate() {
+            let (text, w) = template.render(index, &names, &all)?;
+            for (k, v) in w.iter().take(values.len()).enumerate() {
                 if v.to_bits() != values[k].to_bits() {
                     written[k] = *v;
                 }
@@ -534,6 +592,7 @@ impl<'a> Driver<'a> {
             names: self.batch.names.clone(),
             values: values.clone(),
             written,
+            set: self.batch.set.clone(),
             prepared_at: now(),
             finished_at: None,
             seconds: None,

@@ -6,6 +6,7 @@
 //! back to its last complete line before anything is appended). Size: about 150 bytes per
 //! event plus the batch line (the points, about 25 bytes per coordinate).
 
+use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
@@ -30,6 +31,10 @@ pub enum Entry {
         points: Vec<Vec<f64>>,
         /// Fingerprint of the solver configuration (hex).
         solver: String,
+        /// Quantities held at given values in every run (a test condition), by name; absent
+        /// when there are none ([`Batch::new_at`](crate::Batch::new_at)).
+        #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+        set: BTreeMap<String, f64>,
     },
     /// Run `index`, attempt `attempt`, is about to be started by `executor`.
     Submit {

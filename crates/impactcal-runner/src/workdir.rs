@@ -9,6 +9,7 @@
 //! in the same directory, flushed to disk, then renamed over the target (and the directory
 //! flushed), so a reader sees the old file or the whole new one, never half of it.
 
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -74,6 +75,12 @@ pub struct RunRecord {
     pub values: Vec<f64>,
     /// The values as written into the inputs (after rounding to fit fixed-width fields).
     pub written: Vec<f64>,
+    /// Quantities held at given values in this run (a test condition, such as another impact
+    /// speed), by name: not coordinates of the point, but part of what the run computes. A
+    /// program that reads `params.json` must apply them (or refuse the run). Absent when
+    /// there are none.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub set: BTreeMap<String, f64>,
     /// When the inputs were written (seconds since the Unix epoch).
     pub prepared_at: f64,
     /// When the result was read back, if it was.

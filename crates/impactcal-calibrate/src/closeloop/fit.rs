@@ -21,20 +21,32 @@ use impactcal_core::{Cfc, Histories, Model, ParameterSpace};
 use super::linalg::{Lsq, dot};
 use super::nuisance::{self, Frame, Terms};
 use crate::error::{CalibrateError, Result};
-use crate::study::execute::{InProcess, Observer, RunOutcome, Runs, histories_of};
+use crate::study::execute::{Dispatch, Observer, RunOutcome, Runs, Worker, histories_of};
 use crate::study::reconcile;
 
 /// The journaled runner of one loop (its output folder and fingerprint), counting the runs
-/// it is asked for.
+/// it is asked for: in this process, or through a [`Worker`] on its executor. Each batch
+/// names the model's parameters (declared, then added candidates) and the `condition` the
+/// model is at, so that a worker rebuilds exactly the model the loop runs.
 #[derive(Clone, Copy)]
 pub(crate) struct Journaled<'a> {
     pub dir: &'a Path,
     pub fingerprint: &'a str,
     pub observer: &'a dyn Observer,
     pub used: &'a Cell<usize>,
+    pub worker: Option<&'a Worker>,
+    pub condition: &'a [(String, f64)],
 }
 
-impl Journaled<'_> {
+impl<'a> Journaled<'a> {
+    /// The same runner for a model at the condition `set` (the holdout's).
+    pub fn at(self, set: &'a [(String, f64)]) -> Self {
+        Journaled {
+            condition: set,
+            ..self
+        }
+    }
+
     /// Runs `points` of `model` as runs `first..` of journal stage `stage` (finished runs are
     /// read back).
     ///
@@ -47,7 +59,11 @@ impl Journaled<'_> {
         first: usize,
         points: &[Vec<f64>],
     ) -> Result<Vec<RunOutcome>> {
-        let exec = InProcess(model);
+        let exec = Dispatch {
+            model,
+            worker: self.worker,
+            condition: self.condition,
+        };
         self.used.set(self.used.get() + points.len());
         Runs::open(&exec, self.dir, self.fingerprint, self.observer)?.stage_from(
             stage,

@@ -73,7 +73,7 @@ use crate::error::{CalibrateError, Result};
 use crate::metrics::{CurveMetrics, Iso18571};
 use crate::study::TestData;
 use crate::study::channels::test_on_model;
-use crate::study::execute::{Observer, histories_of};
+use crate::study::execute::{Observer, Worker, histories_of};
 
 pub use attribution::{Amplitude, Attribution, Score};
 pub use detection::Detection;
@@ -113,6 +113,40 @@ pub fn run_loop<M: Enrichable>(
     options: &LoopOptions,
     dir: &Path,
     observer: &dyn Observer,
+) -> Result<LoopResult> {
+    run_loop_on(
+        model,
+        description,
+        test,
+        holdout,
+        options,
+        dir,
+        observer,
+        None,
+    )
+}
+
+/// [`run_loop`] with the model's runs on a [`Worker`] (a process pool, a Slurm cluster)
+/// instead of this process (`worker = None`). Each run's `params.json` names the model's
+/// parameters (declared, then added candidates, in the order of [`Enrichable::enrich`]) and
+/// the condition `set` of a holdout run; the worker must rebuild exactly that model (as
+/// [`impactcal_core::enrich::rebuild`] does from the loop's base model) and refuse a name
+/// it does not know. The journal is the same as in process, so a loop may be resumed on
+/// another executor; the result is the same bit for bit.
+///
+/// # Errors
+/// As [`run_loop`]; a run the worker fails is a [`CalibrateError::Core`] simulation error
+/// naming the run's stage and the worker's exit status and last line of standard error.
+#[allow(clippy::too_many_arguments)]
+pub fn run_loop_on<M: Enrichable>(
+    model: &M,
+    description: &str,
+    test: TestData<'_>,
+    holdout: Option<Holdout<'_>>,
+    options: &LoopOptions,
+    dir: &Path,
+    observer: &dyn Observer,
+    worker: Option<&Worker>,
 ) -> Result<LoopResult> {
     let space = model.space().clone();
     let d0 = space.dim();
@@ -157,6 +191,8 @@ pub fn run_loop<M: Enrichable>(
         fingerprint: &fp,
         observer,
         used: &used,
+        worker,
+        condition: &[],
     };
 
     // Nominal run, the test on the model's channels.
@@ -332,7 +368,7 @@ pub fn run_loop<M: Enrichable>(
             let enriched_model = model.enrich(&outcome.added)?;
             let enriched_at = enriched_model.at_condition(h.set)?;
             let nominal_h = histories_of(
-                &runner.stage(
+                &runner.at(h.set).stage(
                     &declared_at,
                     "holdout-nominal",
                     std::slice::from_ref(&nominal),
@@ -342,7 +378,7 @@ pub fn run_loop<M: Enrichable>(
             check_covered(h.histories, test.map, &nominal_h, "holdout")?;
             let test_h = test_on_model(h.histories, test.map, test.cfc, &nominal_h)?;
             let calibrated_h = histories_of(
-                &runner.stage(
+                &runner.at(h.set).stage(
                     &declared_at,
                     "holdout-calibrated",
                     std::slice::from_ref(&fit0.point),
@@ -350,7 +386,7 @@ pub fn run_loop<M: Enrichable>(
                 "the holdout's calibrated run",
             )?;
             let enriched_h = histories_of(
-                &runner.stage(
+                &runner.at(h.set).stage(
                     &enriched_at,
                     "holdout-enriched",
                     std::slice::from_ref(&fit.point),
@@ -358,7 +394,7 @@ pub fn run_loop<M: Enrichable>(
                 "the holdout's enriched run",
             )?;
             let spread_h = model_spread(
-                runner,
+                runner.at(h.set),
                 &declared_at,
                 &nominal,
                 &nominal_h,

@@ -55,6 +55,13 @@ pub trait Executor: Sync {
     fn cancel(&self) -> Cancel {
         Cancel::new()
     }
+
+    /// Quantities held at given values in every run (a test condition, such as the impact
+    /// speed of a holdout test), recorded in each run's `params.json` under `set` so that a
+    /// worker process rebuilds the model at that condition (default: none).
+    fn condition(&self) -> &[(String, f64)] {
+        &[]
+    }
 }
 
 /// A [`Model`] run in this process, points in parallel on rayon's pool, through the
@@ -68,14 +75,7 @@ impl<M: Model> Executor for InProcess<'_, M> {
     }
 
     fn solver(&self) -> Solver {
-        Solver {
-            inputs: Vec::new(),
-            command: SolverCommand::InProcess {
-                description: "in-process model".into(),
-            },
-            // The model's histories go straight to the run's result file: no second copy.
-            output: OutputSpec::csv(impactcal_runner::workdir::RESULT),
-        }
+        in_process()
     }
 
     fn model(&self) -> Option<&dyn Model> {
@@ -115,6 +115,76 @@ impl Executor for Runner {
     }
     fn cancel(&self) -> Cancel {
         self.cancel.clone()
+    }
+}
+
+/// A solver command that runs one point of whatever model a caller names per batch: the
+/// program reads each run's `params.json` (the names of the point's coordinates, their
+/// values and the condition `set`) and rebuilds the model from them, as `impactcal
+/// loop-point` does for the closed loop's built-in models, whose space grows as effects are
+/// added and whose holdout runs are at another condition. Runs on any executor.
+#[derive(Debug, Clone)]
+pub struct Worker {
+    /// The solver: a command without templates, writing our CSV.
+    pub solver: Solver,
+    /// Where the runs happen.
+    pub executor: impactcal_runner::Executor,
+    /// Further attempts per failing run.
+    pub retries: u32,
+    /// Stops the runs when set (a Ctrl-C handler sets it).
+    pub cancel: Cancel,
+}
+
+/// The runs of one [`Model`] at one condition: in this process, or through a [`Worker`].
+pub(crate) struct Dispatch<'a> {
+    /// The model (its space names the coordinates; run in process without a worker).
+    pub model: &'a dyn Model,
+    /// The worker, if the runs go to one.
+    pub worker: Option<&'a Worker>,
+    /// The condition the model is at.
+    pub condition: &'a [(String, f64)],
+}
+
+impl Executor for Dispatch<'_> {
+    fn space(&self) -> &ParameterSpace {
+        self.model.space()
+    }
+    fn solver(&self) -> Solver {
+        match self.worker {
+            Some(w) => w.solver.clone(),
+            None => in_process(),
+        }
+    }
+    fn executor(&self) -> impactcal_runner::Executor {
+        self.worker
+            .map_or(impactcal_runner::Executor::Local, |w| w.executor.clone())
+    }
+    fn model(&self) -> Option<&dyn Model> {
+        match self.worker {
+            Some(_) => None,
+            None => Some(self.model),
+        }
+    }
+    fn retries(&self) -> u32 {
+        self.worker.map_or(0, |w| w.retries)
+    }
+    fn cancel(&self) -> Cancel {
+        self.worker.map_or_else(Cancel::new, |w| w.cancel.clone())
+    }
+    fn condition(&self) -> &[(String, f64)] {
+        self.condition
+    }
+}
+
+/// The runner's solver for a model run in this process.
+fn in_process() -> Solver {
+    Solver {
+        inputs: Vec::new(),
+        command: SolverCommand::InProcess {
+            description: "in-process model".into(),
+        },
+        // The model's histories go straight to the run's result file: no second copy.
+        output: OutputSpec::csv(impactcal_runner::workdir::RESULT),
     }
 }
 
@@ -211,9 +281,16 @@ impl<'a> Runs<'a> {
         }
         let name = batch_name(stage, first, announce);
         let space = self.executor.space();
-        let batch = Batch::for_space(&self.root, &name, self.executor.solver(), space, points)?
-            .with_retries(self.executor.retries())
-            .with_identity(self.fingerprint.clone());
+        let batch = Batch::for_space_at(
+            &self.root,
+            &name,
+            self.executor.solver(),
+            space,
+            points,
+            self.executor.condition(),
+        )?
+        .with_retries(self.executor.retries())
+        .with_identity(self.fingerprint.clone());
         let outcomes: Mutex<Vec<Option<RunOutcome>>> = Mutex::new(vec![None; points.len()]);
         let opened = |reused: usize| {
             if announce {

@@ -47,7 +47,7 @@ use impactcal_core::{Cfc, ChannelMap, Histories, Model, SamplingMethod};
 use crate::error::{CalibrateError, Result};
 use crate::metrics::{CurveMetrics, Iso18571};
 
-pub use execute::{Executor, InProcess, Observer, RunOutcome, Runner, Silent};
+pub use execute::{Executor, InProcess, Observer, RunOutcome, Runner, Silent, Worker};
 pub use m1::{M1, Verdict};
 pub use options::{StudyOptions, ValidStudyOptions};
 pub use result::StudyResult;

@@ -99,6 +99,19 @@ impl Executor {
             Executor::Slurm(_) => "slurm",
         }
     }
+
+    /// Checks the executor's options (as [`run_batch`] does before any run), so that a
+    /// caller with many batches can refuse bad options before the first.
+    ///
+    /// # Errors
+    /// [`RunnerError::Config`] naming the option.
+    pub fn check(&self) -> Result<()> {
+        match self {
+            Executor::Local => Ok(()),
+            Executor::Processes(o) => o.check(),
+            Executor::Slurm(o) => o.check(),
+        }
+    }
 }
 
 /// Runs every point of `batch` that the journal does not hold a result for, on
