@@ -104,6 +104,18 @@ fn hidden_damping_is_found_added_and_the_error_falls_on_calibration_and_holdout(
     assert!(h.enriched.iso18571_r > h.calibrated.iso18571_r);
     // The holdout's chi-square is at its quantile too (a model it never saw).
     assert!(h.enriched.chi2_red < 1.2, "{}", h.enriched.chi2_red);
+    // M1: the test leaves the calibrated model's predictive envelope at most samples and
+    // the enriched one's at about 2/(N+1) = 1 % of them, on both tests; M2 pairs at least
+    // as many shapes after as before.
+    for m in [c, h] {
+        assert!(m.calibrated.m1_exceedance > 0.3, "{m:?}");
+        assert!(m.enriched.m1_exceedance < 0.05, "{m:?}");
+        assert!(
+            m.enriched.m2_above_0_9 >= m.calibrated.m2_above_0_9,
+            "{m:?}"
+        );
+        assert_eq!(m.enriched.m2_shapes, 3);
+    }
     let e = r.errors.holdout.as_ref().unwrap();
     assert!(e.enriched < e.calibrated && e.calibrated < e.nominal);
     // The report renders, residual signature figures included.
@@ -126,6 +138,11 @@ fn negative_control_at_most_one_false_alarm_in_ten_seeds() {
             alarms += 1;
         }
         assert!(r.added.is_empty() || alarms <= 1);
+        // A right model: the test is one more draw of its predictive distribution.
+        if r.verdict == Verdict::NoModelFormError {
+            let e = r.metrics_calibration.enriched.m1_exceedance;
+            assert!(e < 0.05, "seed {seed}: M1 exceedance {e}");
+        }
         assert!((r.nuisance.gains["a2"] - GAIN).abs() < 0.01);
     }
     assert!(alarms <= 1, "{alarms} false alarms in 10 seeds");

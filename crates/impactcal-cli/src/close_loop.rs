@@ -351,11 +351,8 @@ pub fn close<M: Enrichable>(
 
 /// Writes `loop.json` and the report, and prints the verdict.
 pub fn finish(result: &LoopResult, out: &Path) -> Result<(), CliError> {
-    let json = serde_json::to_string_pretty(result)
-        .map_err(|e| CliError::failure(format!("cannot encode the loop's result: {e}")))?;
-    write_text(&(json + "\n"), Some(&out.join("loop.json")))?;
     let doc = report(result);
-    let files = impactcal::calibrate::report::write(&doc, out)?;
+    let files = write_result(result, &doc, out)?;
     for line in &doc.lead {
         eprintln!("{line}");
     }
@@ -412,4 +409,16 @@ fn point<M: Enrichable>(
         .to_unit(values)
         .map_err(|e| CliError::from(e).context(params))?;
     Ok(m.simulate(values)?)
+}
+
+/// Writes `loop.json` and the report document `doc` of `result` into `out`.
+pub fn write_result(
+    result: &LoopResult,
+    doc: &impactcal::calibrate::report::Report,
+    out: &Path,
+) -> Result<impactcal::calibrate::report::ReportFiles, CliError> {
+    let json = serde_json::to_string_pretty(result)
+        .map_err(|e| CliError::failure(format!("cannot encode the loop's result: {e}")))?;
+    write_text(&(json + "\n"), Some(&out.join("loop.json")))?;
+    Ok(impactcal::calibrate::report::write(doc, out)?)
 }

@@ -57,6 +57,40 @@ pub struct Args {
     /// Base rows of the Sobol' design on the surrogate (n (d + 2) evaluations).
     #[arg(long, default_value_t = 1024)]
     pub sensitivity_samples: usize,
+    /// The closed loop instead: a test with structural damping the model lacks, noise, a
+    /// late trigger and one wrong gain; the loop finds what it can and the report reveals
+    /// what was hidden (`test.csv`, `holdout.csv`, the run journal, `loop.json`,
+    /// `report.html`, `report.md`, `demo.json`).
+    #[arg(long)]
+    pub close_loop: bool,
+    /// Closed loop: simulated time (s).
+    #[arg(long, default_value_t = END_TIME)]
+    pub end_time: f64,
+    /// Closed loop: sensor channels of the test (the ones that move most).
+    #[arg(long, default_value_t = 24)]
+    pub channels: usize,
+    /// Closed loop: the wrong gain of the first channel (25.4 shows the units flag).
+    #[arg(long, default_value_t = 1.2)]
+    pub gain: f64,
+    /// Closed loop: jitter runs measuring the model's own noise.
+    #[arg(long, default_value_t = 8)]
+    pub loop_ensemble: usize,
+    /// Closed loop: CORS runs of the first calibration.
+    #[arg(long, default_value_t = 24)]
+    pub loop_reconcile: usize,
+    /// Closed loop: CORS runs of each recalibration.
+    #[arg(long, default_value_t = 24)]
+    pub loop_recalibrate: usize,
+    /// Closed loop: Gauss-Newton polish iterations after each CORS search.
+    #[arg(long, default_value_t = 8)]
+    pub loop_polish: usize,
+    /// Closed loop: most candidates added.
+    #[arg(long, default_value_t = 2)]
+    pub max_added: usize,
+    /// Closed loop: the candidates the loop may consider (comma-separated; all the
+    /// airframe's undeclared quantities when absent).
+    #[arg(long, value_delimiter = ',')]
+    pub candidates: Option<Vec<String>>,
 }
 
 #[derive(Serialize)]
@@ -78,6 +112,9 @@ struct Summary<'a> {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if args.close_loop {
+        return crate::demo_loop::run(&args);
+    }
     let started = Instant::now();
     let pool = thread_pool(args.threads)?;
     std::fs::create_dir_all(&args.out)

@@ -9,6 +9,7 @@ mod close_loop;
 mod compare;
 mod convert;
 mod demo;
+mod demo_loop;
 mod error;
 mod expand;
 mod filter;
@@ -82,7 +83,8 @@ enum Command {
     /// writes its histories (what the processes and slurm executors run for each point).
     StudyPoint(study::PointArgs),
     /// The source paper's study on the coarse airframe against a test with hidden changes:
-    /// Table 1 screened by M1, Table 2 studied and reconciled, the changes revealed.
+    /// Table 1 screened by M1, Table 2 studied and reconciled, the changes revealed; with
+    /// `--close-loop`, the closed loop against a test with hidden damping.
     Demo(demo::Args),
     /// Run a batch of parameter points through a solver (in process, a local process pool
     /// or Slurm) from a TOML configuration; journaled, and resumed by running it again.

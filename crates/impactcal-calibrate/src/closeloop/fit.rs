@@ -250,7 +250,12 @@ fn polish_from<M: Model>(
                     .collect::<Vec<f64>>(),
             );
         }
-        jac.extend(nuisance::columns(&y, &ctx.frame, &terms));
+        jac.extend(nuisance::columns(
+            &y,
+            &ctx.frame,
+            &terms,
+            ctx.fixed_gains.is_none(),
+        ));
         let lsq = Lsq::new(&jac)?;
         let se: Vec<f64> = lsq.variances()[..p].iter().map(|v| v.sqrt()).collect();
         let step = lsq.solve(&residual);

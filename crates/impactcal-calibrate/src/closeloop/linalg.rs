@@ -38,6 +38,19 @@ impl Lsq {
         })
     }
 
+    /// The numerical rank `r`.
+    pub fn rank(&self) -> usize {
+        self.s.len()
+    }
+
+    /// `U z` for `z` of length `r`: the image of the parameter change `V S^-1 z`. With
+    /// `z ~ N(0, I)` it is `J delta` for `delta ~ N(0, (J^T J)^+)`.
+    pub fn span(&self, z: &[f64]) -> Vec<f64> {
+        (0..self.u.nrows())
+            .map(|i| z.iter().enumerate().map(|(j, c)| self.u[(i, j)] * c).sum())
+            .collect()
+    }
+
     /// `U^T y` (length = rank).
     fn ut(&self, y: &[f64]) -> Vec<f64> {
         (0..self.s.len())

@@ -51,6 +51,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod agreement;
 pub mod attribution;
 pub mod detection;
 pub mod discrepancy;
@@ -83,6 +84,7 @@ pub use nuisance::Nuisance;
 pub use options::LoopOptions;
 pub use result::{Added, ErrorSummary, Errors, LoopResult, ModelScore, Round, Stages, Verdict};
 
+use agreement::Posterior;
 use fit::{Ctx, Journaled};
 use nuisance::{Frame, Terms};
 
@@ -217,6 +219,7 @@ pub fn run_loop_on<M: Enrichable>(
         .max_time_shift
         .unwrap_or(0.1 * dt * (samples - 1) as f64);
     let band = Cfc::from_class(options.noise_band_cfc)?;
+    let unit_gains = (!options.fit_gains).then(|| vec![1.0; labels.len()]);
 
     // The model's own noise and the noise floor.
     let spread = model_spread(
@@ -240,20 +243,20 @@ pub fn run_loop_on<M: Enrichable>(
         max_shift,
         options,
         band,
-        None,
+        unit_gains.as_deref(),
     )?;
     let ctx = Ctx {
         frame,
         cfc: test.cfc,
         max_shift,
-        fixed_gains: None,
+        fixed_gains: unit_gains,
         runner,
         seed: options.seed,
         batch: options.batch,
     };
     let inflation = floor.inflation();
     let onset = noise_floor::onset(&y_nominal, samples);
-    let n_nuisance = 1 + 2 * labels.len();
+    let n_nuisance = 1 + if options.fit_gains { 2 } else { 1 } * labels.len();
 
     // Calibration and forward selection.
     observer.step("calibration");
@@ -333,30 +336,28 @@ pub fn run_loop_on<M: Enrichable>(
     observer.step("before and after");
     let p_of = |d: usize| d + n_nuisance;
     let (terms_nominal, _) = ctx.profile(&y_nominal);
+    let posterior = |jac| Posterior { jac, inflation };
+    let judge = Judge {
+        lag1: floor.lag1(),
+        options,
+    };
     let metrics_calibration = Stages {
-        nominal: errors_of(
-            &ctx.frame,
-            &y_nominal,
-            &terms_nominal,
-            p_of(d0),
-            floor.lag1(),
-            options.alpha,
-        )?,
-        calibrated: errors_of(
+        nominal: judge.errors(&ctx.frame, &y_nominal, &terms_nominal, p_of(d0), None, 0)?,
+        calibrated: judge.errors(
             &ctx.frame,
             &fit0.y,
             &fit0.terms,
             p_of(d0),
-            floor.lag1(),
-            options.alpha,
+            Some(posterior(&fit0.jac)),
+            1,
         )?,
-        enriched: errors_of(
+        enriched: judge.errors(
             &ctx.frame,
             &fit.y,
             &fit.terms,
             p_of(fit.point.len()),
-            floor.lag1(),
-            options.alpha,
+            Some(posterior(&fit.jac)),
+            2,
         )?,
     };
 
@@ -419,32 +420,24 @@ pub fn run_loop_on<M: Enrichable>(
             )?;
             let profile = |y: &[f64]| nuisance::profile(y, &frame_h, max_shift, Some(&gains)).0;
             let ys = [y_nom_h, prep(&calibrated_h)?, prep(&enriched_h)?];
-            let lag = floor_h.lag1();
+            let judge = Judge {
+                lag1: floor_h.lag1(),
+                options,
+            };
+            let at = |k: usize| {
+                judge.errors(
+                    &frame_h,
+                    &ys[k],
+                    &profile(&ys[k]),
+                    p_of(0),
+                    None,
+                    3 + k as u64,
+                )
+            };
             Some(Stages {
-                nominal: errors_of(
-                    &frame_h,
-                    &ys[0],
-                    &profile(&ys[0]),
-                    p_of(0),
-                    lag,
-                    options.alpha,
-                )?,
-                calibrated: errors_of(
-                    &frame_h,
-                    &ys[1],
-                    &profile(&ys[1]),
-                    p_of(0),
-                    lag,
-                    options.alpha,
-                )?,
-                enriched: errors_of(
-                    &frame_h,
-                    &ys[2],
-                    &profile(&ys[2]),
-                    p_of(0),
-                    lag,
-                    options.alpha,
-                )?,
+                nominal: at(0)?,
+                calibrated: at(1)?,
+                enriched: at(2)?,
             })
         }
     };
@@ -490,6 +483,7 @@ pub fn run_loop_on<M: Enrichable>(
         metrics_holdout,
         rounds: outcome.rounds,
         runs: used.get(),
+        m1_members: options.m1_members,
         time_step: dt,
         start: test_m.start(),
     })
@@ -569,45 +563,78 @@ fn frame_of(
     Ok((frame, floor))
 }
 
-/// The errors of model response `y` under nuisance `terms` against the frame's test.
-fn errors_of(
-    frame: &Frame,
-    y: &[f64],
-    terms: &Terms,
-    p: usize,
+/// What judges a model's response against a test: the noise's lag-one correlation and the
+/// loop's options.
+struct Judge<'a> {
     lag1: f64,
-    alpha: f64,
-) -> Result<Errors> {
-    let corrected = nuisance::corrected_test(frame, terms);
-    let num: f64 = corrected.iter().zip(y).map(|(a, b)| (a - b).powi(2)).sum();
-    let den: f64 = corrected.iter().map(|a| a * a).sum();
-    let residual = nuisance::residual(y, frame, terms);
-    let det = detection::detect(&frame.labels, &residual, frame.samples, p, lag1, alpha)?;
-    let iso = Iso18571::new();
-    let t = frame.samples;
-    let (mut sg, mut r, mut k) = (0.0, 0.0, 0.0);
-    for s in 0..frame.labels.len() {
-        if let Ok(m) = CurveMetrics::between(
-            &corrected[s * t..(s + 1) * t],
-            &y[s * t..(s + 1) * t],
-            frame.dt,
-            &iso,
-        ) {
-            sg += m.sprague_geers.comprehensive;
-            r += m.iso18571.r;
-            k += 1.0;
+    options: &'a LoopOptions,
+}
+
+impl Judge<'_> {
+    /// The errors of model response `y` under nuisance `terms` against the frame's test,
+    /// with `p` fitted quantities; `posterior` widens the M1 ensemble by the parameters'
+    /// linearised uncertainty; `stream` separates the seeds of the M1 ensembles.
+    fn errors(
+        &self,
+        frame: &Frame,
+        y: &[f64],
+        terms: &Terms,
+        p: usize,
+        posterior: Option<Posterior<'_>>,
+        stream: u64,
+    ) -> Result<Errors> {
+        let corrected = nuisance::corrected_test(frame, terms);
+        let num: f64 = corrected.iter().zip(y).map(|(a, b)| (a - b).powi(2)).sum();
+        let den: f64 = corrected.iter().map(|a| a * a).sum();
+        let residual = nuisance::residual(y, frame, terms);
+        let det = detection::detect(
+            &frame.labels,
+            &residual,
+            frame.samples,
+            p,
+            self.lag1,
+            self.options.alpha,
+        )?;
+        let iso = Iso18571::new();
+        let t = frame.samples;
+        let (mut sg, mut r, mut k) = (0.0, 0.0, 0.0);
+        for s in 0..frame.labels.len() {
+            if let Ok(m) = CurveMetrics::between(
+                &corrected[s * t..(s + 1) * t],
+                &y[s * t..(s + 1) * t],
+                frame.dt,
+                &iso,
+            ) {
+                sg += m.sprague_geers.comprehensive;
+                r += m.iso18571.r;
+                k += 1.0;
+            }
         }
+        let m1_exceedance = agreement::m1_exceedance(
+            frame,
+            y,
+            terms,
+            posterior,
+            self.options.m1_members,
+            self.options
+                .seed
+                .wrapping_add(stream.wrapping_mul(0x9E37_79B9_7F4A_7C15)),
+        )?;
+        let m2 = agreement::m2_count(frame, y, terms).ok();
+        Ok(Errors {
+            rel_l2: if den > 0.0 {
+                (num / den).sqrt()
+            } else {
+                f64::NAN
+            },
+            chi2_red: det.chi2_red,
+            sprague_geers_c: if k > 0.0 { sg / k } else { f64::NAN },
+            iso18571_r: if k > 0.0 { r / k } else { f64::NAN },
+            m1_exceedance,
+            m2_above_0_9: m2.map(|m| m.0),
+            m2_shapes: m2.map_or(0, |m| m.1),
+        })
     }
-    Ok(Errors {
-        rel_l2: if den > 0.0 {
-            (num / den).sqrt()
-        } else {
-            f64::NAN
-        },
-        chi2_red: det.chi2_red,
-        sprague_geers_c: if k > 0.0 { sg / k } else { f64::NAN },
-        iso18571_r: if k > 0.0 { r / k } else { f64::NAN },
-    })
 }
 
 /// Every test channel must pair with a model channel (through the map, or by label).

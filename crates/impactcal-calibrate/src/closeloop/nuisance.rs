@@ -271,9 +271,9 @@ pub(crate) fn residual(y: &[f64], frame: &Frame, terms: &Terms) -> Vec<f64> {
 }
 
 /// The whitened derivative columns of the nuisance terms at `y`: `tau` (`-g_s y'_s(t -
-/// tau)`), then each channel's gain (`y_s(t - tau)` on that channel) and bias (1 on that
-/// channel).
-pub(crate) fn columns(y: &[f64], frame: &Frame, terms: &Terms) -> Vec<Vec<f64>> {
+/// tau)`), then each channel's gain (`y_s(t - tau)` on that channel; left out when `gains`
+/// is false, the gains being known) and bias (1 on that channel).
+pub(crate) fn columns(y: &[f64], frame: &Frame, terms: &Terms, gains: bool) -> Vec<Vec<f64>> {
     let t = frame.samples;
     let n = y.len();
     let ys = shifted(y, frame, terms.tau);
@@ -295,7 +295,9 @@ pub(crate) fn columns(y: &[f64], frame: &Frame, terms: &Terms) -> Vec<Vec<f64>> 
             g[i] = ys[i] * frame.weights[i];
             b[i] = frame.weights[i];
         }
-        cols.push(g);
+        if gains {
+            cols.push(g);
+        }
         cols.push(b);
     }
     cols

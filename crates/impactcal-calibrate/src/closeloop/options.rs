@@ -42,6 +42,14 @@ pub struct LoopOptions {
     /// CFC class whose residual measures the noise when the pre-impact window is too short
     /// (default 1000).
     pub noise_band_cfc: u32,
+    /// Whether a gain per channel is fitted (default true). `false` when the sensors'
+    /// sensitivities are known (a calibration of the sensors): the gains stay 1, only the
+    /// trigger offset and the biases are profiled, and an effect whose signature on a
+    /// channel is mostly a change of scale is no longer absorbed by that channel's gain.
+    pub fit_gains: bool,
+    /// Members of each model's predictive ensemble for M1 (default 199; no runs: see
+    /// `closeloop::agreement`).
+    pub m1_members: usize,
 }
 
 impl Default for LoopOptions {
@@ -63,6 +71,8 @@ impl Default for LoopOptions {
             sigma: None,
             noise_band_cfc: 1000,
             candidates: None,
+            m1_members: 199,
+            fit_gains: true,
         }
     }
 }
@@ -106,6 +116,16 @@ impl LoopOptions {
         }
         if !(self.jitter > 0.0 && self.jitter < 0.1) {
             return bad("jitter", format!("{} must lie in (0, 0.1)", self.jitter));
+        }
+        if self.m1_members < 19 {
+            return bad(
+                "m1_members",
+                format!(
+                    "{}: an M1 envelope needs at least 19 members (a right model then leaves \
+                     it at 10 % of the samples)",
+                    self.m1_members
+                ),
+            );
         }
         if self.batch == 0 {
             return bad("batch", "must be at least 1".into());

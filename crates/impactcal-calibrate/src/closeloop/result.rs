@@ -68,6 +68,16 @@ pub struct Errors {
     pub sprague_geers_c: f64,
     /// Mean ISO/TS 18571 rating over the channels.
     pub iso18571_r: f64,
+    /// M1: fraction of the samples at which the test's `Q_e(t)` leaves the envelope of the
+    /// model's predictive ensemble (its linearised parameter posterior where the loop has
+    /// its Jacobian, and the noise floor; `closeloop::agreement`). About `2 / (N + 1)` for
+    /// a right model with `N` members, towards 1 with model-form error.
+    pub m1_exceedance: f64,
+    /// M2: paired impact shapes of model and test with `|M2| > 0.9`; `None` when the
+    /// shapes cannot be formed (a response without signal on the compared channels).
+    pub m2_above_0_9: Option<usize>,
+    /// Impact shapes compared a side by M2.
+    pub m2_shapes: usize,
 }
 
 /// Errors of the three models against one test.
@@ -144,6 +154,8 @@ pub struct LoopResult {
     pub rounds: Vec<Round>,
     /// True-model runs used (journaled runs read back count too).
     pub runs: usize,
+    /// Members of the predictive ensembles behind the M1 exceedances.
+    pub m1_members: usize,
     /// Sampling step of the compared histories (s): the time axis of the patterns.
     pub time_step: f64,
     /// Time of their first sample (s).
