@@ -27,6 +27,27 @@ enum OptimizeCommand {
     /// Print the next points to evaluate (CSV with the parameter header): missing design
     /// points first, then CORS points.
     Suggest(SuggestArgs),
+    /// Print the answers of a study from its history (JSON): the best sample (lowest
+    /// objective seen) and the evaluated point of lowest smoothed-surrogate value, the
+    /// better answer under a noisy objective.
+    Answer(AnswerArgs),
+}
+
+/// Arguments of `impactcal optimize answer`.
+#[derive(ClapArgs, Debug)]
+struct AnswerArgs {
+    /// Bounds file (`name,lower,upper,nominal[,unit]`).
+    #[arg(long)]
+    bounds: PathBuf,
+    /// History file: the parameter columns and `objective` (empty for a failed run).
+    #[arg(long)]
+    history: PathBuf,
+    /// The surrogate's kernel (linear tail).
+    #[arg(long, value_enum, default_value_t = KernelArg::Cubic)]
+    kernel: KernelArg,
+    /// Output file (default: standard output).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 /// Kernel choices on the command line.
