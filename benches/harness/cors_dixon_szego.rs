@@ -1,10 +1,15 @@
 //! CORS-RBF on the Dixon-Szego functions: evaluations to 1% relative error and the time
 //! spent choosing each point, one JSON line per (function, seed).
 //!
-//! `cargo run --release --example cors_dixon_szego -- [--seeds 30] [--budget 300]
+//! `cargo run --release -p impactcal-cors --example cors_dixon_szego -- [--seeds 30] [--budget 300]
 //! [--functions branin,hartmann3] [--transform identity|log|shifted-log|median-cap]
 //! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]
 //! [--restart-patience N | --no-restart] [--points]`
+//!
+//! `--noise LEVEL --noise-file FILE` runs the whole budget on `f(x) + LEVEL * range * z_k`,
+//! with the range of each function and the draws `z_k` of each seed read from the table
+//! that `cors_pysot.py --write-noise` writes (the same noise as pySOT's runs), and reports
+//! the luckiest sample and [`Cors::surrogate_answer`] with the true value at each.
 //!
 //! `--points` adds every chosen point to each line (`"points":[[x1, x2, ...], ...]`, shortest
 //! round-trip decimals), so that two builds can be checked to choose the same points bit for
@@ -14,8 +19,81 @@
 
 use std::time::Instant;
 
-use impactcal::core::test_functions;
-use impactcal::cors::{Cors, CorsOptions, Restart, SurrogateKernel, Transform};
+use std::collections::HashMap;
+
+use impactcal_core::test_functions::{self, TestFunction};
+use impactcal_cors::{Cors, CorsOptions, Restart, SurrogateKernel, Transform};
+
+/// The noise table of `cors_pysot.py --write-noise`: range per function, draws per seed.
+struct Noise {
+    level: f64,
+    ranges: HashMap<String, f64>,
+    draws: HashMap<u64, Vec<f64>>,
+}
+
+impl Noise {
+    fn read(level: f64, path: &str) -> Self {
+        let text = std::fs::read_to_string(path).expect("the noise table");
+        let (mut ranges, mut draws) = (HashMap::new(), HashMap::new());
+        for line in text.lines() {
+            let parts: Vec<&str> = line.split_whitespace().collect();
+            match parts.first() {
+                Some(&"range") => {
+                    ranges.insert(parts[1].to_string(), parts[2].parse().unwrap());
+                }
+                Some(&"z") => {
+                    let z = parts[2..].iter().map(|v| v.parse().unwrap()).collect();
+                    draws.insert(parts[1].parse().unwrap(), z);
+                }
+                _ => {}
+            }
+        }
+        Noise {
+            level,
+            ranges,
+            draws,
+        }
+    }
+}
+
+/// The whole budget on the noisy function; one JSON line with both answers.
+fn run_noisy(
+    name: &str,
+    f: &TestFunction,
+    seed: u64,
+    options: CorsOptions,
+    budget: usize,
+    noise: &Noise,
+) {
+    let sd = noise.level * noise.ranges[name];
+    let z = &noise.draws[&seed];
+    let mut study = Cors::new(f.space().unwrap(), options).unwrap();
+    let mut k = 0;
+    study
+        .minimize(
+            |x| {
+                let v = f.eval(x) + sd * z[k];
+                k += 1;
+                v
+            },
+            budget,
+        )
+        .unwrap();
+    let sample = study.best().unwrap();
+    let answer = study.surrogate_answer().unwrap().unwrap();
+    let (t_sample, t_answer) = (f.eval(&sample.x), f.eval(&answer.x));
+    println!(
+        "{{\"tool\":\"impactcal-cors\",\"function\":\"{name}\",\"seed\":{seed},\"noise\":{},\"evaluations\":{},\"sample_noisy\":{},\"sample_true\":{t_sample},\"sample_error\":{},\"answer_predicted\":{},\"answer_observed\":{},\"answer_true\":{t_answer},\"answer_error\":{},\"smoothing\":{}}}",
+        noise.level,
+        study.evaluations().len(),
+        sample.value.unwrap(),
+        f.relative_error(t_sample),
+        answer.predicted,
+        answer.observed,
+        f.relative_error(t_answer),
+        answer.smoothing,
+    );
+}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -77,6 +155,12 @@ fn main() {
                     patience: Some(p.parse().unwrap()),
                     ..Restart::default()
                 });
+            }
+            if let Some(level) = get("--noise") {
+                let path = get("--noise-file").expect("--noise-file with --noise");
+                let noise = Noise::read(level.parse().unwrap(), &path);
+                run_noisy(name, &f, seed, options, budget, &noise);
+                continue;
             }
             let mut study = Cors::new(f.space().unwrap(), options).unwrap();
             let mut hit: Option<usize> = None;

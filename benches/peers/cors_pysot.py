@@ -4,6 +4,13 @@ Prints one JSON line per (strategy, function, seed), in the format of our
 `benches/harness/cors_dixon_szego.rs`: evaluations until the relative error drops below 1% (null
 if not within the budget) and the mean time per adaptive iteration spent outside the
 objective (the optimiser's overhead). Run through cors_pysot.sh.
+
+Noisy objectives: `--write-noise FILE` writes the shared noise table (the range of each
+function over its box, and per seed the standard normal draws added to evaluation 1, 2, ...);
+`--noise LEVEL --noise-file FILE` then runs the whole budget on `f(x) + LEVEL * range * z_k`
+and reports pySOT's answer (the point of the lowest noisy value) with the true value there.
+The range is `max f - f*` with the maximum over 100,000 uniform points of the box (numpy
+seed 0) and `f*` the published minimum.
 """
 
 import json
@@ -81,6 +88,63 @@ class Reached(Exception):
     pass
 
 
+def write_noise(path, seeds, budget):
+    rng = np.random.default_rng(0)
+    with open(path, "w") as out:
+        for name, (f, lb, ub, fmin) in FUNCTIONS.items():
+            lb, ub = np.array(lb, float), np.array(ub, float)
+            x = lb + (ub - lb) * rng.random((100_000, len(lb)))
+            top = max(f(p) for p in x)
+            out.write(f"range {name} {float(top - fmin)!r}\n")
+        for seed in range(seeds):
+            z = np.random.default_rng(10_000 + seed).standard_normal(budget)
+            out.write(f"z {seed} " + " ".join(repr(float(v)) for v in z) + "\n")
+
+
+def read_noise(path):
+    ranges, z = {}, {}
+    for line in open(path):
+        parts = line.split()
+        if parts[0] == "range":
+            ranges[parts[1]] = float(parts[2])
+        elif parts[0] == "z":
+            z[int(parts[1])] = [float(v) for v in parts[2:]]
+    return ranges, z
+
+
+def run_noisy(strategy_name, name, seed, budget, level, table):
+    """The whole budget on the noisy function; pySOT's answer is the point of the lowest
+    noisy value (what `strategy` and the controller return as the best)."""
+    f, lb, ub, fmin = FUNCTIONS[name]
+    ranges, z = table
+    sd = level * ranges[name]
+    prob = Problem(f, lb, ub)
+    np.random.seed(seed)
+    dim = prob.dim
+    design = SymmetricLatinHypercube(dim=dim, num_pts=2 * (dim + 1))
+    surrogate = RBFInterpolant(dim=dim, lb=prob.lb, ub=prob.ub, kernel=CubicKernel(), tail=LinearTail(dim))
+    cls = DYCORSStrategy if strategy_name == "dycors" else SRBFStrategy
+    strategy = cls(max_evals=budget, opt_prob=prob, exp_design=design, surrogate=surrogate,
+                   asynchronous=True, batch_size=1)
+    state = {"n": 0, "best": np.inf, "x": None}
+
+    def objective(x):
+        x = np.asarray(x, float)
+        v = prob.eval(x) + sd * z[seed][state["n"]]
+        state["n"] += 1
+        if v < state["best"]:
+            state["best"], state["x"] = v, x.copy()
+        return v
+
+    controller = SerialController(objective=objective)
+    controller.strategy = strategy
+    controller.run()
+    true = float(f(state["x"]))
+    return {"tool": f"pysot-{strategy_name}", "function": name, "seed": seed, "noise": level,
+            "evaluations": state["n"], "sample_noisy": state["best"], "sample_true": true,
+            "sample_error": (true - fmin) / abs(fmin), "sample_x": state["x"].tolist()}
+
+
 def run(strategy_name, name, seed, budget):
     f, lb, ub, fmin = FUNCTIONS[name]
     prob = Problem(f, lb, ub)
@@ -128,10 +192,18 @@ def main():
     budget = int(opts.get("--budget", 300))
     names = opts.get("--functions", ",".join(FUNCTIONS)).split(",")
     strategies = opts.get("--strategies", "dycors,srbf").split(",")
+    if "--write-noise" in opts:
+        write_noise(opts["--write-noise"], seeds, budget)
+        return
+    table = read_noise(opts["--noise-file"]) if "--noise" in opts else None
     for s in strategies:
         for name in names:
             for seed in range(seeds):
-                print(json.dumps(run(s, name, seed, budget)), flush=True)
+                if table is None:
+                    row = run(s, name, seed, budget)
+                else:
+                    row = run_noisy(s, name, seed, budget, float(opts["--noise"]), table)
+                print(json.dumps(row), flush=True)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,9 @@
 //! `impactcal optimize suggest`: the next points of a CORS-RBF study, stateless over a
 //! history file, so that a shell loop of suggest, run, append drives a study with any
-//! simulator.
+//! simulator; `impactcal optimize answer`: the best sample and the smoothed surrogate's
+//! answer of such a history.
 
+use std::io::Write;
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
@@ -25,6 +27,27 @@ enum OptimizeCommand {
     /// Print the next points to evaluate (CSV with the parameter header): missing design
     /// points first, then CORS points.
     Suggest(SuggestArgs),
+    /// Print the answers of a study from its history (JSON): the best sample (lowest
+    /// objective seen) and the evaluated point of lowest smoothed-surrogate value, the
+    /// better answer under a noisy objective.
+    Answer(AnswerArgs),
+}
+
+/// Arguments of `impactcal optimize answer`.
+#[derive(ClapArgs, Debug)]
+struct AnswerArgs {
+    /// Bounds file (`name,lower,upper,nominal[,unit]`).
+    #[arg(long)]
+    bounds: PathBuf,
+    /// History file: the parameter columns and `objective` (empty for a failed run).
+    #[arg(long)]
+    history: PathBuf,
+    /// The surrogate's kernel (linear tail).
+    #[arg(long, value_enum, default_value_t = KernelArg::Cubic)]
+    kernel: KernelArg,
+    /// Output file (default: standard output).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 /// Kernel choices on the command line.
@@ -108,7 +131,76 @@ struct SuggestArgs {
 pub fn run(args: Args) -> Result<(), CliError> {
     match args.command {
         OptimizeCommand::Suggest(a) => suggest(a),
+        OptimizeCommand::Answer(a) => answer(a),
     }
+}
+
+fn kernel(arg: KernelArg) -> SurrogateKernel {
+    match arg {
+        KernelArg::Cubic => SurrogateKernel::Cubic,
+        KernelArg::ThinPlate => SurrogateKernel::ThinPlate,
+    }
+}
+
+/// `impactcal optimize answer`: both answers as JSON, rows counted from 1 after the header.
+fn answer(args: AnswerArgs) -> Result<(), CliError> {
+    let space = ParameterSpace::read_csv(&args.bounds)?;
+    let (points, values) = read_history(&space, &args.history)?;
+    let history = args.history.display().to_string();
+    let options = CorsOptions {
+        kernel: kernel(args.kernel),
+        ..CorsOptions::default()
+    };
+    let study = Cors::from_history(space.clone(), options, points.as_ref(), &values, None)
+        .map_err(|e| CliError::from(e).context(&history))?;
+    let best = study.best().ok_or_else(|| {
+        CliError::input(format!(
+            "{history}: no successful evaluation to answer from"
+        ))
+    })?;
+    let sample_row = study
+        .evaluations()
+        .iter()
+        .position(|e| std::ptr::eq(e, best))
+        .unwrap_or(0);
+    let surrogate = study
+        .surrogate_answer()
+        .map_err(|e| CliError::from(e).context(&history))?
+        .ok_or_else(|| {
+            CliError::input(format!(
+                "{history}: the successful evaluations hold fewer than {} distinct points \
+                 spanning the space, too few for the smoothed surrogate",
+                space.dim() + 2
+            ))
+        })?;
+    let named = |x: &[f64]| {
+        space
+            .names()
+            .iter()
+            .zip(x)
+            .map(|(n, v)| (n.to_string(), serde_json::json!(v)))
+            .collect::<serde_json::Map<_, _>>()
+    };
+    let doc = serde_json::json!({
+        "best_sample": {
+            "row": sample_row + 1,
+            "parameters": named(&best.x),
+            "objective": best.value,
+        },
+        "surrogate": {
+            "row": surrogate.index + 1,
+            "parameters": named(&surrogate.x),
+            "objective": surrogate.observed,
+            "predicted": surrogate.predicted,
+            "smoothing": surrogate.smoothing,
+            "loo_rmse": surrogate.loo_rmse,
+        },
+    });
+    let (mut out, name) = writer(args.out.as_deref())?;
+    let text =
+        serde_json::to_string_pretty(&doc).map_err(|e| CliError::io(format!("{name}: {e}")))?;
+    writeln!(out, "{text}").map_err(|e| CliError::io(format!("{name}: {e}")))?;
+    Ok(())
 }
 
 /// Reads the history: the parameters (by name, any column order) and the objectives. Only
@@ -157,10 +249,7 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
     }
     let (points, values) = read_history(&space, &args.history)?;
     let options = CorsOptions {
-        kernel: match args.kernel {
-            KernelArg::Cubic => SurrogateKernel::Cubic,
-            KernelArg::ThinPlate => SurrogateKernel::ThinPlate,
-        },
+        kernel: kernel(args.kernel),
         transform: match args.transform {
             TransformArg::Identity => Transform::Identity,
             TransformArg::Log => Transform::Log,

@@ -279,3 +279,61 @@ fn bad_search_options_are_input_errors() {
         assert!(err.contains(expected), "{flags:?}: {err}");
     }
 }
+
+/// `optimize answer` on the history of a noisy Branin loop gives the library's best sample
+/// and smoothed-surrogate answer; a history too short for the surrogate is an input error.
+#[test]
+fn answer_reports_best_sample_and_surrogate_answer() {
+    let f = test_functions::by_name("branin").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let bounds = branin_bounds(dir.path());
+    let history = dir.path().join("history.csv");
+    let mut study = Cors::new(f.space().unwrap(), CorsOptions::with_seed(3)).unwrap();
+    // Deterministic "noise" of a few units (1 % of Branin's range over the box is 3).
+    let mut k = 0.0_f64;
+    study
+        .minimize(
+            |x| {
+                k += 1.0;
+                f.eval(x) + 3.0 * (k * 2.399).sin()
+            },
+            40,
+        )
+        .unwrap();
+    for e in study.evaluations() {
+        append(&history, &e.x, e.value.unwrap());
+    }
+    let answer = |path: &Path| {
+        impactcal(&[
+            "optimize",
+            "answer",
+            "--bounds",
+            bounds.to_str().unwrap(),
+            "--history",
+            path.to_str().unwrap(),
+        ])
+    };
+    let out = answer(&history);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let best = study.best().unwrap();
+    let lib = study.surrogate_answer().unwrap().unwrap();
+    assert_eq!(doc["best_sample"]["objective"], best.value.unwrap());
+    assert_eq!(doc["best_sample"]["parameters"]["x1"], best.x[0]);
+    assert_eq!(doc["surrogate"]["row"], lib.index + 1);
+    assert_eq!(doc["surrogate"]["parameters"]["x2"], lib.x[1]);
+    assert_eq!(doc["surrogate"]["predicted"], lib.predicted);
+    assert_eq!(doc["surrogate"]["smoothing"], lib.smoothing);
+    assert!(lib.smoothing > 0.0);
+
+    let short = dir.path().join("short.csv");
+    std::fs::write(&short, "x1,x2,objective\n1,2,3\n4,5,6\n").unwrap();
+    let out = answer(&short);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("too few for the smoothed surrogate"), "{err}");
+}

@@ -16,6 +16,9 @@
 //!   for a failed run), or the closed loop [`Cors::minimize`]. State to and from JSON
 //!   ([`Cors::save`], [`Cors::load`]), and [`Cors::from_history`] for stateless drivers.
 //!   A point that had to be space-filling says why ([`FillReason`]).
+//! - Under a noisy objective, [`Cors::surrogate_answer`] is the evaluated point where a
+//!   smoothed RBF (smoothing chosen by leave-one-out) is lowest, next to the luckiest
+//!   sample [`Cors::best`].
 //! - [`CorsOptions`]: kernel, pattern, initial design, objective [`Transform`], stopping
 //!   and restart rules (one stall rule for both), seed; checked into [`ValidCorsOptions`].
 //!
@@ -39,6 +42,7 @@
 //! # Ok::<(), impactcal_cors::CorsError>(())
 //! ```
 
+pub mod answer;
 pub mod design;
 pub mod error;
 mod geometry;
@@ -50,6 +54,7 @@ mod step;
 mod subproblem;
 pub mod surrogate;
 
+pub use answer::SurrogateAnswer;
 pub use error::{CorsError, Result};
 pub use optimizer::{Cors, Outcome, StopReason};
 pub use options::{

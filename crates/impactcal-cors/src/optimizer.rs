@@ -8,6 +8,7 @@ use impactcal_core::points::{from_rows, to_rows};
 use impactcal_core::{CoreError, ParamGuard, ParameterSpace};
 use serde::{Deserialize, Serialize};
 
+use crate::answer::SurrogateAnswer;
 use crate::design::find_near_duplicate;
 use crate::error::{CorsError, Result};
 use crate::geometry::distance;
@@ -127,6 +128,19 @@ impl Cors {
     /// The best successful evaluation (lowest value; the earliest on ties).
     pub fn best(&self) -> Option<&Evaluation> {
         self.state.best()
+    }
+
+    /// The answer under a noisy objective: the evaluated point where a smoothed RBF of every
+    /// successful evaluation is lowest (see [`SurrogateAnswer`] and the module
+    /// [`crate::answer`]), rather than the luckiest sample [`best`](Self::best). Without
+    /// noise the chosen smoothing is (near) zero and both agree. `None` while the successes
+    /// hold fewer than `d + 2` distinct points or do not span the space. Costs about 30 RBF
+    /// fits of the whole history; call it once, at the end.
+    ///
+    /// # Errors
+    /// Mapping errors of the parameter space (not expected).
+    pub fn surrogate_answer(&self) -> Result<Option<SurrogateAnswer>> {
+        crate::answer::surrogate_answer(&self.state)
     }
 
     /// The design points of this study's seed, one per row, in the parameter space (the

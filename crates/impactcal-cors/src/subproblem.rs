@@ -30,6 +30,30 @@ use crate::surrogate::RbfSurrogate;
 /// Candidates per parallel task: small batches cost more in scheduling than they save.
 const PAR_CHUNK: usize = 1024;
 
+/// Screening work (candidates x points x dimension) below which the thread pool costs more
+/// than it saves: such screenings run on the calling thread. Either way the results, and
+/// their order, are the same.
+const PAR_MIN_WORK: usize = 1 << 21;
+
+/// `f` applied to every candidate (row-major, `dim` values each), in order: in parallel
+/// when the screening against `points` points is large enough to pay for the thread pool.
+fn screen<T: Send>(
+    cands: &[f64],
+    dim: usize,
+    points: usize,
+    f: impl Fn(&[f64]) -> T + Sync + Send,
+) -> Vec<T> {
+    if cands.len() * (points + 1) < PAR_MIN_WORK {
+        cands.chunks_exact(dim).map(f).collect()
+    } else {
+        cands
+            .par_chunks_exact(dim)
+            .with_min_len(PAR_CHUNK)
+            .map(f)
+            .collect()
+    }
+}
+
 /// Points that a new point must keep away from, in the unit box.
 #[derive(Debug, Clone, Default)]
 pub struct Blockers {
@@ -246,11 +270,10 @@ pub fn maximin(blockers: &Blockers, n: usize, rng: &mut impl Rng) -> (Vec<f64>, 
         Columns::new(&blockers.ok, dim),
         Columns::new(&blockers.failed, dim),
     );
-    let dists: Vec<f64> = cands
-        .par_chunks_exact(dim)
-        .with_min_len(PAR_CHUNK)
-        .map(|c| ok.min_distance(c).min(failed.min_distance(c)))
-        .collect();
+    let n_points = (blockers.ok.len() + blockers.failed.len()) / dim.max(1);
+    let dists: Vec<f64> = screen(&cands, dim, n_points, |c| {
+        ok.min_distance(c).min(failed.min_distance(c))
+    });
     let i = argmax(&dists);
     let start = cands[i * dim..(i + 1) * dim].to_vec();
     let h = 0.5 / (n.max(2) as f64).powf(1.0 / dim as f64);
@@ -291,14 +314,12 @@ pub fn cors_step(
         Columns::new(&blockers.ok, dim),
         Columns::new(&blockers.failed, dim),
     );
-    let screened: Vec<((f64, f64), f64)> = cands
-        .par_chunks_exact(dim)
-        .with_min_len(PAR_CHUNK)
-        .map(|c| {
-            let dists = (ok.min_distance(c), failed.min_distance(c));
-            (dists, surrogate.value(c))
-        })
-        .collect();
+    // Distances to the blockers and the surrogate: about twice the points.
+    let n_points = 2 * (blockers.ok.len() + blockers.failed.len()) / dim.max(1);
+    let screened: Vec<((f64, f64), f64)> = screen(&cands, dim, n_points, |c| {
+        let dists = (ok.min_distance(c), failed.min_distance(c));
+        (dists, surrogate.value(c))
+    });
     // Delta from the global candidates, refined around the best of them.
     let global_min: Vec<f64> = screened[..n_global]
         .iter()
