@@ -77,6 +77,7 @@ mod projection;
 pub mod radial;
 pub mod rbf;
 pub mod shape_basis;
+mod smoothing;
 pub mod surrogate;
 mod thin_qr;
 pub mod trend;
