@@ -79,7 +79,7 @@ pub struct Erbf {
     r_ratio: f64,
     /// With smoothing: the SVD of `R` and the absolute ridge `lambda`
     /// ([`crate::smoothing`]).
-    smoother: Option<(RSvd, f64)>,
+    smoother: Option<Box<(RSvd, f64)>>,
 }
 
 impl Erbf {
@@ -134,13 +134,13 @@ impl Erbf {
         let smoother = if options.smoothing > 0.0 {
             let svd = RSvd::new(factor.r.as_ref())?;
             let lambda = svd.lambda(options.smoothing);
-            Some((svd, lambda))
+            Some(Box::new((svd, lambda)))
         } else {
             None
         };
         let coef = direct_is_cheaper(unit.nrows(), unit.ncols(), t, options.gamma).then(|| {
             let mut z = centred.as_ref().map_or(values, |f| f.as_ref()).to_owned();
-            solve_rt(factor.r.as_ref(), smoother.as_ref(), z.as_mut());
+            solve_rt(factor.r.as_ref(), smoother.as_deref(), z.as_mut());
             &factor.q1 * &z
         });
         let projection = Projection::new(factor.q1, unit.as_ref(), &options);
@@ -251,7 +251,7 @@ impl Erbf {
     /// `Z = R^{-T} F` (`N x T`), formed on demand.
     fn z(&self) -> Mat<f64> {
         let mut z = self.responses().to_owned();
-        solve_rt(self.r.as_ref(), self.smoother.as_ref(), z.as_mut());
+        solve_rt(self.r.as_ref(), self.smoother.as_deref(), z.as_mut());
         z
     }
 
@@ -341,7 +341,7 @@ impl Erbf {
                         let len = cols.ncols();
                         let u = &unit[k * CHUNK * m..(k * CHUNK + len) * m];
                         self.projection.project(u, cols.as_mut());
-                        solve_r(self.r.as_ref(), self.smoother.as_ref(), cols);
+                        solve_r(self.r.as_ref(), self.smoother.as_deref(), cols);
                     });
                 matmul(
                     out.as_mut(),
@@ -413,7 +413,7 @@ impl Erbf {
         };
         let f = self.responses();
         if !exact {
-            if let Some((svd, lambda)) = &self.smoother {
+            if let Some((svd, lambda)) = self.smoother.as_deref() {
                 return svd.loo(*lambda, f);
             }
             // alpha = G^{-1} F = R^{-1} Z; (G^{-1})_kk = |row k of R^{-1}|^2.
@@ -438,7 +438,7 @@ impl Erbf {
                 // w = R^{-1} Q_1^T b (filtered with smoothing, the same lambda), so that
                 // f^{(-k)}(x_k) = F_{-k}^T w.
                 let mut w = factor.q1.transpose() * &b;
-                let smoother = match &self.smoother {
+                let smoother = match self.smoother.as_deref() {
                     Some((_, lambda)) => Some((
                         RSvd::new(factor.r.as_ref()).map_err(|e| undefined(e.to_string()))?,
                         *lambda,
@@ -461,7 +461,7 @@ impl Erbf {
     /// The SVD of this fit's triangular factor, which scores every smoothing with
     /// [`loo_smoothed`](Self::loo_smoothed).
     pub(crate) fn r_svd(&self) -> Result<RSvd> {
-        match &self.smoother {
+        match self.smoother.as_deref() {
             Some((svd, _)) => Ok(svd.clone()),
             None => RSvd::new(self.r.as_ref()),
         }
@@ -497,7 +497,7 @@ impl Erbf {
             Some(c) => matmul(out, Accum::Replace, bt.transpose(), c.as_ref(), 1.0, par()),
             None => {
                 let mut v = self.projection.q1().transpose() * bt;
-                solve_r(self.r.as_ref(), self.smoother.as_ref(), v.as_mut());
+                solve_r(self.r.as_ref(), self.smoother.as_deref(), v.as_mut());
                 matmul(
                     out,
                     Accum::Replace,

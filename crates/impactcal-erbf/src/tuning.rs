@@ -223,7 +223,7 @@ impl ErbfCache {
         };
         match &mut self.fitted {
             Some((k, model, svd)) if *k == key => {
-                if model.options().smoothing == o.smoothing {
+                if model.options().smoothing.to_bits() == o.smoothing.to_bits() {
                     return model.loo_errors(LooMethod::Closed);
                 }
                 if o.smoothing == 0.0 {
