@@ -18,7 +18,8 @@
 //! reports and [`choose_count`] keeps below the surrogate's own leave-one-out error.
 
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef, Par, Side};
+use faer::linalg::matmul::triangular::{self, BlockStructure};
+use faer::{Accum, Mat, MatRef, Side};
 use impactcal_shapes::{ImpactShapes, ShapeOptions, SvdMethod, Truncation};
 
 use crate::buffer;
@@ -36,7 +37,7 @@ pub const TRUNCATION_RATIO: f64 = 0.25;
 pub const GRAM_RATIO: usize = 2;
 
 /// Time samples per block when the deviations from the mean are formed on the fly.
-const BLOCK: usize = 1024;
+const BLOCK: usize = 2048;
 
 /// The mean history and impact shapes (time functions) of an ensemble of histories.
 #[derive(Debug, Clone)]
@@ -110,7 +111,18 @@ impl ShapeSpectrum {
         let mut total = 0.0;
         for_centred_blocks(values, &mean, |_, c| {
             total += c.squared_norm_l2();
-            matmul(gram.as_mut(), Accum::Add, c, c.transpose(), 1.0, Par::Seq);
+            // Only the lower triangle: the eigensolver reads no more.
+            triangular::matmul(
+                gram.as_mut(),
+                BlockStructure::TriangularLower,
+                Accum::Add,
+                c,
+                BlockStructure::Rectangular,
+                c.transpose(),
+                BlockStructure::Rectangular,
+                1.0,
+                faer::get_global_parallelism(),
+            );
         });
         let eigen = gram
             .self_adjoint_eigen(Side::Lower)
@@ -206,7 +218,7 @@ impl ShapeSpectrum {
                         c.transpose(),
                         scaled.as_ref(),
                         1.0,
-                        Par::Seq,
+                        faer::get_global_parallelism(),
                     );
                 });
             }
