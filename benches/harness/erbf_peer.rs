@@ -127,6 +127,7 @@ fn shape_cases(
     fh: MatRef<'_, f64>,
 ) {
     let names: Vec<String> = (0..f.ncols()).map(|t| format!("y{t}")).collect();
+    bounds(prefix, reps, q.nrows(), f);
     for (label, kind) in [
         ("shapes_cubic", SurrogateKind::Cubic),
         ("shapes_erbf", SurrogateKind::Erbf),
@@ -136,7 +137,12 @@ fn shape_cases(
             ResponseSurrogate::fit_with(space, x, f, names.clone(), &options).unwrap()
         });
         let (pred, _) = time(reps, || model.predict_batch(q).unwrap());
+        let SurrogateModel::Components(components) = model.model() else {
+            panic!("a shape-basis fit gives a component model");
+        };
+        let (coords, _) = time(reps, || components.predict_coordinates(q).unwrap());
         let err = held_out_error(model.predict_batch(xh).unwrap().as_ref(), fh);
+        println!("ours {prefix}{label}_coordinates_1000 {coords:.6}");
         println!("ours {prefix}{label}_fit {fit:.6}");
         println!("ours {prefix}{label}_predict_1000 {pred:.6}");
         println!("ours {prefix}{label}_held_out {err:.6e}");
@@ -154,6 +160,30 @@ fn shape_cases(
         let err = held_out_error(model.predict_batch(xh).unwrap().as_ref(), fh);
         println!("ours {prefix}{label}_held_out {err:.6e}");
     }
+}
+
+/// What any prediction of `q` whole histories costs at least: writing the `q x T` result
+/// (a fresh buffer, as a prediction allocates it), and the `q x N x T` product of the
+/// full-history surrogates (`V^T F`, the step after the basis evaluation).
+fn bounds(prefix: &str, reps: usize, q: usize, f: MatRef<'_, f64>) {
+    let (n, t) = f.shape();
+    let (write, _) = time(reps, || impactcal::erbf::buffer::zeros(q, t));
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let v = Mat::from_fn(n, q, |_, _| rng.random::<f64>());
+    let (product, _) = time(reps, || {
+        let mut out = impactcal::erbf::buffer::zeros(q, t);
+        faer::linalg::matmul::matmul(
+            out.as_mut(),
+            faer::Accum::Replace,
+            v.transpose(),
+            f,
+            1.0,
+            faer::get_global_parallelism(),
+        );
+        out
+    });
+    println!("ours {prefix}bound_write_1000 {write:.6}");
+    println!("ours {prefix}bound_product_1000 {product:.6}");
 }
 
 fn main() {

@@ -194,7 +194,9 @@ fn describe(model: &ResponseSurrogate) -> String {
 
 fn describe_options(o: &ComponentOptions) -> String {
     match o {
-        ComponentOptions::Erbf(e) => format!("erbf r_c={:.3}", e.rc),
+        ComponentOptions::Erbf(e) => {
+            format!("erbf r_c={:.3} smoothing={:.2e}", e.rc, e.smoothing)
+        }
         ComponentOptions::Rbf(r) => {
             let shape = match r.radial {
                 RadialFunction::Gaussian { width } => format!(" width={width:.3}"),

@@ -18,7 +18,7 @@ use crate::erbf::Erbf;
 use crate::error::{ErbfError, Result};
 use crate::loo::LooMethod;
 use crate::rbf::{RbfInterpolant, relative_max_error};
-use crate::shape_basis::{ShapeBasis, choose_count};
+use crate::shape_basis::{ShapeBasis, ShapeSpectrum, choose_count};
 use crate::tuning::{ComponentOptions, candidates, tune};
 
 /// How the outputs are represented for the surrogate.
@@ -164,14 +164,15 @@ impl Components {
     ) -> Result<Self> {
         crate::data::check_training(points, values, Some(space.dim()))?;
         let unit = space.to_unit_matrix(points)?;
-        let (mut shape_basis, coords) = match basis {
+        let (spectrum, coords) = match basis {
             OutputBasis::Full => (None, Mat::<f64>::zeros(0, 0)),
             OutputBasis::Shapes { .. } => {
-                let (b, a) = ShapeBasis::new(values)?;
-                (Some(b), a)
+                let s = ShapeSpectrum::new(values)?;
+                let a = s.coordinates();
+                (Some(s), a)
             }
         };
-        let targets = if shape_basis.is_some() {
+        let targets = if spectrum.is_some() {
             coords.as_ref()
         } else {
             values
@@ -190,7 +191,7 @@ impl Components {
                 (tuned.options, Some(tuned.loo))
             }
         };
-        let count = match (basis, &shape_basis) {
+        let count = match (basis, &spectrum) {
             (OutputBasis::Shapes { count: Some(k) }, Some(b)) => {
                 if k == 0 || k > b.singular_values().len() {
                     return Err(invalid_option::<ErbfError>(
@@ -222,9 +223,10 @@ impl Components {
             }
             _ => targets.ncols(),
         };
-        if let Some(b) = &mut shape_basis {
-            b.truncate(count);
-        }
+        let shape_basis = match &spectrum {
+            Some(s) => Some(s.basis(values, count)?),
+            None => None,
+        };
         let coords = if shape_basis.is_some() {
             coords.subcols(0, count).to_owned()
         } else {
@@ -234,7 +236,7 @@ impl Components {
             space: space.clone(),
             points: points.to_owned(),
             unit,
-            values: values.to_owned(),
+            values: crate::buffer::copy(values),
             basis: shape_basis,
             coords,
             groups: Vec::new(),
@@ -517,15 +519,15 @@ impl<'de> Deserialize<'de> for Components {
             let (basis, coords) = match data.shapes {
                 None => (None, Mat::zeros(0, 0)),
                 Some(k) => {
-                    let (mut b, a) = ShapeBasis::new(values.as_ref())?;
-                    if k == 0 || k > a.ncols() {
+                    let s = ShapeSpectrum::new(values.as_ref())?;
+                    let r = s.singular_values().len();
+                    if k == 0 || k > r {
                         return Err(ErbfError::InvalidModel(format!(
-                            "{k} shapes kept, but the data have {} ",
-                            a.ncols()
+                            "{k} shapes kept, but the data have {r}"
                         )));
                     }
-                    b.truncate(k);
-                    (Some(b), a.subcols(0, k).to_owned())
+                    let b = s.basis(values.as_ref(), k)?;
+                    (Some(b), s.coordinates().subcols(0, k).to_owned())
                 }
             };
             let mut out = Components {

@@ -29,6 +29,10 @@
 //! direct product), solves `R v = w` (`N^2 / 2`), and takes `v^T F` (`N T`). The fit costs
 //! one QR of `A^T` and no work proportional to `T` beyond copying `F`. When `T` is so
 //! small that `b(x)^T c` is cheaper, the model stores `c` instead.
+//!
+//! With [`ErbfOptions::smoothing`] above zero the model stops interpolating and solves the
+//! ridge problem of [`crate::smoothing`]: the solves with `R` become filters on its
+//! singular values.
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
@@ -49,6 +53,7 @@ use crate::loo::LooMethod;
 use crate::options::{ErbfOptions, ValidErbfOptions};
 use crate::projection::Projection;
 use crate::rbf::{condition_number, relative_max_error};
+use crate::smoothing::RSvd;
 use crate::thin_qr::{ThinQr, thin_qr};
 
 /// A fitted ERBF model of `T` outputs over a parameter space of `m` inputs.
@@ -72,6 +77,9 @@ pub struct Erbf {
     /// prediction (see [`direct_is_cheaper`]).
     coef: Option<Mat<f64>>,
     r_ratio: f64,
+    /// With smoothing: the SVD of `R` and the absolute ridge `lambda`
+    /// ([`crate::smoothing`]).
+    smoother: Option<Box<(RSvd, f64)>>,
 }
 
 impl Erbf {
@@ -95,7 +103,7 @@ impl Erbf {
     ///
     /// And [`ErbfError::DuplicateSamples`] for two samples closer than the tolerance in
     /// scaled inputs, naming both; [`ErbfError::Singular`] when `min |R_ii| / max |R_ii|`
-    /// falls below `N eps`.
+    /// falls below `N eps` without smoothing (with smoothing the problem stays well posed).
     pub fn fit(
         space: &ParameterSpace,
         points: MatRef<'_, f64>,
@@ -107,14 +115,15 @@ impl Erbf {
         let unit = space.to_unit_matrix(points)?;
         reject_duplicates(unit.as_ref(), options.duplicate_tolerance)?;
         let t = values.ncols();
-        let mean: Vec<f64> = if options.center_outputs {
+        let centre = options.center_outputs || options.smoothing > 0.0;
+        let mean: Vec<f64> = if centre {
             (0..t)
                 .map(|c| values.col(c).iter().sum::<f64>() / values.nrows() as f64)
                 .collect()
         } else {
             vec![0.0; t]
         };
-        let centred = options.center_outputs.then(|| {
+        let centred = centre.then(|| {
             let mut f = buffer::copy(values);
             for (col, &m) in f.col_iter_mut().zip(&mean) {
                 col.iter_mut().for_each(|v| *v -= m);
@@ -122,9 +131,16 @@ impl Erbf {
             f
         });
         let factor = Factor::new(unit.as_ref(), &options, true)?;
+        let smoother = if options.smoothing > 0.0 {
+            let svd = RSvd::new(factor.r.as_ref())?;
+            let lambda = svd.lambda(options.smoothing);
+            Some(Box::new((svd, lambda)))
+        } else {
+            None
+        };
         let coef = direct_is_cheaper(unit.nrows(), unit.ncols(), t, options.gamma).then(|| {
             let mut z = centred.as_ref().map_or(values, |f| f.as_ref()).to_owned();
-            solve_lower_triangular_in_place(factor.r.transpose(), z.as_mut(), par());
+            solve_rt(factor.r.as_ref(), smoother.as_deref(), z.as_mut());
             &factor.q1 * &z
         });
         let projection = Projection::new(factor.q1, unit.as_ref(), &options);
@@ -140,6 +156,7 @@ impl Erbf {
             centred,
             coef,
             r_ratio: factor.ratio,
+            smoother,
         })
     }
 
@@ -234,7 +251,7 @@ impl Erbf {
     /// `Z = R^{-T} F` (`N x T`), formed on demand.
     fn z(&self) -> Mat<f64> {
         let mut z = self.responses().to_owned();
-        solve_lower_triangular_in_place(self.r.transpose(), z.as_mut(), par());
+        solve_rt(self.r.as_ref(), self.smoother.as_deref(), z.as_mut());
         z
     }
 
@@ -324,7 +341,7 @@ impl Erbf {
                         let len = cols.ncols();
                         let u = &unit[k * CHUNK * m..(k * CHUNK + len) * m];
                         self.projection.project(u, cols.as_mut());
-                        solve_upper_triangular_in_place(self.r.as_ref(), cols, Par::Seq);
+                        solve_r(self.r.as_ref(), self.smoother.as_deref(), cols);
                     });
                 matmul(
                     out.as_mut(),
@@ -396,6 +413,9 @@ impl Erbf {
         };
         let f = self.responses();
         if !exact {
+            if let Some((svd, lambda)) = self.smoother.as_deref() {
+                return svd.loo(*lambda, f);
+            }
             // alpha = G^{-1} F = R^{-1} Z; (G^{-1})_kk = |row k of R^{-1}|^2.
             let mut rinv = Mat::<f64>::identity(n, n);
             solve_upper_triangular_in_place(self.r.as_ref(), rinv.as_mut(), par());
@@ -415,9 +435,17 @@ impl Erbf {
                     .map_err(|e| undefined(e.to_string()))?;
                 let uk = Mat::from_fn(1, self.dim(), |_, j| self.unit[(k, j)]);
                 let b = basis_matrix_t(uk.as_ref(), unit.as_ref(), &self.options);
-                // w = R^{-1} Q_1^T b, so that f^{(-k)}(x_k) = F_{-k}^T w.
+                // w = R^{-1} Q_1^T b (filtered with smoothing, the same lambda), so that
+                // f^{(-k)}(x_k) = F_{-k}^T w.
                 let mut w = factor.q1.transpose() * &b;
-                solve_upper_triangular_in_place(factor.r.as_ref(), w.as_mut(), Par::Seq);
+                let smoother = match self.smoother.as_deref() {
+                    Some((_, lambda)) => Some((
+                        RSvd::new(factor.r.as_ref()).map_err(|e| undefined(e.to_string()))?,
+                        *lambda,
+                    )),
+                    None => None,
+                };
+                solve_r(factor.r.as_ref(), smoother.as_ref(), w.as_mut());
                 let fk = without_row(f.as_ref(), k);
                 Ok((0..t)
                     .map(|c| {
@@ -430,8 +458,31 @@ impl Erbf {
         collect_rows(rows, t)
     }
 
+    /// The SVD of this fit's triangular factor, which scores every smoothing with
+    /// [`loo_smoothed`](Self::loo_smoothed).
+    pub(crate) fn r_svd(&self) -> Result<RSvd> {
+        match self.smoother.as_deref() {
+            Some((svd, _)) => Ok(svd.clone()),
+            None => RSvd::new(self.r.as_ref()),
+        }
+    }
+
+    /// Closed-form (kernel-view) leave-one-out errors of the model with the same basis and
+    /// `smoothing > 0` instead of this fit's: centred outputs, `svd` from
+    /// [`r_svd`](Self::r_svd). Equal to `loo_errors(LooMethod::Closed)` of that model,
+    /// without refitting it.
+    pub(crate) fn loo_smoothed(&self, svd: &RSvd, smoothing: f64) -> Result<Mat<f64>> {
+        let (n, t) = self.values.shape();
+        let mut f = self.values.clone();
+        for c in 0..t {
+            let m = f.col(c).iter().sum::<f64>() / n as f64;
+            f.col_mut(c).iter_mut().for_each(|v| *v -= m);
+        }
+        svd.loo(svd.lambda(smoothing), f.as_ref())
+    }
+
     /// `max_k |f(x_k) - F_k| / max |F|` over all outputs: the reproduction error of the
-    /// training data (near `1e-14` for a well-posed fit).
+    /// training data (near `1e-14` for a well-posed fit without smoothing).
     pub fn training_residual(&self) -> f64 {
         match self.predict_batch(self.points.as_ref()) {
             Ok(p) => relative_max_error(p.as_ref(), self.values.as_ref()),
@@ -446,7 +497,7 @@ impl Erbf {
             Some(c) => matmul(out, Accum::Replace, bt.transpose(), c.as_ref(), 1.0, par()),
             None => {
                 let mut v = self.projection.q1().transpose() * bt;
-                solve_upper_triangular_in_place(self.r.as_ref(), v.as_mut(), Par::Seq);
+                solve_r(self.r.as_ref(), self.smoother.as_deref(), v.as_mut());
                 matmul(
                     out,
                     Accum::Replace,
@@ -457,6 +508,22 @@ impl Erbf {
                 );
             }
         }
+    }
+}
+
+/// `w <- R^{-1} w`, or its filtered form with smoothing ([`RSvd::solve`]).
+fn solve_r(r: MatRef<'_, f64>, smoother: Option<&(RSvd, f64)>, w: faer::MatMut<'_, f64>) {
+    match smoother {
+        Some((svd, lambda)) => svd.solve(*lambda, w),
+        None => solve_upper_triangular_in_place(r, w, Par::Seq),
+    }
+}
+
+/// `z <- R^{-T} z`, or its filtered form with smoothing ([`RSvd::solve_transpose`]).
+fn solve_rt(r: MatRef<'_, f64>, smoother: Option<&(RSvd, f64)>, z: faer::MatMut<'_, f64>) {
+    match smoother {
+        Some((svd, lambda)) => svd.solve_transpose(*lambda, z),
+        None => solve_lower_triangular_in_place(r.transpose(), z, par()),
     }
 }
 
@@ -497,7 +564,8 @@ impl Factor {
         }
         let ratio = if hi > 0.0 { lo / hi } else { 0.0 };
         let threshold = n as f64 * f64::EPSILON;
-        if ratio.is_nan() || ratio <= threshold {
+        // With smoothing a (near-)singular kernel matrix is well posed.
+        if ratio.is_nan() || (ratio <= threshold && options.smoothing <= 0.0) {
             return Err(ErbfError::Singular { ratio, threshold });
         }
         Ok(Factor { q1, r, ratio })

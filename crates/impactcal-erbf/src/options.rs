@@ -46,6 +46,13 @@ pub struct ErbfOptions {
     /// Two samples closer than this (Euclidean distance in unit-scaled inputs) are
     /// rejected as duplicates.
     pub duplicate_tolerance: f64,
+    /// Smoothing: a ridge `lambda = smoothing tr(A A^T) / N` on the coefficients, so that
+    /// the fit minimises `||A c - F||^2 + lambda ||c||^2` instead of interpolating; `0`
+    /// (the default, the original method) interpolates. With smoothing the outputs are
+    /// centred whatever [`center_outputs`](Self::center_outputs) says. Finite,
+    /// non-negative.
+    #[serde(default)]
+    pub smoothing: f64,
 }
 
 impl Default for ErbfOptions {
@@ -57,6 +64,7 @@ impl Default for ErbfOptions {
             weights: FamilyWeights::default(),
             center_outputs: false,
             duplicate_tolerance: 1e-9,
+            smoothing: 0.0,
         }
     }
 }
@@ -68,8 +76,8 @@ impl ParamGuard for ErbfOptions {
     ///
     /// # Errors
     /// [`CoreError::InvalidOption`] for an odd order or one below 2, a `gamma` or `r_c`
-    /// that is not finite and positive, a negative or non-finite family weight or
-    /// duplicate tolerance, or all weights zero.
+    /// that is not finite and positive, a negative or non-finite family weight, duplicate
+    /// tolerance or smoothing, or all weights zero.
     fn check_ref(&self) -> impactcal_core::Result<()> {
         let bad = |name: &'static str, value: String, message: &str| {
             Err(CoreError::invalid_option(name, value, message))
@@ -92,6 +100,7 @@ impl ParamGuard for ErbfOptions {
             ("left/right weight", w.left_right),
             ("beta weight", w.beta),
             ("duplicate tolerance", self.duplicate_tolerance),
+            ("smoothing", self.smoothing),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v.to_string(), "must be finite and non-negative");

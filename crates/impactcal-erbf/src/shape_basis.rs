@@ -18,16 +18,26 @@
 //! reports and [`choose_count`] keeps below the surrogate's own leave-one-out error.
 
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef};
+use faer::linalg::matmul::triangular::{self, BlockStructure};
+use faer::{Accum, Mat, MatRef, Side};
 use impactcal_shapes::{ImpactShapes, ShapeOptions, SvdMethod, Truncation};
 
 use crate::buffer;
-use crate::error::Result;
+use crate::error::{ErbfError, Result};
+use impactcal_core::{CoreError, check_finite_mat};
 
 /// How far below the surrogate's own leave-one-out error the truncation error must stay
 /// when the shape count is chosen automatically: `0.25`, so that the truncation adds at
 /// most `sqrt(1 + 0.25^2) - 1 = 3 %` to the error of the history (the two are orthogonal).
 pub const TRUNCATION_RATIO: f64 = 0.25;
+
+/// Histories of at least this many samples per run (`T >= GRAM_RATIO N`) are decomposed
+/// through the `N x N` Gram matrix of the runs ([`ShapeSpectrum`]); shorter ones by the
+/// full thin SVD.
+pub const GRAM_RATIO: usize = 2;
+
+/// Time samples per block when the deviations from the mean are formed on the fly.
+const BLOCK: usize = 2048;
 
 /// The mean history and impact shapes (time functions) of an ensemble of histories.
 #[derive(Debug, Clone)]
@@ -43,22 +53,104 @@ pub struct ShapeBasis {
     total: f64,
 }
 
-impl ShapeBasis {
-    /// Decomposes the training outputs `values` (`N x T`) and returns the basis with every
-    /// shape up to the numerical rank `r` of the deviations (at least one), and the
-    /// training coordinates `A` (`N x r`, `A_ki = sigma_i u_ki`).
-    ///
-    /// Cost: one thin SVD of an `N x T` matrix, `O(N^2 T)`.
+/// The spectrum of an ensemble before the shape count is chosen: mean history, singular
+/// values and run coordinates of every resolved shape, without the `T`-long time functions
+/// (which [`ShapeSpectrum::basis`] computes for the shapes kept only).
+///
+/// For long histories (`T >= GRAM_RATIO N`) it is the method of snapshots: with the
+/// deviations `C = F - 1 f_bar^T` (`N x T`, formed block by block, never stored), the Gram
+/// matrix `K = C C^T = U diag(sigma^2) U^T` (`N x N`, `O(N^2 T)`) gives the singular values
+/// and the left singular vectors `U`, hence the coordinates `A = U diag(sigma)`; the time
+/// functions of the `k` shapes kept are `G_k = C^T U_k diag(sigma_k)^{-1}` (`O(N k T)`).
+/// Whatever the accuracy of `U`, the rebuilt training runs
+/// `1 f_bar^T + A_k G_k^T = 1 f_bar^T + U_k U_k^T C` are the exact orthogonal projection of
+/// the runs onto the `k` coordinates. Squaring `C` costs precision for weak shapes only:
+/// eigenvalues of `K` are accurate to about `eps sigma_1^2`, so shapes with
+/// `sigma_i^2 <= 10 N eps sigma_1^2` (`sigma_i / sigma_1` below about `4e-7` for `N = 100`)
+/// are treated as numerically zero; truncation errors below that level are not resolved.
+/// Shorter histories use the full thin SVD of `C`, which resolves down to
+/// `max(N, T) eps sigma_1`.
+#[derive(Debug, Clone)]
+pub struct ShapeSpectrum {
+    mean: Vec<f64>,
+    sigma: Vec<f64>,
+    /// `U` (`N x r`), orthonormal columns, signs fixed as in
+    /// [`ImpactShapes`] (the largest-magnitude entry of each column positive).
+    left: Mat<f64>,
+    /// The time functions of every shape when the full SVD computed them (`T x r`).
+    functions: Option<Mat<f64>>,
+    total: f64,
+}
+
+impl ShapeSpectrum {
+    /// Decomposes the training outputs `values` (`N x T`): mean history, singular values of
+    /// the deviations up to the numerical rank `r` (at least one) and the left singular
+    /// vectors. Cost `O(N^2 T)` (one `N x N x T` product for long histories).
     ///
     /// # Errors
-    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) or
-    /// [`CoreError::Empty`](impactcal_core::CoreError::Empty) (under
-    /// [`ErbfError::Shapes`](crate::ErbfError::Shapes)) for bad data; a failed SVD.
-    pub fn new(values: MatRef<'_, f64>) -> Result<(Self, Mat<f64>)> {
+    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) naming the entry or
+    /// [`CoreError::Empty`](impactcal_core::CoreError::Empty) for bad data;
+    /// [`ShapesError::NoConvergence`](impactcal_shapes::ShapesError::NoConvergence) (under
+    /// [`ErbfError::Shapes`]) when the eigen- or singular value decomposition fails.
+    pub fn new(values: MatRef<'_, f64>) -> Result<Self> {
         let (n, t) = values.shape();
+        if n == 0 || t == 0 {
+            return Err(CoreError::Empty {
+                what: "outputs of the shape basis".into(),
+            }
+            .into());
+        }
+        check_finite_mat("outputs of the shape basis", values)?;
         let mean: Vec<f64> = (0..t)
             .map(|c| values.col(c).iter().sum::<f64>() / n.max(1) as f64)
             .collect();
+        if t < GRAM_RATIO * n {
+            return Self::by_svd(values, mean);
+        }
+        let mut gram = Mat::<f64>::zeros(n, n);
+        let mut total = 0.0;
+        for_centred_blocks(values, &mean, |_, c| {
+            total += c.squared_norm_l2();
+            // Only the lower triangle: the eigensolver reads no more.
+            triangular::matmul(
+                gram.as_mut(),
+                BlockStructure::TriangularLower,
+                Accum::Add,
+                c,
+                BlockStructure::Rectangular,
+                c.transpose(),
+                BlockStructure::Rectangular,
+                1.0,
+                faer::get_global_parallelism(),
+            );
+        });
+        let eigen = gram
+            .self_adjoint_eigen(Side::Lower)
+            .map_err(|_| ErbfError::Shapes(impactcal_shapes::ShapesError::NoConvergence))?;
+        let lambda = eigen.S().column_vector();
+        let vectors = eigen.U();
+        let top = lambda.iter().copied().fold(0.0_f64, f64::max);
+        let floor = 10.0 * n as f64 * f64::EPSILON * top;
+        // Eigenvalues come in non-decreasing order: walk them from the top.
+        let order: Vec<usize> = (0..n)
+            .rev()
+            .filter(|&i| lambda[i] > floor && lambda[i] > 0.0)
+            .collect();
+        let order = if order.is_empty() { vec![n - 1] } else { order };
+        let sigma: Vec<f64> = order.iter().map(|&i| lambda[i].max(0.0).sqrt()).collect();
+        let mut left = Mat::from_fn(n, order.len(), |k, j| vectors[(k, order[j])]);
+        fix_signs(left.as_mut());
+        Ok(ShapeSpectrum {
+            mean,
+            sigma,
+            left,
+            functions: None,
+            total,
+        })
+    }
+
+    /// The full thin SVD of the deviations (short histories).
+    fn by_svd(values: MatRef<'_, f64>, mean: Vec<f64>) -> Result<Self> {
         let mut centred = buffer::copy(values);
         for (col, &m) in centred.col_iter_mut().zip(&mean) {
             col.iter_mut().for_each(|v| *v -= m);
@@ -69,19 +161,138 @@ impl ShapeBasis {
             method: SvdMethod::Full,
         };
         let shapes = ImpactShapes::from_matrix(centred.as_ref(), &options)?;
-        let sigma = shapes.singular_values().to_vec();
-        let u = shapes.shapes();
-        let coords = Mat::from_fn(n, sigma.len(), |k, i| sigma[i] * u[(k, i)]);
-        let g = shapes.time_functions();
-        let r = g.ncols();
-        let functions = Mat::from_fn(t, r + 1, |i, j| if j < r { g[(i, j)] } else { mean[i] });
-        let basis = ShapeBasis {
+        Ok(ShapeSpectrum {
             mean,
-            functions,
-            sigma,
+            sigma: shapes.singular_values().to_vec(),
+            left: shapes.shapes().to_owned(),
+            functions: Some(shapes.time_functions().to_owned()),
             total,
-        };
-        Ok((basis, coords))
+        })
+    }
+
+    /// Singular values of the deviations up to the numerical rank, non-increasing.
+    pub fn singular_values(&self) -> &[f64] {
+        &self.sigma
+    }
+
+    /// The coordinates of the training runs on every shape, `A = U diag(sigma)` (`N x r`).
+    pub fn coordinates(&self) -> Mat<f64> {
+        Mat::from_fn(self.left.nrows(), self.sigma.len(), |k, i| {
+            self.sigma[i] * self.left[(k, i)]
+        })
+    }
+
+    /// The basis of the first `k` shapes (`k` clamped to `1..=r`), their time functions
+    /// computed from `values`, the same `N x T` outputs the spectrum was made from
+    /// (`O(N k T)`).
+    ///
+    /// # Errors
+    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when
+    /// `values` is not `N x T`.
+    pub fn basis(&self, values: MatRef<'_, f64>, k: usize) -> Result<ShapeBasis> {
+        let (n, t) = (self.left.nrows(), self.mean.len());
+        if values.shape() != (n, t) {
+            return Err(impactcal_core::error::dimension_mismatch(
+                "outputs of the shape basis (N x T)",
+                n * t,
+                values.nrows() * values.ncols(),
+            ));
+        }
+        let k = k.clamp(1, self.sigma.len().max(1));
+        let mut functions = Mat::<f64>::zeros(t, k + 1);
+        match &self.functions {
+            Some(g) => functions
+                .as_mut()
+                .subcols_mut(0, k)
+                .copy_from(g.subcols(0, k)),
+            None => {
+                // G_k = C^T U_k diag(sigma_k)^{-1}, block of samples by block.
+                let mut scaled = self.left.subcols(0, k).to_owned();
+                for (j, s) in self.sigma[..k].iter().enumerate() {
+                    scaled.col_mut(j).iter_mut().for_each(|v| *v /= s);
+                }
+                for_centred_blocks(values, &self.mean, |start, c| {
+                    matmul(
+                        functions.as_mut().submatrix_mut(start, 0, c.ncols(), k),
+                        Accum::Replace,
+                        c.transpose(),
+                        scaled.as_ref(),
+                        1.0,
+                        faer::get_global_parallelism(),
+                    );
+                });
+            }
+        }
+        functions
+            .col_mut(k)
+            .iter_mut()
+            .zip(&self.mean)
+            .for_each(|(g, m)| *g = *m);
+        Ok(ShapeBasis {
+            mean: self.mean.clone(),
+            functions,
+            sigma: self.sigma.clone(),
+            total: self.total,
+        })
+    }
+}
+
+/// Calls `f(start, C_b)` for consecutive blocks of at most [`BLOCK`] time samples of the
+/// deviations `C = F - 1 f_bar^T`, formed in one reused `N x BLOCK` buffer.
+fn for_centred_blocks(
+    values: MatRef<'_, f64>,
+    mean: &[f64],
+    mut f: impl FnMut(usize, MatRef<'_, f64>),
+) {
+    let (n, t) = values.shape();
+    let mut block = Mat::<f64>::zeros(n, BLOCK.min(t));
+    let mut start = 0;
+    while start < t {
+        let len = BLOCK.min(t - start);
+        let mut b = block.as_mut().subcols_mut(0, len);
+        for j in 0..len {
+            let m = mean[start + j];
+            b.as_mut()
+                .col_mut(j)
+                .iter_mut()
+                .zip(values.col(start + j).iter())
+                .for_each(|(d, v)| *d = v - m);
+        }
+        f(start, block.as_ref().subcols(0, len));
+        start += len;
+    }
+}
+
+/// Makes the largest-magnitude entry of every column of `u` positive (the first on ties),
+/// the rule of [`ImpactShapes`]; the time functions, computed from `u`, follow.
+fn fix_signs(mut u: faer::MatMut<'_, f64>) {
+    for j in 0..u.ncols() {
+        let mut best = 0.0f64;
+        let mut sign = 1.0;
+        for &x in u.as_ref().col(j).iter() {
+            if x.abs() > best {
+                best = x.abs();
+                sign = x.signum();
+            }
+        }
+        if sign < 0.0 {
+            u.as_mut().col_mut(j).iter_mut().for_each(|x| *x = -*x);
+        }
+    }
+}
+
+impl ShapeBasis {
+    /// Decomposes the training outputs `values` (`N x T`) and returns the basis with every
+    /// shape up to the numerical rank `r` of the deviations (at least one), and the
+    /// training coordinates `A` (`N x r`, `A_ki = sigma_i u_ki`): [`ShapeSpectrum::new`]
+    /// then [`ShapeSpectrum::basis`] with all `r` shapes.
+    ///
+    /// # Errors
+    /// As [`ShapeSpectrum::new`].
+    pub fn new(values: MatRef<'_, f64>) -> Result<(Self, Mat<f64>)> {
+        let spectrum = ShapeSpectrum::new(values)?;
+        let basis = spectrum.basis(values, spectrum.singular_values().len())?;
+        Ok((basis, spectrum.coordinates()))
     }
 
     /// Number of shapes kept `k`.
@@ -243,6 +454,81 @@ mod tests {
             one.truncation_error(1),
             max_relative = 1e-10
         );
+    }
+
+    /// An `N x T` ensemble around a mean history whose deviations have the singular values
+    /// `10^(-i/2)`, `i = 0..N` (so the weaker half is below what the Gram route resolves).
+    fn graded_ensemble(n: usize, t: usize) -> Mat<f64> {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut random = |r: usize, c: usize| Mat::from_fn(r, c, |_, _| rng.random::<f64>() - 0.5);
+        // Orthonormal columns, each orthogonal to the constant vector so that the mean of
+        // the runs is exactly the mean history added below.
+        let mut p = random(n, n - 1);
+        for j in 0..n - 1 {
+            let m = p.col(j).iter().sum::<f64>() / n as f64;
+            p.col_mut(j).iter_mut().for_each(|v| *v -= m);
+        }
+        let p = p.qr().compute_thin_Q();
+        let q = random(t, n - 1).qr().compute_thin_Q();
+        let mut ps = p.clone();
+        for (j, col) in ps.col_iter_mut().enumerate() {
+            let s = 10f64.powf(-(j as f64) / 2.0);
+            col.iter_mut().for_each(|v| *v *= s);
+        }
+        let mut f = &ps * q.transpose();
+        for (j, col) in f.col_iter_mut().enumerate() {
+            let m = 5.0 + (j as f64 * 0.01).sin();
+            col.iter_mut().for_each(|v| *v += m);
+        }
+        f
+    }
+
+    /// The Gram route (method of snapshots) and the full thin SVD agree: singular values to
+    /// `1e-10 sigma_1`, the time functions of the kept shapes to `1e-8`, the rebuilt runs
+    /// to `1e-10` relative; the training runs are rebuilt to the truncation error.
+    #[test]
+    fn gram_route_matches_the_full_svd() {
+        let (n, t, k) = (30, 600, 8);
+        let f = graded_ensemble(n, t);
+        let mean: Vec<f64> = (0..t)
+            .map(|c| f.col(c).iter().sum::<f64>() / n as f64)
+            .collect();
+        let gram = ShapeSpectrum::new(f.as_ref()).unwrap();
+        assert!(gram.functions.is_none(), "T >= 2 N takes the Gram route");
+        let svd = ShapeSpectrum::by_svd(f.as_ref(), mean).unwrap();
+        let (sg, ss) = (gram.singular_values(), svd.singular_values());
+        // The Gram route resolves sigma_i / sigma_1 down to about sqrt(10 N eps) = 2.6e-7.
+        assert!((12..=14).contains(&sg.len()), "{} resolved", sg.len());
+        for (a, b) in sg.iter().zip(ss) {
+            assert!((a - b).abs() <= 1e-10 * ss[0], "{a} vs {b}");
+        }
+        let bg = gram.basis(f.as_ref(), k).unwrap();
+        let bs = svd.basis(f.as_ref(), k).unwrap();
+        let (gg, gs) = (bg.functions(), bs.functions());
+        for j in 0..k {
+            for i in 0..t {
+                assert_relative_eq!(gg[(i, j)], gs[(i, j)], epsilon = 1e-8);
+            }
+        }
+        let rg = bg.rebuild(gram.coordinates().as_ref());
+        let rs = bs.rebuild(svd.coordinates().as_ref());
+        let centred_norm = bs.total.sqrt();
+        assert!((&rg - &rs).norm_l2() <= 1e-10 * centred_norm);
+        // Training runs back to the truncation error (the orthogonal projection).
+        let miss = (&rg - &f).norm_l2() / centred_norm;
+        assert_relative_eq!(miss, bg.truncation_error(k), max_relative = 1e-6);
+        assert_relative_eq!(bg.truncation_error(k), 10f64.powi(-4), max_relative = 0.01);
+    }
+
+    #[test]
+    fn bad_outputs_are_named() {
+        let mut f = graded_ensemble(6, 40);
+        f[(2, 17)] = f64::NAN;
+        let e = ShapeSpectrum::new(f.as_ref()).unwrap_err();
+        assert!(e.to_string().contains("row 2"), "{e}");
+        let empty = Mat::<f64>::zeros(0, 5);
+        assert!(ShapeSpectrum::new(empty.as_ref()).is_err());
     }
 
     #[test]

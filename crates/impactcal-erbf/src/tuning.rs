@@ -16,11 +16,15 @@
 //!   `phi_max 10^p`, `p = -9..=2`, with `phi_max` the largest `|phi(r)|` over the sample
 //!   distances: from interpolation to the limit where the kernel part vanishes and only
 //!   the least-squares polynomial tail is left;
-//! - ERBF radii `r_c = h 2^j`, `j = -2..=4` (ERBF has no smoothing term).
+//! - ERBF radii `r_c = h 2^j`, `j = -2..=4`, each with the smoothing `0` and `10^p`,
+//!   `p = -9..=2`, relative to the mean diagonal of ERBF's kernel matrix
+//!   ([`ErbfOptions::smoothing`]), all with centred outputs (which smoothing implies) so
+//!   that the candidates differ only in radius and smoothing.
 //!
 //! Classic RBF candidates are scored by Rippa's exact closed form (valid with smoothing);
 //! ERBF candidates by ERBF's closed-form kernel-view approximation, which is cheap but only
-//! approximate. Smaller smoothing wins ties, so data without noise stays interpolated.
+//! approximate (one factorisation and one SVD per radius serve all its smoothings,
+//! [`crate::smoothing`]). Smaller smoothing wins ties, so data without noise stays interpolated.
 
 use faer::{Mat, MatRef};
 use impactcal_core::ParameterSpace;
@@ -31,6 +35,7 @@ use crate::loo::LooMethod;
 use crate::options::ErbfOptions;
 use crate::radial::RadialFunction;
 use crate::rbf::{RbfInterpolant, RbfOptions};
+use crate::smoothing::RSvd;
 
 /// The options of one component surrogate: a family and its parameters.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -83,10 +88,14 @@ pub fn candidates(base: ComponentOptions, unit: MatRef<'_, f64>) -> Vec<Componen
     let h = median_spacing(unit);
     match base {
         ComponentOptions::Erbf(o) => (-2..=4)
-            .map(|j| {
-                ComponentOptions::Erbf(ErbfOptions {
-                    rc: h * 2f64.powi(j),
-                    ..o
+            .flat_map(|j| {
+                smoothing_grid(1.0).map(move |smoothing| {
+                    ComponentOptions::Erbf(ErbfOptions {
+                        rc: h * 2f64.powi(j),
+                        smoothing,
+                        center_outputs: true,
+                        ..o
+                    })
                 })
             })
             .collect(),
@@ -112,9 +121,7 @@ pub fn candidates(base: ComponentOptions, unit: MatRef<'_, f64>) -> Vec<Componen
                     .abs()
                     .max(radial.value(dmax).abs())
                     .max(f64::MIN_POSITIVE);
-                let smoothing =
-                    std::iter::once(0.0).chain((-9..=2).map(|p| phi_max * 10f64.powi(p)));
-                for s in smoothing {
+                for s in smoothing_grid(phi_max) {
                     out.push(ComponentOptions::Rbf(RbfOptions {
                         radial,
                         smoothing: s,
@@ -147,8 +154,15 @@ pub fn tune(
     let mut best: Option<Tuned> = None;
     let mut best_sse = vec![f64::INFINITY; t];
     let mut first_error = None;
+    let mut erbf_cache = ErbfCache::default();
     for &candidate in candidates {
-        let loo = match candidate_loo(space, points, unit.as_ref(), values, candidate) {
+        let loo = match candidate {
+            ComponentOptions::Erbf(o) => erbf_cache.loo(space, points, values, o),
+            ComponentOptions::Rbf(_) => {
+                candidate_loo(space, points, unit.as_ref(), values, candidate)
+            }
+        };
+        let loo = match loo {
             Ok(e) => e,
             Err(e) => {
                 first_error.get_or_insert(e);
@@ -187,6 +201,53 @@ pub fn tune(
     }
 }
 
+/// The last ERBF fit and the SVD of its factor, reused for the candidates that differ from
+/// it only in their smoothing (one factorisation per radius).
+#[derive(Default)]
+struct ErbfCache {
+    fitted: Option<(ErbfOptions, Erbf, Option<RSvd>)>,
+}
+
+impl ErbfCache {
+    /// Closed-form LOO errors of ERBF with options `o`.
+    fn loo(
+        &mut self,
+        space: &ParameterSpace,
+        points: MatRef<'_, f64>,
+        values: MatRef<'_, f64>,
+        o: ErbfOptions,
+    ) -> Result<Mat<f64>> {
+        let key = ErbfOptions {
+            smoothing: 0.0,
+            ..o
+        };
+        match &mut self.fitted {
+            Some((k, model, svd)) if *k == key => {
+                if model.options().smoothing.to_bits() == o.smoothing.to_bits() {
+                    return model.loo_errors(LooMethod::Closed);
+                }
+                if o.smoothing == 0.0 {
+                    return Erbf::fit(space, points, values, o)?.loo_errors(LooMethod::Closed);
+                }
+                let factor_svd = match svd.take() {
+                    Some(s) => s,
+                    None => model.r_svd()?,
+                };
+                let loo = model.loo_smoothed(&factor_svd, o.smoothing);
+                *svd = Some(factor_svd);
+                loo
+            }
+            _ => {
+                self.fitted = None;
+                let model = Erbf::fit(space, points, values, o)?;
+                let loo = model.loo_errors(LooMethod::Closed);
+                self.fitted = Some((key, model, None));
+                loo
+            }
+        }
+    }
+}
+
 /// LOO errors of one candidate (`N x T`).
 fn candidate_loo(
     space: &ParameterSpace,
@@ -203,6 +264,11 @@ fn candidate_loo(
             RbfInterpolant::fit(unit, values, o)?.loo_errors(LooMethod::Closed)
         }
     }
+}
+
+/// `0` and `unit 10^p`, `p = -9..=2`, least smoothing first.
+fn smoothing_grid(unit: f64) -> impl Iterator<Item = f64> {
+    std::iter::once(0.0).chain((-9..=2).map(move |p| unit * 10f64.powi(p)))
 }
 
 fn diameter(unit: MatRef<'_, f64>) -> f64 {

@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use approx::assert_relative_eq;
+use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef};
 use impactcal_core::{CoreError, Parameter, ParameterSpace};
 use impactcal_erbf::{Accuracy, Erbf, ErbfError, ErbfOptions, LooMethod};
@@ -522,5 +523,71 @@ fn tiny_designs_with_long_outputs() {
         let q = to_raw(&space, random_unit(7, 3, 22).as_ref());
         let p = model.predict_batch(q.as_ref()).unwrap();
         assert!(p.col_iter().all(|c| c.iter().all(|v| v.is_finite())));
+    }
+}
+
+/// With smoothing the fit solves the ridge problem `min ||A c - F_c||^2 + lambda ||c||^2`
+/// on centred outputs (`lambda = smoothing tr(A A^T) / N`): its stationarity condition
+/// `A^T (F_c - A c) = lambda c` holds; its closed-form leave-one-out errors equal explicit
+/// kernel ridge refits with the kernel matrix `G = A A^T` held fixed; and the exact refits
+/// (`LooMethod::Refit`) lie close to them.
+#[test]
+fn smoothing_solves_the_ridge_problem_and_its_loo_is_exact() {
+    let (n, m) = (25, 2);
+    let u = random_unit(n, m, 17);
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let f = Mat::from_fn(n, 2, |i, c| {
+        (3.0 * u[(i, 0)]).sin() + c as f64 * u[(i, 1)] + 0.1 * (rng.random::<f64>() - 0.5)
+    });
+    let smoothing = 1e-2;
+    let opts = ErbfOptions {
+        smoothing,
+        ..ErbfOptions::default()
+    };
+    let e = Erbf::fit(&unit_space(m), u.as_ref(), f.as_ref(), opts).unwrap();
+    let a = e.interpolation_matrix();
+    let g = &a * a.transpose();
+    let lambda = smoothing * (0..n).map(|k| g[(k, k)]).sum::<f64>() / n as f64;
+    let mut fc = f.clone();
+    for c in 0..2 {
+        let mean = f.col(c).iter().sum::<f64>() / n as f64;
+        fc.col_mut(c).iter_mut().for_each(|v| *v -= mean);
+    }
+    let c = e.coefficients();
+    let lhs = a.transpose() * (&fc - &a * &c);
+    let rhs = &c * lambda;
+    assert!(
+        (&lhs - &rhs).norm_max() <= 1e-9 * rhs.norm_max(),
+        "ridge condition"
+    );
+    // The fit no longer interpolates.
+    assert!(e.training_residual() > 1e-4);
+    // Kernel ridge refits without each sample, G fixed.
+    let loo = e.loo_errors(LooMethod::Closed).unwrap();
+    for k in 0..n {
+        let keep: Vec<usize> = (0..n).filter(|&i| i != k).collect();
+        let gk = Mat::from_fn(n - 1, n - 1, |i, j| {
+            g[(keep[i], keep[j])] + if i == j { lambda } else { 0.0 }
+        });
+        let fk = Mat::from_fn(n - 1, 2, |i, c| fc[(keep[i], c)]);
+        let alpha = gk.partial_piv_lu().solve(&fk);
+        for c in 0..2 {
+            let pred: f64 = (0..n - 1).map(|i| g[(k, keep[i])] * alpha[(i, c)]).sum();
+            assert_relative_eq!(loo[(k, c)], fc[(k, c)] - pred, epsilon = 1e-8);
+        }
+    }
+    let refit = e.loo_errors(LooMethod::Refit).unwrap();
+    let gap = (&refit - &loo).norm_l2() / loo.norm_l2();
+    assert!(gap < 0.5, "refit and kernel-view LOO differ by {gap}");
+    // Bad smoothing is refused.
+    for bad in [-1.0, f64::NAN, f64::INFINITY] {
+        let o = ErbfOptions {
+            smoothing: bad,
+            ..ErbfOptions::default()
+        };
+        assert!(matches!(
+            Erbf::fit(&unit_space(m), u.as_ref(), f.as_ref(), o),
+            Err(ErbfError::Core(CoreError::InvalidOption { .. }))
+        ));
     }
 }
