@@ -64,7 +64,7 @@ pub struct Args {
     #[arg(long)]
     pub close_loop: bool,
     /// Closed loop: simulated time (s).
-    #[arg(long, default_value_t = END_TIME)]
+    #[arg(long, default_value_t = crate::demo_loop::END_TIME)]
     pub end_time: f64,
     /// Closed loop: sensor channels of the test (the ones that move most).
     #[arg(long, default_value_t = 24)]
@@ -84,6 +84,10 @@ pub struct Args {
     /// Closed loop: Gauss-Newton polish iterations after each CORS search.
     #[arg(long, default_value_t = 8)]
     pub loop_polish: usize,
+    /// Closed loop: the least fraction of the residual a candidate must explain to be added
+    /// (the library's default).
+    #[arg(long, default_value_t = 0.5)]
+    pub loop_min_explained: f64,
     /// Closed loop: most candidates added.
     #[arg(long, default_value_t = 2)]
     pub max_added: usize,

@@ -22,6 +22,10 @@ use crate::error::CliError;
 use crate::output::write_text;
 use crate::simulate::thread_pool;
 
+/// The loop demo's window (s): the window of the coarse-airframe loop test. Over 25 ms
+/// the declared thicknesses, calibrated first, take up more of the damping's signature
+/// (docs/validation.md, "The closed-loop demo").
+pub const END_TIME: f64 = 0.015;
 /// What the test hides: structural damping (1/s) the model holds at zero.
 pub const HIDDEN_DAMPING: f64 = 10.0;
 /// The test's trigger offset (s): two samples late.
@@ -126,6 +130,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         reconcile: args.loop_reconcile,
         recalibrate: args.loop_recalibrate,
         max_added: args.max_added,
+        min_explained: args.loop_min_explained,
         polish: args.loop_polish,
         candidates: args.candidates.clone(),
         seed: 1,
