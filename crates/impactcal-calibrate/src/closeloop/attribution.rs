@@ -99,6 +99,21 @@ impl Attribution {
     pub fn best(&self) -> Option<&Score> {
         self.ranked.first().filter(|s| s.status == "best")
     }
+
+    /// When no candidate is eligible, the highest-scoring one that fails only the
+    /// explained-fraction rule (identifiable, admissible, significant): its one-run
+    /// linearised share, measured where the declared parameters may already imitate part of
+    /// the effect, understates what a recalibration with it freed removes; forward
+    /// selection tries that recalibration and applies the rule to the share it realises.
+    pub fn short_of_share(&self) -> Option<&Score> {
+        if self.best().is_some() {
+            return None;
+        }
+        self.ranked
+            .iter()
+            .filter(|s| s.status == "explains too little")
+            .max_by(|a, b| a.score.total_cmp(&b.score))
+    }
 }
 
 /// A direction to score: name, kind, group, whitened direction, and for a candidate its

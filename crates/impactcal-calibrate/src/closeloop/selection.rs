@@ -13,9 +13,16 @@
 //! `BIC = RSS / c + k ln n_eff`; Akaike weights
 //! `w_m = exp(-(AIC_m - AIC_min) / 2) / sum_j exp(-(AIC_j - AIC_min) / 2)`.
 //!
-//! Selection stops when no model-form error remains, when no candidate is eligible
-//! (identifiable, admissible, significant, explaining at least `min_explained`), when BIC
-//! does not fall by more than 2, or after `max_added` additions.
+//! When no candidate is eligible only because its linearised share of the residual is below
+//! `min_explained`, the highest-scoring such candidate is tried all the same: the model is
+//! recalibrated with it, and it is kept when the share the recalibration realises,
+//! `1 - RSS_new / RSS_old`, reaches `min_explained` and BIC falls by more than 2. The
+//! one-run share is measured at the calibrated point, where declared parameters may
+//! already imitate part of the missing effect; the recalibration frees them together.
+//!
+//! Selection stops when no model-form error remains, when no candidate is eligible or
+//! realises its share, when BIC does not fall by more than 2, or after `max_added`
+//! additions.
 
 use impactcal_core::{Enrichable, Parameter};
 
@@ -146,7 +153,12 @@ pub(crate) fn forward<M: Enrichable>(
             stopped = format!("max_added ({}) reached", options.max_added);
             break;
         }
-        let Some(best) = attribution.as_ref().and_then(|a| a.best()) else {
+        let chosen = attribution.as_ref().and_then(|a| {
+            a.best()
+                .map(|s| (s, false))
+                .or_else(|| a.short_of_share().map(|s| (s, true)))
+        });
+        let Some((best, trial)) = chosen else {
             stopped = "no candidate is identifiable, admissible, significant and explains \
                        enough of the residual"
                 .to_string();
@@ -185,6 +197,16 @@ pub(crate) fn forward<M: Enrichable>(
         )?;
         let s = score(&fit_n, &trial_added, n_nuisance, inflation, true);
         let prev_bic = models.last().map_or(f64::INFINITY, |m| m.bic);
+        let realised = 1.0 - fit_n.rss / fit.rss;
+        if trial && !(realised >= options.min_explained) {
+            models.push(ModelScore { kept: false, ..s });
+            stopped = format!(
+                "`{}` scored first but explains too little: {:.3} of the residual linearised, \
+                 {:.3} once recalibrated with it (min_explained {})",
+                p.name, best.explained_fraction, realised, options.min_explained
+            );
+            break;
+        }
         if s.bic > prev_bic - 2.0 {
             models.push(ModelScore { kept: false, ..s });
             stopped = format!(
@@ -196,6 +218,14 @@ pub(crate) fn forward<M: Enrichable>(
             break;
         }
         models.push(s);
+        if trial
+            && let Some(entry) = rounds
+                .last_mut()
+                .and_then(|round| round.attribution.as_mut())
+                .and_then(|a| a.ranked.iter_mut().find(|c| c.name == p.name))
+        {
+            entry.status = format!("best once recalibrated (explains {realised:.3})");
+        }
         runs = fit_n.runs;
         det = detect_fit(&fit_n)?;
         fit = fit_n;
