@@ -198,7 +198,7 @@ pub(crate) fn forward<M: Enrichable>(
         let s = score(&fit_n, &trial_added, n_nuisance, inflation, true);
         let prev_bic = models.last().map_or(f64::INFINITY, |m| m.bic);
         let realised = 1.0 - fit_n.rss / fit.rss;
-        if trial && !(realised >= options.min_explained) {
+        if trial && (realised.is_nan() || realised < options.min_explained) {
             models.push(ModelScore { kept: false, ..s });
             stopped = format!(
                 "`{}` scored first but explains too little: {:.3} of the residual linearised, \
