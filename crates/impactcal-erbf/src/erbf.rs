@@ -31,7 +31,7 @@
 //! small that `b(x)^T c` is cheaper, the model stores `c` instead.
 //!
 //! With [`ErbfOptions::smoothing`] above zero the model stops interpolating and solves the
-//! ridge problem of [`crate::smoothing`]: the solves with `R` become filters on its
+//! ridge problem of `smoothing.rs`: the solves with `R` become filters on its
 //! singular values.
 
 use faer::linalg::matmul::matmul;
@@ -78,7 +78,7 @@ pub struct Erbf {
     coef: Option<Mat<f64>>,
     r_ratio: f64,
     /// With smoothing: the SVD of `R` and the absolute ridge `lambda`
-    /// ([`crate::smoothing`]).
+    /// (`smoothing.rs`).
     smoother: Option<Box<(RSvd, f64)>>,
 }
 

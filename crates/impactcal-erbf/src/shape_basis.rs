@@ -88,8 +88,8 @@ impl ShapeSpectrum {
     /// vectors. Cost `O(N^2 T)` (one `N x N x T` product for long histories).
     ///
     /// # Errors
-    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) naming the entry or
-    /// [`CoreError::Empty`](impactcal_core::CoreError::Empty) for bad data;
+    /// [`CoreError::NonFinite`] naming the entry or
+    /// [`CoreError::Empty`] for bad data;
     /// [`ShapesError::NoConvergence`](impactcal_shapes::ShapesError::NoConvergence) (under
     /// [`ErbfError::Shapes`]) when the eigen- or singular value decomposition fails.
     pub fn new(values: MatRef<'_, f64>) -> Result<Self> {
@@ -187,7 +187,7 @@ impl ShapeSpectrum {
     /// (`O(N k T)`).
     ///
     /// # Errors
-    /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when
+    /// [`CoreError::DimensionMismatch`] when
     /// `values` is not `N x T`.
     pub fn basis(&self, values: MatRef<'_, f64>, k: usize) -> Result<ShapeBasis> {
         let (n, t) = (self.left.nrows(), self.mean.len());

@@ -24,7 +24,7 @@
 //! Classic RBF candidates are scored by Rippa's exact closed form (valid with smoothing);
 //! ERBF candidates by ERBF's closed-form kernel-view approximation, which is cheap but only
 //! approximate (one factorisation and one SVD per radius serve all its smoothings,
-//! [`crate::smoothing`]). Smaller smoothing wins ties, so data without noise stays interpolated.
+//! `smoothing.rs`). Smaller smoothing wins ties, so data without noise stays interpolated.
 
 use faer::{Mat, MatRef};
 use impactcal_core::ParameterSpace;
