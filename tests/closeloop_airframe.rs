@@ -55,18 +55,7 @@ fn true_point(m: &AirframeModel) -> Vec<f64> {
 /// its gain and bias cannot be told apart.)
 fn loudest(h: &Histories) -> Vec<String> {
     let f = h.filtered(Cfc::from_class(60).unwrap()).unwrap();
-    let mut z: Vec<(f64, String)> = f
-        .labels()
-        .iter()
-        .enumerate()
-        .map(|(i, l)| {
-            let c = f.channel(i);
-            let mean = c.iter().sum::<f64>() / c.len() as f64;
-            (c.iter().map(|x| (x - mean).powi(2)).sum::<f64>(), l.clone())
-        })
-        .collect();
-    z.sort_by(|a, b| b.0.total_cmp(&a.0));
-    z.into_iter().take(CHANNELS).map(|(_, l)| l).collect()
+    f.most_varying(CHANNELS)
 }
 
 /// The truth (the model with `hidden` set) measured on its loudest vertical channels, and

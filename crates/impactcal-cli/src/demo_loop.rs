@@ -68,19 +68,8 @@ struct Summary<'a> {
 /// Filter errors.
 pub fn moving_channels(h: &Histories, count: usize) -> Result<Vec<String>, CliError> {
     let f = h.filtered(Cfc::from_class(CFC)?)?;
-    let mut scored: Vec<(f64, String)> = f
-        .labels()
-        .iter()
-        .enumerate()
-        .filter(|(_, l)| l.ends_with(".z"))
-        .map(|(i, l)| {
-            let c = f.channel(i);
-            let mean = c.iter().sum::<f64>() / c.len() as f64;
-            (c.iter().map(|x| (x - mean).powi(2)).sum::<f64>(), l.clone())
-        })
-        .collect();
-    scored.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| a.1.cmp(&b.1)));
-    Ok(scored.into_iter().take(count).map(|(_, l)| l).collect())
+    let vertical: Vec<&String> = f.labels().iter().filter(|l| l.ends_with(".z")).collect();
+    Ok(f.select(&vertical)?.most_varying(count))
 }
 
 /// Runs `impactcal demo --close-loop`.

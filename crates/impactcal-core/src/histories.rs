@@ -223,14 +223,30 @@ impl Histories {
     /// The 2-norm across channels at every sample, `Q(t_k) = sqrt(sum_c y_c(t_k)^2)`: the
     /// source paper's response-norm history (for velocity channels, the velocity norm).
     pub fn norm_history(&self) -> Vec<f64> {
-        let mut q = vec![0.0; self.samples];
-        for c in 0..self.channels() {
-            for (acc, v) in q.iter_mut().zip(self.channel(c)) {
-                *acc += v * v;
-            }
-        }
-        q.iter_mut().for_each(|v| *v = v.sqrt());
-        q
+        norm_history_of(&self.data, self.samples)
+    }
+
+    /// The labels of the `count` channels with the largest variance about their own mean,
+    /// largest first, ties by label (all channels when `count` exceeds them): where a
+    /// response moves. A channel that barely moves over the record is nearly a constant,
+    /// whose gain and offset cannot be told apart.
+    pub fn most_varying(&self, count: usize) -> Vec<String> {
+        let mut scored: Vec<(f64, &String)> = self
+            .labels
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                let c = self.channel(i);
+                let mean = c.iter().sum::<f64>() / c.len() as f64;
+                (c.iter().map(|x| (x - mean).powi(2)).sum::<f64>(), l)
+            })
+            .collect();
+        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| a.1.cmp(b.1)));
+        scored
+            .into_iter()
+            .take(count)
+            .map(|(_, l)| l.clone())
+            .collect()
     }
 
     fn unknown(&self, label: &str) -> CoreError {
@@ -387,6 +403,20 @@ fn check_labels(labels: &[String]) -> Result<()> {
     Ok(())
 }
 
+/// [`Histories::norm_history`] of a channel-major block (`data[c * samples + k]`, channels
+/// one after another): `Q(t_k) = sqrt(sum_c data[c * samples + k]^2)`, `samples` values.
+/// A trailing partial channel is summed as far as it goes.
+pub fn norm_history_of(data: &[f64], samples: usize) -> Vec<f64> {
+    let mut q = vec![0.0; samples];
+    for channel in data.chunks(samples.max(1)) {
+        for (acc, v) in q.iter_mut().zip(channel) {
+            *acc += v * v;
+        }
+    }
+    q.iter_mut().for_each(|v| *v = v.sqrt());
+    q
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -405,6 +435,18 @@ mod tests {
             "in/s",
         )
         .unwrap()
+    }
+
+    #[test]
+    fn most_varying_ranks_by_variance_about_the_mean_ties_by_label() {
+        let h = sample();
+        // Variances 2, 2 and 7/6: the two ramps tie and fall back to label order.
+        assert_eq!(h.most_varying(3), vec!["1.x", "1.z", "force"]);
+        assert_eq!(h.most_varying(1), vec!["1.x"]);
+        assert_eq!(h.most_varying(9).len(), 3);
+        let q = h.norm_history();
+        assert_eq!(q, norm_history_of(&h.data, h.samples));
+        assert_relative_eq!(q[1], (1.0f64 + 16.0 + 0.25).sqrt());
     }
 
     fn fault(text: &str) -> (usize, usize) {

@@ -28,7 +28,7 @@
 //! number of optimally paired shapes with `|M2| > 0.9`. One response per model: M2 compares
 //! shapes, not an ensemble.
 
-use impactcal_core::Histories;
+use impactcal_core::{Histories, norm_history_of};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -46,20 +46,6 @@ pub const M2_SHAPES: usize = 10;
 pub(crate) struct Posterior<'a> {
     pub jac: &'a [Vec<f64>],
     pub inflation: f64,
-}
-
-/// `Q(t)`: the norm over channels at each sample of an `S x T` block.
-fn q_of(v: &[f64], samples: usize) -> Vec<f64> {
-    (0..samples)
-        .map(|k| {
-            v.iter()
-                .skip(k)
-                .step_by(samples)
-                .map(|x| x * x)
-                .sum::<f64>()
-                .sqrt()
-        })
-        .collect()
 }
 
 /// The fraction of samples at which the test (nuisance terms `terms` taken out) leaves the
@@ -106,12 +92,12 @@ pub(crate) fn m1_exceedance(
                     v + (p + normal()) * s
                 })
                 .collect();
-            q_of(&draw, t)
+            norm_history_of(&draw, t)
         })
         .collect();
     let time: Vec<f64> = (0..t).map(|k| k as f64 * frame.dt).collect();
     let test = nuisance::corrected_test(frame, terms);
-    Ok(m1::m1(&time, &runs, &q_of(&test, t))?.exceedance_fraction)
+    Ok(m1::m1(&time, &runs, &norm_history_of(&test, t))?.exceedance_fraction)
 }
 
 /// M2 of the model response `y` against the test (nuisance terms taken out): the number of
