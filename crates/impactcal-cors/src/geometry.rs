@@ -38,6 +38,31 @@ impl Columns {
         Columns { n, cols }
     }
 
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Coordinate `j` of point `i`.
+    #[inline]
+    pub fn coordinate(&self, i: usize, j: usize) -> f64 {
+        self.cols[j * self.n + i]
+    }
+
+    /// Writes into `d2` (at most [`Columns::BLOCK`] long) the squared distances from `x` to
+    /// the points `start..start + d2.len()`.
+    #[inline]
+    pub fn squared_distances(&self, x: &[f64], start: usize, d2: &mut [f64]) {
+        let (n, len) = (self.n, d2.len());
+        d2.fill(0.0);
+        for (j, &xj) in x.iter().enumerate() {
+            let col = &self.cols[j * n + start..j * n + start + len];
+            for (d, &c) in d2.iter_mut().zip(col) {
+                *d += (xj - c) * (xj - c);
+            }
+        }
+    }
+
     /// Calls `f(start, d2)` for consecutive blocks of at most [`Columns::BLOCK`] points,
     /// `d2[k]` being the squared distance from `x` to point `start + k`.
     #[inline]
@@ -47,23 +72,42 @@ impl Columns {
         for start in (0..n).step_by(Self::BLOCK) {
             let len = Self::BLOCK.min(n - start);
             let d2 = &mut d2[..len];
-            d2.fill(0.0);
-            for (j, &xj) in x.iter().enumerate() {
-                let col = &self.cols[j * n + start..j * n + start + len];
-                for (d, &c) in d2.iter_mut().zip(col) {
-                    *d += (xj - c) * (xj - c);
-                }
-            }
+            self.squared_distances(x, start, d2);
             f(start, d2);
         }
     }
 
+    /// Squared distance from `x` to the nearest point; infinite for none.
+    pub fn min_squared_distance(&self, x: &[f64]) -> f64 {
+        let mut min = f64::INFINITY;
+        self.for_each_block(x, |_, d2| min = min.min(min_of(d2)));
+        min
+    }
+
     /// Distance from `x` to the nearest point; infinite for none.
     pub fn min_distance(&self, x: &[f64]) -> f64 {
-        let mut min = f64::INFINITY;
-        self.for_each_block(x, |_, d2| min = d2.iter().copied().fold(min, f64::min));
-        min.sqrt()
+        self.min_squared_distance(x).sqrt()
     }
+}
+
+/// The smallest of `v` (infinite for none), taken over four lanes so that it vectorises;
+/// the minimum of numbers that are not NaN does not depend on the order in which it is
+/// taken.
+#[inline]
+pub fn min_of(v: &[f64]) -> f64 {
+    let mut lanes = [f64::INFINITY; 4];
+    let chunks = v.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for (l, x) in lanes.iter_mut().zip(c) {
+            *l = l.min(*x);
+        }
+    }
+    let mut m = lanes[0].min(lanes[1]).min(lanes[2].min(lanes[3]));
+    for x in rest {
+        m = m.min(*x);
+    }
+    m
 }
 
 /// SplitMix64 finaliser: a bijective scrambling of 64 bits.

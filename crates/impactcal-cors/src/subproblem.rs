@@ -24,7 +24,7 @@ use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
-use crate::geometry::{Columns, distance};
+use crate::geometry::{Columns, min_of};
 use crate::surrogate::RbfSurrogate;
 
 /// Candidates per parallel task: small batches cost more in scheduling than they save.
@@ -78,20 +78,30 @@ impl Blockers {
     pub fn is_empty(&self) -> bool {
         self.ok.is_empty() && self.failed.is_empty()
     }
+}
+
+/// The points of [`Blockers`] stored coordinate by coordinate, for the many distance
+/// queries of one step. Its distances equal those of the row-wise loops bit for bit.
+struct BlockerColumns {
+    ok: Columns,
+    failed: Columns,
+}
+
+impl BlockerColumns {
+    fn new(blockers: &Blockers) -> Self {
+        BlockerColumns {
+            ok: Columns::new(&blockers.ok, blockers.dim),
+            failed: Columns::new(&blockers.failed, blockers.dim),
+        }
+    }
 
     /// `(min distance to ok points, min distance to failed points)`.
     fn min_distances(&self, x: &[f64]) -> (f64, f64) {
-        let m = |pts: &[f64]| {
-            pts.chunks_exact(self.dim)
-                .map(|p| crate::geometry::squared_distance(x, p))
-                .fold(f64::INFINITY, f64::min)
-                .sqrt()
-        };
-        (m(&self.ok), m(&self.failed))
+        (self.ok.min_distance(x), self.failed.min_distance(x))
     }
 
     /// Distance to the nearest point of either kind.
-    pub fn min_distance(&self, x: &[f64]) -> f64 {
+    fn min_distance(&self, x: &[f64]) -> f64 {
         let (a, b) = self.min_distances(x);
         a.min(b)
     }
@@ -234,7 +244,7 @@ fn local_candidates(centre: &[f64], n: usize, region: &Region, rng: &mut impl Rn
 
 /// Maximises the distance to the nearest blocker from `x` by a compass search.
 fn refine_maximin(
-    blockers: &Blockers,
+    blockers: &BlockerColumns,
     region: &Region,
     mut x: Vec<f64>,
     mut h: f64,
@@ -266,18 +276,13 @@ fn refine_maximin(
 pub fn maximin(blockers: &Blockers, n: usize, rng: &mut impl Rng) -> (Vec<f64>, f64) {
     let dim = blockers.dim;
     let cands = global_candidates(dim, n.max(1), rng);
-    let (ok, failed) = (
-        Columns::new(&blockers.ok, dim),
-        Columns::new(&blockers.failed, dim),
-    );
+    let near = BlockerColumns::new(blockers);
     let n_points = (blockers.ok.len() + blockers.failed.len()) / dim.max(1);
-    let dists: Vec<f64> = screen(&cands, dim, n_points, |c| {
-        ok.min_distance(c).min(failed.min_distance(c))
-    });
+    let dists: Vec<f64> = screen(&cands, dim, n_points, |c| near.min_distance(c));
     let i = argmax(&dists);
     let start = cands[i * dim..(i + 1) * dim].to_vec();
     let h = 0.5 / (n.max(2) as f64).powf(1.0 / dim as f64);
-    refine_maximin(blockers, &Region::unit(dim), start, h)
+    refine_maximin(&near, &Region::unit(dim), start, h)
 }
 
 fn argmax(v: &[f64]) -> usize {
@@ -310,15 +315,11 @@ pub fn cors_step(
         region,
         rng,
     ));
-    let (ok, failed) = (
-        Columns::new(&blockers.ok, dim),
-        Columns::new(&blockers.failed, dim),
-    );
+    let near = BlockerColumns::new(blockers);
     // Distances to the blockers and the surrogate: about twice the points.
     let n_points = 2 * (blockers.ok.len() + blockers.failed.len()) / dim.max(1);
     let screened: Vec<((f64, f64), f64)> = screen(&cands, dim, n_points, |c| {
-        let dists = (ok.min_distance(c), failed.min_distance(c));
-        (dists, surrogate.value(c))
+        (near.min_distances(c), surrogate.value(c))
     });
     // Delta from the global candidates, refined around the best of them.
     let global_min: Vec<f64> = screened[..n_global]
@@ -328,7 +329,7 @@ pub fn cors_step(
     let i = argmax(&global_min);
     let h = 0.5 / (n_global.max(2) as f64).powf(1.0 / dim as f64);
     let (maximin_x, delta) =
-        refine_maximin(blockers, region, cands[i * dim..(i + 1) * dim].to_vec(), h);
+        refine_maximin(&near, region, cands[i * dim..(i + 1) * dim].to_vec(), h);
     let r = settings.beta * delta;
     let radii = Radii {
         ok: r.max(settings.floor),
@@ -345,14 +346,14 @@ pub fn cors_step(
         .iter()
         .map(|&k| cands[k * dim..(k + 1) * dim].to_vec())
         .collect();
-    let maximin_ok = radii.slack(blockers.min_distances(&maximin_x)) >= 0.0;
+    let maximin_ok = radii.slack(near.min_distances(&maximin_x)) >= 0.0;
     if maximin_ok {
         starts.push(maximin_x.clone());
     }
     // A handful of short descents: cheaper in sequence than through the thread pool.
     let polished: Vec<(Vec<f64>, f64)> = starts
         .into_iter()
-        .map(|x0| polish(surrogate, blockers, region, radii, x0))
+        .map(|x0| polish(surrogate, &near, region, radii, x0))
         .collect();
     let mut chosen: Option<(Vec<f64>, f64)> = None;
     for (x, f) in polished {
@@ -392,36 +393,63 @@ pub fn cors_step(
     }
 }
 
-/// Moves `y` into the box and radially out of every ball it violates (a few passes).
-fn project(blockers: &Blockers, region: &Region, radii: Radii, y: &mut [f64]) {
-    let dim = blockers.dim;
+/// Moves `y` into the box and radially out of every ball it violates (a few passes, each
+/// visiting the points in order and moving `y` out of a ball as soon as it lies inside).
+/// Returns the distances to the nearest ok and failed points of the final `y` when the
+/// last pass moved nothing (`None` when the passes ran out while still moving).
+fn project(
+    near: &BlockerColumns,
+    region: &Region,
+    radii: Radii,
+    y: &mut [f64],
+) -> Option<(f64, f64)> {
     region.clip(y);
+    let mut d2 = [0.0; Columns::BLOCK];
     for _ in 0..4 {
         let mut moved = false;
-        for (pts, r) in [(&blockers.ok, radii.ok), (&blockers.failed, radii.failed)] {
-            for p in pts.chunks_exact(dim) {
-                let dist = distance(y, p);
-                if dist < r && dist > 0.0 {
-                    let scale = r * (1.0 + 1e-9) / dist;
-                    for (yj, pj) in y.iter_mut().zip(p) {
-                        *yj = pj + (*yj - pj) * scale;
+        let mut nearest = [f64::INFINITY; 2];
+        for (set, (pts, r)) in [(&near.ok, radii.ok), (&near.failed, radii.failed)]
+            .into_iter()
+            .enumerate()
+        {
+            let mut i = 0;
+            while i < pts.len() {
+                let d2 = &mut d2[..Columns::BLOCK.min(pts.len() - i)];
+                pts.squared_distances(y, i, d2);
+                match d2.iter().position(|&q| {
+                    let dist = q.sqrt();
+                    dist < r && dist > 0.0
+                }) {
+                    None => {
+                        nearest[set] = nearest[set].min(min_of(d2));
+                        i += d2.len();
                     }
-                    moved = true;
+                    Some(k) => {
+                        let p = i + k;
+                        let scale = r * (1.0 + 1e-9) / d2[k].sqrt();
+                        for (j, yj) in y.iter_mut().enumerate() {
+                            let pj = pts.coordinate(p, j);
+                            *yj = pj + (*yj - pj) * scale;
+                        }
+                        moved = true;
+                        i = p + 1;
+                    }
                 }
             }
         }
         region.clip(y);
         if !moved {
-            break;
+            return Some((nearest[0].sqrt(), nearest[1].sqrt()));
         }
     }
+    None
 }
 
 /// Projected-gradient descent of `s` from the feasible `x0`; returns the end point and its
 /// value. Every accepted iterate is feasible.
 fn polish(
     s: &RbfSurrogate,
-    blockers: &Blockers,
+    near: &BlockerColumns,
     region: &Region,
     radii: Radii,
     x0: Vec<f64>,
@@ -443,14 +471,16 @@ fn polish(
             for ((yj, xj), gj) in y.iter_mut().zip(&x).zip(&grad) {
                 *yj = xj - step * gj / gnorm;
             }
-            project(blockers, region, radii, &mut y);
+            let nearest = project(near, region, radii, &mut y);
             let descent: f64 = grad
                 .iter()
                 .zip(&x)
                 .zip(&y)
                 .map(|((g, a), b)| g * (a - b))
                 .sum();
-            if descent > 0.0 && radii.slack(blockers.min_distances(&y)) >= 0.0 {
+            if descent > 0.0
+                && radii.slack(nearest.unwrap_or_else(|| near.min_distances(&y))) >= 0.0
+            {
                 let fy = s.value(&y);
                 if fy <= f - 1e-4 * descent {
                     x.copy_from_slice(&y);
@@ -486,7 +516,11 @@ mod tests {
             let cols = Columns::new(&b.ok, dim);
             for _ in 0..50 {
                 let x: Vec<f64> = (0..dim).map(|_| rng.random_range(-0.2..1.2)).collect();
-                let (row, _) = b.min_distances(&x);
+                let row =
+                    b.ok.chunks_exact(dim)
+                        .map(|p| crate::geometry::squared_distance(&x, p))
+                        .fold(f64::INFINITY, f64::min)
+                        .sqrt();
                 assert_eq!(cols.min_distance(&x).to_bits(), row.to_bits(), "n = {n}");
             }
         }

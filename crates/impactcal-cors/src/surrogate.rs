@@ -100,8 +100,9 @@ impl RbfSurrogate {
     }
 
     /// `sum_i c_i phi(|x - x_i|)`. The squared distances of a block of centres are formed
-    /// coordinate by coordinate, which vectorises across centres; every distance and the
-    /// sum over centres keep the order of operations of the plain loop.
+    /// coordinate by coordinate and the kernel values of the block at once, which
+    /// vectorises across centres; every distance, every kernel value and the sum over
+    /// centres (in order) keep the operations of the plain loop, bit for bit.
     fn kernel_part(&self, x: &[f64]) -> f64 {
         match self.kernel {
             RadialFunction::Cubic => self.weighted_sum(x, |r| r * r * r),
@@ -113,9 +114,14 @@ impl RbfSurrogate {
     #[inline]
     fn weighted_sum(&self, x: &[f64], phi: impl Fn(f64) -> f64) -> f64 {
         let mut sum = -0.0;
+        let mut k = [0.0; Columns::BLOCK];
         self.columns.for_each_block(x, |start, d2| {
-            for (d, w) in d2.iter().zip(&self.weights[start..]) {
-                sum += w * phi(d.sqrt());
+            let k = &mut k[..d2.len()];
+            for (kv, d) in k.iter_mut().zip(d2) {
+                *kv = phi(d.sqrt());
+            }
+            for (kv, w) in k.iter().zip(&self.weights[start..]) {
+                sum += w * kv;
             }
         });
         sum
@@ -128,18 +134,50 @@ impl RbfSurrogate {
     }
 
     /// `s(x)`, with `grad s(x)` written into `grad` (length `d`):
-    /// `sum_i c_i (phi'(r_i) / r_i) (x - x_i) + a`.
+    /// `sum_i c_i (phi'(r_i) / r_i) (x - x_i) + a`. Distances and kernel terms are formed
+    /// a block of centres at a time (as in [`value`](Self::value)); the sums over centres
+    /// keep the order and the operations of the plain loop, bit for bit.
     pub fn value_gradient(&self, x: &[f64], grad: &mut [f64]) -> f64 {
+        match self.kernel {
+            RadialFunction::Cubic => self.value_gradient_with(x, grad, |r| r * r * r, |r| 3.0 * r),
+            kernel => self.value_gradient_with(
+                x,
+                grad,
+                |r| kernel.value(r),
+                |r| kernel.derivative_over_r(r),
+            ),
+        }
+    }
+
+    /// [`value_gradient`](Self::value_gradient) for `phi` and `phi'(r) / r` known at
+    /// compile time.
+    #[inline]
+    fn value_gradient_with(
+        &self,
+        x: &[f64],
+        grad: &mut [f64],
+        phi_of: impl Fn(f64) -> f64,
+        slope_of: impl Fn(f64) -> f64,
+    ) -> f64 {
         grad.copy_from_slice(&self.a);
         let mut v = self.a0 + self.a.iter().zip(x).map(|(a, v)| a * v).sum::<f64>();
-        for (c, w) in self.centres.chunks_exact(self.dim).zip(&self.weights) {
-            let r = crate::geometry::distance(x, c);
-            v += w * self.kernel.value(r);
-            let g = w * self.kernel.derivative_over_r(r);
-            for ((gj, xj), cj) in grad.iter_mut().zip(x).zip(c) {
-                *gj += g * (xj - cj);
+        let (mut phi, mut g) = ([0.0; Columns::BLOCK], [0.0; Columns::BLOCK]);
+        self.columns.for_each_block(x, |start, d2| {
+            let len = d2.len();
+            let weights = &self.weights[start..start + len];
+            for ((d, w), (p, gk)) in d2.iter().zip(weights).zip(phi.iter_mut().zip(&mut g)) {
+                let r = d.sqrt();
+                *p = w * phi_of(r);
+                *gk = w * slope_of(r);
             }
-        }
+            let centres = self.centres[start * self.dim..].chunks_exact(self.dim);
+            for ((c, p), gk) in centres.zip(&phi[..len]).zip(&g[..len]) {
+                v += p;
+                for ((gj, xj), cj) in grad.iter_mut().zip(x).zip(c) {
+                    *gj += gk * (xj - cj);
+                }
+            }
+        });
         v
     }
 }

@@ -64,6 +64,7 @@
 //! ```
 
 mod basis;
+pub mod bordered;
 pub mod buffer;
 pub mod components;
 mod data;
@@ -83,6 +84,7 @@ mod thin_qr;
 pub mod trend;
 pub mod tuning;
 
+pub use bordered::{BorderedRbf, RbfCoefficients};
 pub use components::{Components, OutputBasis, Tuning};
 pub use erbf::Erbf;
 pub use error::{ErbfError, Result};
