@@ -10,6 +10,7 @@ use crate::error::{CorsError, Result};
 use crate::geometry::mix;
 use crate::options::{CorsOptions, Restart, ValidCorsOptions};
 use crate::stall::StallRule;
+use crate::surrogate::FitCache;
 
 /// Tag of the saved state format.
 pub(crate) const FORMAT: &str = "impactcal-cors/1";
@@ -189,6 +190,9 @@ pub struct CorsState {
     pub(crate) pending: Vec<Suggestion>,
     pub(crate) next_id: u64,
     pub(crate) plan: Option<Plan>,
+    /// The factorisation of the last surrogate (not saved: rebuilt on the first fit).
+    #[serde(skip)]
+    pub(crate) fit_cache: FitCache,
 }
 
 /// The unchecked serialised form of [`CorsState`].
@@ -251,6 +255,7 @@ impl TryFrom<StateData> for CorsState {
             pending: d.pending,
             next_id: d.next_id,
             plan: d.plan,
+            fit_cache: FitCache::default(),
         })
     }
 }
@@ -271,6 +276,7 @@ impl CorsState {
             pending: Vec::new(),
             next_id: 0,
             plan: None,
+            fit_cache: FitCache::default(),
         })
     }
 

@@ -6,9 +6,6 @@
 //! it before proposing, and rebuilding a study from its history
 //! ([`Cors::from_history`](crate::Cors::from_history)) calls it at every row.
 
-use faer::Mat;
-use impactcal_core::points::from_rows;
-
 use crate::design::affine_rank_of_rows;
 use crate::error::Result;
 use crate::geometry::{distance, stream};
@@ -234,9 +231,8 @@ fn fit_surrogate(
     if vals.iter().any(|v| !v.is_finite()) {
         return Ok(Err(FillReason::TransformNotFinite));
     }
-    let x: Mat<f64> = from_rows(&pts, "surrogate points")?;
     Ok(
-        match RbfSurrogate::fit(x.as_ref(), &vals, state.options.kernel) {
+        match state.fit_cache.fit(&pts, &vals, state.options.kernel) {
             Ok(s) => Ok((s, best_x)),
             Err(e) => Err(FillReason::SurrogateFailed {
                 message: e.to_string(),

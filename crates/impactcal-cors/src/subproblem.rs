@@ -318,8 +318,23 @@ pub fn cors_step(
     let near = BlockerColumns::new(blockers);
     // Distances to the blockers and the surrogate: about twice the points.
     let n_points = 2 * (blockers.ok.len() + blockers.failed.len()) / dim.max(1);
+    // When the surrogate's centres are the first ok points (the usual case: no merged
+    // duplicates), the distances its evaluation forms give their nearest one too.
+    let centres = surrogate.centres();
+    let shared = blockers.ok.len() >= centres.len()
+        && blockers.ok[..centres.len()]
+            .iter()
+            .zip(centres)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+    let others = Columns::new(&blockers.ok[centres.len().min(blockers.ok.len())..], dim);
     let screened: Vec<((f64, f64), f64)> = screen(&cands, dim, n_points, |c| {
-        (near.min_distances(c), surrogate.value(c))
+        if shared {
+            let (value, nearest) = surrogate.value_and_nearest(c);
+            let ok = nearest.min(others.min_squared_distance(c)).sqrt();
+            ((ok, near.failed.min_distance(c)), value)
+        } else {
+            (near.min_distances(c), surrogate.value(c))
+        }
     });
     // Delta from the global candidates, refined around the best of them.
     let global_min: Vec<f64> = screened[..n_global]
@@ -412,14 +427,24 @@ fn project(
             .into_iter()
             .enumerate()
         {
+            // A squared distance of at least `clear` has a distance of at least `r` (the
+            // margin covers the rounding of `r * r` and of the square root), so a block
+            // without a smaller positive one needs no square root.
+            let clear = r * r * (1.0 + 1e-12);
             let mut i = 0;
             while i < pts.len() {
                 let d2 = &mut d2[..Columns::BLOCK.min(pts.len() - i)];
                 pts.squared_distances(y, i, d2);
-                match d2.iter().position(|&q| {
-                    let dist = q.sqrt();
-                    dist < r && dist > 0.0
-                }) {
+                let suspect = d2.iter().fold(false, |s, &q| s | ((q < clear) & (q > 0.0)));
+                let inside = if suspect {
+                    d2.iter().position(|&q| {
+                        let dist = q.sqrt();
+                        dist < r && dist > 0.0
+                    })
+                } else {
+                    None
+                };
+                match inside {
                     None => {
                         nearest[set] = nearest[set].min(min_of(d2));
                         i += d2.len();

@@ -6,12 +6,19 @@
 //! tail coefficients in these coordinates. The copy evaluates value and gradient without
 //! allocation, which the candidate screening (thousands of points) and the local polish
 //! (hundreds of gradient steps) need.
+//!
+//! A study fits its surrogate through [`FitCache`]: the factorisation of the RBF system is
+//! extended by the points added since the last step ([`BorderedRbf`], `O(n^2)` per point)
+//! instead of being formed again (`O(n^3)`).
+
+use std::sync::Mutex;
 
 use faer::{ColRef, MatRef};
-use impactcal_erbf::{RadialFunction, RbfInterpolant, RbfOptions};
+use impactcal_core::points::from_rows;
+use impactcal_erbf::{BorderedRbf, RadialFunction, RbfCoefficients, RbfInterpolant, RbfOptions};
 
 use crate::error::Result;
-use crate::geometry::Columns;
+use crate::geometry::{Columns, min_of};
 use crate::options::SurrogateKernel;
 
 /// A fitted cubic or thin-plate RBF with a linear tail on the unit box: the surrogate of
@@ -59,6 +66,25 @@ impl RbfSurrogate {
         Self::from_interpolant(&rbf)
     }
 
+    /// The surrogate of coefficients solved by a bordered factorisation over `points`
+    /// (row-major, as pushed to it).
+    fn from_coefficients(
+        kernel: RadialFunction,
+        dim: usize,
+        points: &[f64],
+        coef: RbfCoefficients,
+    ) -> Self {
+        RbfSurrogate {
+            kernel,
+            dim,
+            centres: points.to_vec(),
+            columns: Columns::new(points, dim),
+            weights: coef.weights,
+            a0: coef.constant,
+            a: coef.linear,
+        }
+    }
+
     /// Copies the coefficients of a single-output interpolant with a linear tail.
     ///
     /// # Errors
@@ -103,19 +129,23 @@ impl RbfSurrogate {
     /// coordinate by coordinate and the kernel values of the block at once, which
     /// vectorises across centres; every distance, every kernel value and the sum over
     /// centres (in order) keep the operations of the plain loop, bit for bit.
-    fn kernel_part(&self, x: &[f64]) -> f64 {
+    /// Also returns the smallest squared distance from `x` to a centre (infinite for none).
+    fn kernel_part(&self, x: &[f64]) -> (f64, f64) {
         match self.kernel {
             RadialFunction::Cubic => self.weighted_sum(x, |r| r * r * r),
             kernel => self.weighted_sum(x, |r| kernel.value(r)),
         }
     }
 
-    /// `sum_i c_i phi(|x - x_i|)` for a kernel `phi` known at compile time.
+    /// `sum_i c_i phi(|x - x_i|)` for a kernel `phi` known at compile time, and the
+    /// smallest squared distance to a centre.
     #[inline]
-    fn weighted_sum(&self, x: &[f64], phi: impl Fn(f64) -> f64) -> f64 {
+    fn weighted_sum(&self, x: &[f64], phi: impl Fn(f64) -> f64) -> (f64, f64) {
         let mut sum = -0.0;
+        let mut nearest = f64::INFINITY;
         let mut k = [0.0; Columns::BLOCK];
         self.columns.for_each_block(x, |start, d2| {
+            nearest = nearest.min(min_of(d2));
             let k = &mut k[..d2.len()];
             for (kv, d) in k.iter_mut().zip(d2) {
                 *kv = phi(d.sqrt());
@@ -124,13 +154,25 @@ impl RbfSurrogate {
                 sum += w * kv;
             }
         });
-        sum
+        (sum, nearest)
     }
 
     /// `s(x)`.
     pub fn value(&self, x: &[f64]) -> f64 {
+        self.value_and_nearest(x).0
+    }
+
+    /// `s(x)` and the smallest squared distance from `x` to a centre (infinite for none),
+    /// which the evaluation forms anyway.
+    pub fn value_and_nearest(&self, x: &[f64]) -> (f64, f64) {
         let tail: f64 = self.a.iter().zip(x).map(|(a, v)| a * v).sum();
-        self.kernel_part(x) + self.a0 + tail
+        let (kernel, nearest) = self.kernel_part(x);
+        (kernel + self.a0 + tail, nearest)
+    }
+
+    /// The centres, row-major (`N x d`).
+    pub fn centres(&self) -> &[f64] {
+        &self.centres
     }
 
     /// `s(x)`, with `grad s(x)` written into `grad` (length `d`):
@@ -179,5 +221,136 @@ impl RbfSurrogate {
             }
         });
         v
+    }
+}
+
+/// The bordered factorisation of a study's last surrogate, kept between steps: a memo
+/// that never changes a result. A fit over points that extend the cached ones (the same
+/// values, bit for bit, in the same order: the next step of the same run) pushes only the
+/// new points; any other set (a restart, a study read back from a file, another kernel) is
+/// factorised by pushing its points one by one from an empty model. Either way the
+/// factors are those of the same sequence of pushes, so a resumed study fits exactly as
+/// an uninterrupted one.
+#[derive(Debug, Default)]
+pub(crate) struct FitCache(Mutex<Option<BorderedRbf>>);
+
+impl Clone for FitCache {
+    fn clone(&self) -> Self {
+        let inner = match self.0.lock() {
+            Ok(g) => g.clone(),
+            Err(poisoned) => poisoned.into_inner().clone(),
+        };
+        FitCache(Mutex::new(inner))
+    }
+}
+
+impl FitCache {
+    /// Fits the surrogate to `points` (distinct points of the unit box, affinely spanning)
+    /// and `values`. When the bordered system is singular the fit of
+    /// [`RbfSurrogate::fit`] (with its small smoothing) is tried instead.
+    ///
+    /// # Errors
+    /// The error of `impactcal-erbf` when no fit succeeds.
+    pub(crate) fn fit(
+        &self,
+        points: &[Vec<f64>],
+        values: &[f64],
+        kernel: SurrogateKernel,
+    ) -> Result<RbfSurrogate> {
+        let radial = radial_of(kernel);
+        let dim = points.first().map_or(0, Vec::len);
+        let mut guard = match self.0.lock() {
+            Ok(g) => g,
+            Err(poisoned) => poisoned.into_inner(),
+        };
+        let extends = |m: &BorderedRbf| {
+            m.radial() == radial
+                && m.dim() == dim
+                && m.n_points() <= points.len()
+                && m.points()
+                    .chunks_exact(dim.max(1))
+                    .zip(points)
+                    .all(|(a, b)| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()))
+        };
+        let model = match guard.take() {
+            Some(m) if extends(&m) => m,
+            _ => BorderedRbf::new(radial, &vec![0.0; dim], &vec![1.0; dim])?,
+        };
+        let model = guard.insert(model);
+        for p in &points[model.n_points()..] {
+            model.push(p)?;
+        }
+        if model.is_factorised() {
+            let coef = model.solve(values)?;
+            return Ok(RbfSurrogate::from_coefficients(
+                radial,
+                dim,
+                model.points(),
+                coef,
+            ));
+        }
+        drop(guard);
+        let x = from_rows(points, "surrogate points")?;
+        RbfSurrogate::fit(x.as_ref(), values, kernel)
+    }
+}
+
+fn radial_of(kernel: SurrogateKernel) -> RadialFunction {
+    match kernel {
+        SurrogateKernel::Cubic => RadialFunction::Cubic,
+        SurrogateKernel::ThinPlate => RadialFunction::ThinPlate,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn points(n: usize, dim: usize) -> (Vec<Vec<f64>>, Vec<f64>) {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let pts: Vec<Vec<f64>> = (0..n)
+            .map(|_| (0..dim).map(|_| rng.random::<f64>()).collect())
+            .collect();
+        let vals = pts
+            .iter()
+            .map(|p| p.iter().map(|v| (4.0 * v).cos()).sum())
+            .collect();
+        (pts, vals)
+    }
+
+    /// A fit extended step by step through the cache equals, bit for bit, a fit of the
+    /// same points through an empty cache (what a resumed study does), and agrees with the
+    /// from-scratch interpolant of `impactcal-erbf`; a set that does not extend the cached
+    /// one (a restart) is fitted afresh.
+    #[test]
+    fn cached_extension_equals_a_fresh_fit() {
+        let (pts, vals) = points(60, 4);
+        let cache = FitCache::default();
+        for n in [12, 13, 20, 60] {
+            cache
+                .fit(&pts[..n], &vals[..n], SurrogateKernel::Cubic)
+                .unwrap();
+        }
+        let extended = cache.fit(&pts, &vals, SurrogateKernel::Cubic).unwrap();
+        let fresh = FitCache::default()
+            .fit(&pts, &vals, SurrogateKernel::Cubic)
+            .unwrap();
+        let x = from_rows(&pts, "points").unwrap();
+        let scratch = RbfSurrogate::fit(x.as_ref(), &vals, SurrogateKernel::Cubic).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        for _ in 0..20 {
+            let q: Vec<f64> = (0..4).map(|_| rng.random::<f64>()).collect();
+            assert_eq!(extended.value(&q).to_bits(), fresh.value(&q).to_bits());
+            assert!((extended.value(&q) - scratch.value(&q)).abs() < 1e-9);
+        }
+        // A restart: other points, fitted afresh.
+        let restart = cache
+            .fit(&pts[30..], &vals[30..], SurrogateKernel::Cubic)
+            .unwrap();
+        for (p, v) in pts[30..].iter().zip(&vals[30..]) {
+            assert!((restart.value(p) - v).abs() < 1e-10);
+        }
     }
 }
