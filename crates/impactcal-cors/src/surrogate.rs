@@ -7,9 +7,9 @@
 //! allocation, which the candidate screening (thousands of points) and the local polish
 //! (hundreds of gradient steps) need.
 //!
-//! A study fits its surrogate through [`FitCache`]: the factorisation of the RBF system is
-//! extended by the points added since the last step ([`BorderedRbf`], `O(n^2)` per point)
-//! instead of being formed again (`O(n^3)`).
+//! A study keeps the factorisation of its RBF system between steps and extends it by the
+//! points added since the last one ([`BorderedRbf`], `O(n^2)` per point) instead of forming
+//! it again (`O(n^3)`).
 
 use std::sync::Mutex;
 

@@ -243,14 +243,7 @@ impl BorderedRbf {
         if x.len() != self.dim {
             return Err(dimension_mismatch("point: coordinates", self.dim, x.len()));
         }
-        if let Some((j, v)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(CoreError::NonFinite {
-                what: "point".into(),
-                location: format!("coordinate {j}"),
-                value: *v,
-            }
-            .into());
-        }
+        check_finite("point", "coordinate", x)?;
         let column = self.column(x);
         self.points.extend_from_slice(x);
         let bordered = self.factors.as_ref().and_then(|f| {
@@ -288,14 +281,7 @@ impl BorderedRbf {
         if values.len() != n {
             return Err(dimension_mismatch("values: one per point", n, values.len()));
         }
-        if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(CoreError::NonFinite {
-                what: "values".into(),
-                location: format!("row {i}"),
-                value: *v,
-            }
-            .into());
-        }
+        check_finite("values", "row", values)?;
         let Some(f) = &self.factors else {
             return Err(ErbfError::Singular {
                 ratio: 0.0,
@@ -391,6 +377,20 @@ impl BorderedRbf {
             size: m,
             max_pivot,
         })
+    }
+}
+
+/// [`CoreError::NonFinite`] naming the first NaN or infinite entry of `v` (`what`, then
+/// `"<unit> <index>"`).
+fn check_finite(what: &str, unit: &str, v: &[f64]) -> Result<()> {
+    match v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+        Some((i, x)) => Err(CoreError::NonFinite {
+            what: what.into(),
+            location: format!("{unit} {i}"),
+            value: *x,
+        }
+        .into()),
+        None => Ok(()),
     }
 }
 

@@ -52,9 +52,9 @@ fn build(radial: RadialFunction, pts: &[Vec<f64>]) -> BorderedRbf {
     model
 }
 
-/// The largest interpolation residual over `max |f|`; the largest difference between the
-/// bordered fit and `RbfInterpolant::fit` at the points and at random queries over the
-/// larger of `max |f|` and `sum |c_i|` (the kernel sum whose rounding bounds how closely
+/// The largest interpolation residual, and the largest difference between the bordered fit
+/// and `RbfInterpolant::fit` at the points and at random queries, both over the larger of
+/// `max |f|` and `sum |c_i|` (the kernel sum whose rounding bounds how closely
 /// any two solvers can agree: 1 to 10 times `max |f|` for well-spread points, up to 10^4
 /// times with points 1e-4 apart); and the number of full refactorisations.
 fn errors(radial: RadialFunction, pts: &[Vec<f64>], seed: u64) -> (f64, f64, usize) {
@@ -65,12 +65,16 @@ fn errors(radial: RadialFunction, pts: &[Vec<f64>], seed: u64) -> (f64, f64, usi
         .solve(&values)
         .unwrap_or_else(|e| panic!("{e} for {radial:?} at {pts:?}"));
     let scale = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    // The size of the kernel sum relative to the values: rounding in any evaluation of
+    // `sum c_i phi_i` is of the order of eps times it, and it grows as points close in.
+    let growth = (coef.weights.iter().map(|c| c.abs()).sum::<f64>() / scale).max(1.0);
     let residual = pts
         .iter()
         .zip(&values)
         .map(|(p, v)| (coef.value(radial, model.points(), p) - v).abs())
         .fold(0.0, f64::max)
-        / scale;
+        / scale
+        / growth;
     let x = Mat::from_fn(pts.len(), dim, |i, j| pts[i][j]);
     let f = Mat::from_fn(pts.len(), 1, |i, _| values[i]);
     // On some 1-D sets the from-scratch fit finds an exactly zero pivot (its tail scaling
@@ -89,14 +93,7 @@ fn errors(radial: RadialFunction, pts: &[Vec<f64>], seed: u64) -> (f64, f64, usi
         .map(|q| (coef.value(radial, model.points(), q) - scratch.predict(q).unwrap()[0]).abs())
         .fold(0.0, f64::max)
         / scale;
-    // The size of the kernel sum relative to the values: rounding in any evaluation of
-    // `sum c_i phi_i` is of the order of eps times it, and it grows as points close in.
-    let growth = coef.weights.iter().map(|c| c.abs()).sum::<f64>() / scale;
-    (
-        residual,
-        mismatch / growth.max(1.0),
-        model.refactorisations(),
-    )
+    (residual, mismatch / growth, model.refactorisations())
 }
 
 proptest! {
@@ -104,9 +101,9 @@ proptest! {
 
     /// Random point sets, some with points within 1e-4 to 1e-3 of another (CORS keeps its
     /// points at least `1e-3 sqrt(d)` apart): the bordered
-    /// interpolant interpolates to 1e-10 and equals a from-scratch fit to 1e-9 (relative to
-    /// the larger of the largest value and the kernel sum), for the cubic and the
-    /// thin-plate spline.
+    /// interpolant interpolates to 1e-10 and equals a from-scratch fit to 1e-9, both relative
+    /// to the larger of the largest value and the kernel sum `sum |c_i|` (the same for
+    /// well-spread points), for the cubic and the thin-plate spline.
     #[test]
     fn bordered_fit_matches_a_fit_from_scratch(
         seed in any::<u64>(),
