@@ -267,7 +267,7 @@ fn column_means(values: MatRef<'_, f64>) -> Result<Vec<f64>> {
 fn centred_gram(values: MatRef<'_, f64>, mean: &[f64]) -> (Mat<f64>, f64) {
     let (n, t) = values.shape();
     let blocks = t.div_ceil(BLOCK);
-    let groups = blocks.min(GRAM_GROUPS).max(1);
+    let groups = blocks.clamp(1, GRAM_GROUPS);
     let per_group = blocks.div_ceil(groups);
     let parts: Vec<(Mat<f64>, f64)> = (0..groups)
         .into_par_iter()
