@@ -22,8 +22,8 @@ use std::time::Instant;
 use faer::{Mat, MatRef};
 use impactcal::core::{Parameter, ParameterSpace};
 use impactcal::erbf::{
-    Erbf, ErbfOptions, FitOptions, OutputBasis, RadialFunction, RbfInterpolant, RbfOptions,
-    ResponseSurrogate, SurrogateKind, SurrogateModel, Tuning,
+    Erbf, ErbfOptions, FitOptions, LooMethod, OutputBasis, RadialFunction, RbfInterpolant,
+    RbfOptions, ResponseSurrogate, ShapeSpectrum, SurrogateKind, SurrogateModel, Tuning,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -162,6 +162,43 @@ fn shape_cases(
     }
 }
 
+/// The steps of a shape-basis cubic fit, timed one by one (medians): the spectrum of the
+/// deviations (mean, Gram matrix, eigenproblem), the time functions of the kept shapes, the
+/// coordinate surrogate with its leave-one-out errors, and the coordinate prediction.
+fn shape_phases(
+    prefix: &str,
+    reps: usize,
+    space: &ParameterSpace,
+    x: MatRef<'_, f64>,
+    f: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+) {
+    let (spectrum_t, spectrum) = time(reps, || ShapeSpectrum::new(f).unwrap());
+    let coords = spectrum.coordinates();
+    let unit = space.to_unit_matrix(x).unwrap();
+    let (surrogate_t, (model, loo)) = time(reps, || {
+        let model =
+            RbfInterpolant::fit(unit.as_ref(), coords.as_ref(), RbfOptions::cubic()).unwrap();
+        let loo = model.loo_errors(LooMethod::Closed).unwrap();
+        (model, loo)
+    });
+    let energy: Vec<f64> = (0..loo.ncols())
+        .map(|c| loo.col(c).iter().map(|e| e * e).sum())
+        .collect();
+    let k = impactcal::erbf::shape_basis::choose_count(spectrum.singular_values(), &energy);
+    let (basis_t, _) = time(reps, || spectrum.basis(f, k).unwrap());
+    let uq = space.to_unit_matrix(q).unwrap();
+    let (predict_t, _) = time(reps, || model.predict_batch(uq.as_ref()).unwrap());
+    println!("ours {prefix}phase_spectrum {spectrum_t:.6}");
+    println!("ours {prefix}phase_coordinate_fit_loo {surrogate_t:.6}");
+    println!("ours {prefix}phase_time_functions {basis_t:.6}");
+    println!("ours {prefix}phase_coordinate_predict {predict_t:.6}");
+    println!(
+        "ours {prefix}phase_rank {}",
+        spectrum.singular_values().len()
+    );
+}
+
 /// What any prediction of `q` whole histories costs at least: writing the `q x T` result
 /// (a fresh buffer, as a prediction allocates it), and the `q x N x T` product of the
 /// full-history surrogates (`V^T F`, the step after the basis evaluation).
@@ -233,6 +270,7 @@ fn main() {
         "ours erbf_training_residual {:.3e}",
         erbf.training_residual()
     );
+    shape_phases("", reps, &space, x.as_ref(), f.as_ref(), q.as_ref());
     shape_cases(
         "",
         reps,
@@ -274,6 +312,7 @@ fn airframe_cases(adir: &Path, reps: usize) {
     let mut rng = ChaCha8Rng::seed_from_u64(77);
     let q = Mat::from_fn(1000, m, |_, _| rng.random::<f64>());
     write_bin(&adir.join("airframe_queries.bin"), q.as_ref(), m);
+    shape_phases("airframe_", reps, &space, x, f, q.as_ref());
     shape_cases("airframe_", reps, &space, x, f, q.as_ref(), xh, fh);
     let (fit_e, erbf) = time(reps, || {
         Erbf::fit(&space, x, f, ErbfOptions::default()).unwrap()

@@ -34,8 +34,16 @@ pub fn zeros(nrows: usize, ncols: usize) -> Mat<f64> {
     m
 }
 
-/// A copy of `a` in a buffer allocated as by [`zeros`].
+/// A copy of `a`: in a buffer allocated as by [`zeros`] from the threshold above, written
+/// once by [`MatRef::to_owned`] below it.
 pub fn copy(a: MatRef<'_, f64>) -> Mat<f64> {
+    let bytes = a
+        .nrows()
+        .saturating_mul(a.ncols())
+        .saturating_mul(size_of::<f64>());
+    if bytes < HUGE_PAGE_THRESHOLD {
+        return a.to_owned();
+    }
     let mut m = zeros(a.nrows(), a.ncols());
     m.copy_from(a);
     m

@@ -162,7 +162,13 @@ impl Components {
         basis: OutputBasis,
         tuning: Tuning,
     ) -> Result<Self> {
-        crate::data::check_training(points, values, Some(space.dim()))?;
+        // In the shape basis the spectrum checks the values in its first pass.
+        match basis {
+            OutputBasis::Full => crate::data::check_training(points, values, Some(space.dim()))?,
+            OutputBasis::Shapes { .. } => {
+                crate::data::check_training_points(points, values, Some(space.dim()))?
+            }
+        }
         let unit = space.to_unit_matrix(points)?;
         let (spectrum, coords) = match basis {
             OutputBasis::Full => (None, Mat::<f64>::zeros(0, 0)),

@@ -73,6 +73,18 @@ pub(crate) fn check_training(
     values: MatRef<'_, f64>,
     expected_dim: Option<usize>,
 ) -> Result<()> {
+    check_training_points(points, values, expected_dim)?;
+    check_finite_mat("training values", values)?;
+    Ok(())
+}
+
+/// [`check_training`] without the pass over the values for finiteness, for callers that
+/// check them on their own first pass (the shape basis).
+pub(crate) fn check_training_points(
+    points: MatRef<'_, f64>,
+    values: MatRef<'_, f64>,
+    expected_dim: Option<usize>,
+) -> Result<()> {
     if points.nrows() == 0 {
         return Err(no_samples());
     }
@@ -107,7 +119,6 @@ pub(crate) fn check_training(
         ));
     }
     check_finite_mat("training points", points)?;
-    check_finite_mat("training values", values)?;
     Ok(())
 }
 

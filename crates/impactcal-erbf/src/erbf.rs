@@ -299,8 +299,9 @@ impl Erbf {
     /// projected basis `W = Q_1^T B` (`N x 64`) is evaluated from the fit's tables and
     /// `V = R^{-1} W` solved; one product `V^T F` then gives all `T` outputs. Cost about
     /// `Q (N^2 (1 + 2 gamma m) + N T)`; memory `Q N` besides the result. When the model
-    /// stores `c` (few outputs) each chunk multiplies `B^T c` directly. The result does not
-    /// depend on the number of threads.
+    /// stores `c` (few outputs) each chunk multiplies `B^T c` directly. The product is taken
+    /// in fixed blocks of 512 output columns, one task each. The result does not depend on
+    /// the number of threads.
     ///
     /// # Errors
     /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) or
@@ -343,14 +344,24 @@ impl Erbf {
                         self.projection.project(u, cols.as_mut());
                         solve_r(self.r.as_ref(), self.smoother.as_deref(), cols);
                     });
-                matmul(
-                    out.as_mut(),
-                    Accum::Replace,
-                    v.transpose(),
-                    self.responses(),
-                    1.0,
-                    par(),
-                );
+                // out = V^T F in fixed blocks of output columns, one rayon task each with a
+                // sequential product: no thread waits for another at a barrier (which on a
+                // loaded machine costs more than the product), and the result does not
+                // depend on the number of threads.
+                let f = self.responses();
+                out.par_col_chunks_mut(PRODUCT_COLUMNS)
+                    .enumerate()
+                    .for_each(|(b, mut cols)| {
+                        let block = f.subcols(b * PRODUCT_COLUMNS, cols.ncols());
+                        matmul(
+                            cols.as_mut(),
+                            Accum::Replace,
+                            v.transpose(),
+                            block,
+                            1.0,
+                            Par::Seq,
+                        );
+                    });
             }
         }
         for c in 0..self.n_outputs() {
@@ -539,6 +550,10 @@ fn direct_is_cheaper(n: usize, m: usize, t: usize, gamma: f64) -> bool {
 
 /// Queries per chunk of batch prediction (fixed, so results do not depend on threads).
 const CHUNK: usize = 64;
+
+/// Output columns per task of the product `V^T F` of a batch prediction (fixed, so results
+/// do not depend on threads).
+const PRODUCT_COLUMNS: usize = 512;
 
 fn par() -> Par {
     faer::get_global_parallelism()

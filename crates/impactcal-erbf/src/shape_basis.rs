@@ -19,8 +19,9 @@
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
-use faer::{Accum, Mat, MatRef, Side};
+use faer::{Accum, Mat, MatRef, Par, Side};
 use impactcal_shapes::{ImpactShapes, ShapeOptions, SvdMethod, Truncation};
+use rayon::prelude::*;
 
 use crate::buffer;
 use crate::error::{ErbfError, Result};
@@ -36,8 +37,12 @@ pub const TRUNCATION_RATIO: f64 = 0.25;
 /// full thin SVD.
 pub const GRAM_RATIO: usize = 2;
 
-/// Time samples per block when the deviations from the mean are formed on the fly.
-const BLOCK: usize = 2048;
+/// Time samples per block when the deviations from the mean are formed on the fly: the
+/// unit of work of the Gram matrix and of the time functions.
+const BLOCK: usize = 1024;
+
+/// Most groups of blocks the Gram matrix is summed over (one partial `N x N` matrix each).
+const GRAM_GROUPS: usize = 8;
 
 /// The mean history and impact shapes (time functions) of an ensemble of histories.
 #[derive(Debug, Clone)]
@@ -100,30 +105,11 @@ impl ShapeSpectrum {
             }
             .into());
         }
-        check_finite_mat("outputs of the shape basis", values)?;
-        let mean: Vec<f64> = (0..t)
-            .map(|c| values.col(c).iter().sum::<f64>() / n.max(1) as f64)
-            .collect();
+        let mean = column_means(values)?;
         if t < GRAM_RATIO * n {
             return Self::by_svd(values, mean);
         }
-        let mut gram = Mat::<f64>::zeros(n, n);
-        let mut total = 0.0;
-        for_centred_blocks(values, &mean, |_, c| {
-            total += c.squared_norm_l2();
-            // Only the lower triangle: the eigensolver reads no more.
-            triangular::matmul(
-                gram.as_mut(),
-                BlockStructure::TriangularLower,
-                Accum::Add,
-                c,
-                BlockStructure::Rectangular,
-                c.transpose(),
-                BlockStructure::Rectangular,
-                1.0,
-                faer::get_global_parallelism(),
-            );
-        });
+        let (gram, total) = centred_gram(values, &mean);
         let eigen = gram
             .self_adjoint_eigen(Side::Lower)
             .map_err(|_| ErbfError::Shapes(impactcal_shapes::ShapesError::NoConvergence))?;
@@ -211,16 +197,28 @@ impl ShapeSpectrum {
                 for (j, s) in self.sigma[..k].iter().enumerate() {
                     scaled.col_mut(j).iter_mut().for_each(|v| *v /= s);
                 }
-                for_centred_blocks(values, &self.mean, |start, c| {
-                    matmul(
-                        functions.as_mut().submatrix_mut(start, 0, c.ncols(), k),
-                        Accum::Replace,
-                        c.transpose(),
-                        scaled.as_ref(),
-                        1.0,
-                        faer::get_global_parallelism(),
+                // One block of samples per task, each its own rows of G_k: the result does
+                // not depend on the number of threads.
+                let mean = &self.mean;
+                functions
+                    .as_mut()
+                    .subcols_mut(0, k)
+                    .par_row_chunks_mut(BLOCK)
+                    .enumerate()
+                    .for_each_init(
+                        || Mat::<f64>::zeros(n, BLOCK.min(t)),
+                        |buffer, (b, rows)| {
+                            let c = centre_block(values, mean, b * BLOCK, buffer);
+                            matmul(
+                                rows,
+                                Accum::Replace,
+                                c.transpose(),
+                                scaled.as_ref(),
+                                1.0,
+                                Par::Seq,
+                            );
+                        },
                     );
-                });
             }
         }
         functions
@@ -237,30 +235,92 @@ impl ShapeSpectrum {
     }
 }
 
-/// Calls `f(start, C_b)` for consecutive blocks of at most [`BLOCK`] time samples of the
-/// deviations `C = F - 1 f_bar^T`, formed in one reused `N x BLOCK` buffer.
-fn for_centred_blocks(
+/// The column means of `values` (`N x T`), checked for finiteness in the same pass: a
+/// column whose sum is finite has only finite entries (one infinite or NaN entry makes the
+/// sum infinite or NaN).
+///
+/// # Errors
+/// [`CoreError::NonFinite`] naming the first bad entry.
+fn column_means(values: MatRef<'_, f64>) -> Result<Vec<f64>> {
+    let (n, t) = values.shape();
+    let scale = 1.0 / n as f64;
+    let mean: Vec<f64> = (0..t)
+        .map(|c| values.col(c).iter().sum::<f64>() * scale)
+        .collect();
+    if mean.iter().all(|m| m.is_finite()) {
+        return Ok(mean);
+    }
+    check_finite_mat("outputs of the shape basis", values)?;
+    // Finite entries whose sum overflows: average the scaled entries instead.
+    Ok((0..t)
+        .map(|c| values.col(c).iter().map(|v| v * scale).sum())
+        .collect())
+}
+
+/// The lower triangle of the Gram matrix `K = C C^T` of the deviations
+/// `C = F - 1 f_bar^T` (`N x N`; the upper triangle is zero) and `||C||_F^2`.
+///
+/// The samples are split into at most [`GRAM_GROUPS`] contiguous groups of whole blocks of
+/// [`BLOCK`] samples, independent of the number of threads; each group accumulates its
+/// blocks' products in its own matrix (in parallel across groups, sequentially inside), and
+/// the groups are summed in order, so the result does not depend on the number of threads.
+fn centred_gram(values: MatRef<'_, f64>, mean: &[f64]) -> (Mat<f64>, f64) {
+    let (n, t) = values.shape();
+    let blocks = t.div_ceil(BLOCK);
+    let groups = blocks.clamp(1, GRAM_GROUPS);
+    let per_group = blocks.div_ceil(groups);
+    let parts: Vec<(Mat<f64>, f64)> = (0..groups)
+        .into_par_iter()
+        .map(|g| {
+            let mut gram = Mat::<f64>::zeros(n, n);
+            let mut total = 0.0;
+            let mut buffer = Mat::<f64>::zeros(n, BLOCK.min(t));
+            for b in g * per_group..((g + 1) * per_group).min(blocks) {
+                let c = centre_block(values, mean, b * BLOCK, &mut buffer);
+                total += c.squared_norm_l2();
+                // Only the lower triangle: the eigensolver reads no more.
+                triangular::matmul(
+                    gram.as_mut(),
+                    BlockStructure::TriangularLower,
+                    Accum::Add,
+                    c,
+                    BlockStructure::Rectangular,
+                    c.transpose(),
+                    BlockStructure::Rectangular,
+                    1.0,
+                    Par::Seq,
+                );
+            }
+            (gram, total)
+        })
+        .collect();
+    let mut parts = parts.into_iter();
+    let (mut gram, mut total) = parts.next().unwrap_or_else(|| (Mat::zeros(n, n), 0.0));
+    for (g, s) in parts {
+        gram += &g;
+        total += s;
+    }
+    (gram, total)
+}
+
+/// The deviations `C_b = F_b - 1 f_bar_b^T` of the block of at most [`BLOCK`] samples
+/// starting at `start`, formed in `buffer` (`N x BLOCK`).
+fn centre_block<'a>(
     values: MatRef<'_, f64>,
     mean: &[f64],
-    mut f: impl FnMut(usize, MatRef<'_, f64>),
-) {
-    let (n, t) = values.shape();
-    let mut block = Mat::<f64>::zeros(n, BLOCK.min(t));
-    let mut start = 0;
-    while start < t {
-        let len = BLOCK.min(t - start);
-        let mut b = block.as_mut().subcols_mut(0, len);
-        for j in 0..len {
-            let m = mean[start + j];
-            b.as_mut()
-                .col_mut(j)
-                .iter_mut()
-                .zip(values.col(start + j).iter())
-                .for_each(|(d, v)| *d = v - m);
-        }
-        f(start, block.as_ref().subcols(0, len));
-        start += len;
+    start: usize,
+    buffer: &'a mut Mat<f64>,
+) -> MatRef<'a, f64> {
+    let len = BLOCK.min(values.ncols() - start);
+    for j in 0..len {
+        let m = mean[start + j];
+        buffer
+            .col_mut(j)
+            .iter_mut()
+            .zip(values.col(start + j).iter())
+            .for_each(|(d, v)| *d = v - m);
     }
+    buffer.as_ref().subcols(0, len)
 }
 
 /// Makes the largest-magnitude entry of every column of `u` positive (the first on ties),
@@ -519,6 +579,40 @@ mod tests {
         let miss = (&rg - &f).norm_l2() / centred_norm;
         assert_relative_eq!(miss, bg.truncation_error(k), max_relative = 1e-6);
         assert_relative_eq!(bg.truncation_error(k), 10f64.powi(-4), max_relative = 0.01);
+    }
+
+    /// The Gram route sums fixed groups of sample blocks: the same bits on 1, 2 or 3
+    /// threads, with histories long enough for several groups and a partial last block.
+    #[test]
+    fn spectrum_does_not_depend_on_the_thread_count() {
+        let f = graded_ensemble(12, 9 * BLOCK + 37);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let s = ShapeSpectrum::new(f.as_ref()).unwrap();
+                let b = s.basis(f.as_ref(), 5).unwrap();
+                (s.singular_values().to_vec(), s.left.clone(), b.functions)
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            let other = run(threads);
+            assert_eq!(one.0, other.0);
+            assert_eq!(one.1, other.1);
+            assert_eq!(one.2, other.2);
+        }
+    }
+
+    /// Finite outputs whose column sums overflow still give finite means.
+    #[test]
+    fn means_of_huge_finite_outputs_are_finite() {
+        let f = Mat::from_fn(4, 3, |i, j| if j == 1 { 1e308 } else { (i + j) as f64 });
+        let mean = column_means(f.as_ref()).unwrap();
+        assert_relative_eq!(mean[1], 1e308, max_relative = 1e-15);
+        assert_relative_eq!(mean[2], 3.5);
     }
 
     #[test]

@@ -591,3 +591,35 @@ fn smoothing_solves_the_ridge_problem_and_its_loo_is_exact() {
         ));
     }
 }
+
+/// Long outputs (several blocks of the product `V^T F` and a partial last one): the batch
+/// prediction is the same, bit for bit, on 1 and 3 threads, and at the training points
+/// equals `A c` with the explicit coefficients.
+#[test]
+fn long_output_predictions_do_not_depend_on_threads() {
+    let (n, m, t) = (24, 3, 1300);
+    let space = unit_space(m);
+    let x = lhs(n, m, 5);
+    let f = Mat::from_fn(n, t, |i, c| {
+        let u = row(x.as_ref(), i);
+        (smooth(&u) * (1.0 + 0.01 * c as f64)).sin()
+    });
+    let model = Erbf::fit(&space, x.as_ref(), f.as_ref(), ErbfOptions::default()).unwrap();
+    let q = random_unit(70, m, 6);
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| model.predict_batch(q.as_ref()).unwrap())
+    };
+    assert_eq!(run(1), run(3));
+    // At the training points the batch product equals the explicit form A c.
+    let explicit = model.interpolation_matrix() * model.coefficients();
+    let batch = model.predict_batch(x.as_ref()).unwrap();
+    for i in 0..n {
+        for col in 0..t {
+            assert_relative_eq!(batch[(i, col)], explicit[(i, col)], epsilon = 1e-9);
+        }
+    }
+}
