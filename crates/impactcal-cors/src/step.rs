@@ -139,11 +139,24 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
         let index = evaluated + state.pending.len() + out.len();
         let mut rng = stream(state.options.seed, index);
         let blockers = blockers(state, plan.run_start, &out)?;
-        let n_cand = state.options.candidates_per_dim * d;
+        // Evaluations after the run's initial set before this one.
+        let m = index.saturating_sub(plan.cycle_origin);
+        let per_dim = match &state.options.candidate_decay {
+            Some(decay) => decay.per_dim(state.options.candidates_per_dim, m),
+            None => state.options.candidates_per_dim,
+        };
+        let n_cand = per_dim * d;
         let s = match &fitted {
             Ok((surrogate, best)) => {
                 let k = state.options.pattern.len();
-                let beta = state.options.pattern[index.saturating_sub(plan.cycle_origin) % k];
+                let beta = state.options.pattern[m % k];
+                let cycle = m / k;
+                let phase = usize::from(state.options.local_first);
+                let local = state.options.local_region.is_some() && (cycle + phase) % 2 == 1;
+                let region = match state.options.local_region {
+                    Some(half) if local => Region::around(best, half),
+                    _ => Region::unit(d),
+                };
                 let settings = StepSettings {
                     beta,
                     floor: state.options.min_distance * root_d,
@@ -151,11 +164,12 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
                     candidates: n_cand,
                     local_candidates: state.options.local_candidates_per_dim * d,
                     polish_starts: state.options.polish_starts,
-                };
-                let cycle = index.saturating_sub(plan.cycle_origin) / k;
-                let region = match state.options.local_region {
-                    Some(half) if cycle % 2 == 1 => Region::around(best, half),
-                    _ => Region::unit(d),
+                    perturb: state
+                        .options
+                        .perturbation
+                        .filter(|_| local)
+                        .map(|p| p.probability(m, d)),
+                    merit_weight: state.options.merit_weights.as_ref().map(|w| w[m % w.len()]),
                 };
                 let c = cors_step(surrogate, best, &blockers, &settings, &region, &mut rng);
                 Suggestion {

@@ -8,8 +8,8 @@ use impactcal_core::test_functions;
 use impactcal_core::{CoreError, Parameter, ParameterSpace};
 use impactcal_cors::design::{affine_rank, symmetric_design};
 use impactcal_cors::{
-    Cors, CorsError, CorsOptions, FillReason, InitialDesign, Mode, Origin, Restart, StopReason,
-    Stopping, Transform,
+    CandidateDecay, Cors, CorsError, CorsOptions, FillReason, InitialDesign, Mode, Origin,
+    Perturbation, Restart, StopReason, Stopping, Transform,
 };
 
 fn unit_distance(space: &ParameterSpace, a: &[f64], b: &[f64]) -> f64 {
@@ -361,6 +361,67 @@ fn from_history_matches_the_library_loop() {
     }
 }
 
+/// The search options of the DYCORS and SRBF variants (coordinate perturbation, falling
+/// candidate count, weight cycle) keep a study a function of its history: resuming from
+/// JSON and rebuilding from the rows give the library loop's points bit for bit.
+#[test]
+fn search_variants_resume_and_replay_exactly() {
+    let f = test_functions::by_name("hartmann6").unwrap();
+    let variants = [
+        CorsOptions {
+            perturbation: Some(Perturbation { horizon: 40 }),
+            candidate_decay: Some(CandidateDecay {
+                min_per_dim: 50,
+                horizon: 40,
+            }),
+            ..CorsOptions::with_seed(5)
+        },
+        CorsOptions {
+            merit_weights: Some(vec![0.3, 0.5, 0.8, 0.95]),
+            ..CorsOptions::with_seed(6)
+        },
+    ];
+    for options in variants {
+        let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
+        whole.minimize(|x| f.eval(x), 40).unwrap();
+        let default = {
+            let o = CorsOptions {
+                seed: options.seed,
+                ..CorsOptions::default()
+            };
+            let mut s = Cors::new(f.space().unwrap(), o).unwrap();
+            s.minimize(|x| f.eval(x), 40).unwrap();
+            s
+        };
+        // The variant changes the search (after the common design of 14 points).
+        assert_eq!(whole.evaluations()[..14], default.evaluations()[..14]);
+        assert_ne!(whole.evaluations(), default.evaluations());
+        let mut first = Cors::new(f.space().unwrap(), options.clone()).unwrap();
+        first.minimize(|x| f.eval(x), 23).unwrap();
+        let mut resumed = Cors::from_json(&first.to_json().unwrap(), "state").unwrap();
+        resumed.minimize(|x| f.eval(x), 17).unwrap();
+        assert_eq!(resumed.evaluations(), whole.evaluations());
+        let xs: Vec<Vec<f64>> = whole.evaluations().iter().map(|e| e.x.clone()).collect();
+        let fs: Vec<f64> = whole
+            .evaluations()
+            .iter()
+            .map(|e| e.value.unwrap())
+            .collect();
+        for n in [14, 21, 39] {
+            let mut rebuilt = Cors::from_history_rows(
+                f.space().unwrap(),
+                options.clone(),
+                &xs[..n],
+                &fs[..n],
+                None,
+            )
+            .unwrap();
+            let next = rebuilt.suggest(1).unwrap().pop().unwrap();
+            assert_eq!(next.x, xs[n], "after {n} rows");
+        }
+    }
+}
+
 #[test]
 fn batches_hold_distinct_points_with_consecutive_betas() {
     let f = test_functions::by_name("hartmann6").unwrap();
@@ -570,6 +631,39 @@ fn options_are_validated() {
                 min_improvement: f64::NAN,
                 ..Restart::default()
             }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            perturbation: Some(Perturbation { horizon: 1 }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            candidate_decay: Some(CandidateDecay {
+                min_per_dim: 0,
+                horizon: 300,
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            candidate_decay: Some(CandidateDecay {
+                min_per_dim: 301,
+                horizon: 300,
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            candidate_decay: Some(CandidateDecay {
+                min_per_dim: 100,
+                horizon: 0,
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            merit_weights: Some(vec![]),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            merit_weights: Some(vec![0.5, f64::NAN]),
             ..CorsOptions::default()
         },
     ];
