@@ -128,6 +128,10 @@ struct SuggestArgs {
     /// Start each run with a local cycle (around the best point) instead of a whole-box one.
     #[arg(long, conflicts_with = "global_only")]
     local_first: bool,
+    /// Move the local cycles to the next basin after this many evaluations without
+    /// improvement (off by default).
+    #[arg(long, conflicts_with = "global_only")]
+    local_escape: Option<usize>,
     /// DYCORS-style coordinate perturbation in the local cycles: each coordinate of a
     /// candidate around the best point moves with a probability that falls over this many
     /// evaluations after the initial set (off by default).
@@ -297,6 +301,7 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
             ..Restart::default()
         }),
         local_first: args.local_first,
+        local_escape: args.local_escape,
         perturbation: args.perturb_horizon.map(|horizon| Perturbation { horizon }),
         candidate_decay: args.candidate_floor.map(|min_per_dim| CandidateDecay {
             min_per_dim,

@@ -89,7 +89,7 @@ fn shell_loop_reproduces_the_library_loop() {
 #[test]
 fn search_options_reproduce_the_library_loop() {
     let f = test_functions::by_name("branin").unwrap();
-    let cases: [(&[&str], CorsOptions); 7] = [
+    let cases: [(&[&str], CorsOptions); 8] = [
         (
             &["--local-half-width", "0.15"],
             CorsOptions {
@@ -118,6 +118,13 @@ fn search_options_reproduce_the_library_loop() {
             &["--local-first"],
             CorsOptions {
                 local_first: true,
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--local-escape", "4"],
+            CorsOptions {
+                local_escape: Some(4),
                 ..CorsOptions::with_seed(3)
             },
         ),
@@ -300,6 +307,7 @@ fn bad_search_options_are_input_errors() {
         (&["--local-half-width", "0"][..], "local_region"),
         (&["--restart-patience", "0"][..], "patience"),
         (&["--perturb-horizon", "1"][..], "perturbation.horizon"),
+        (&["--local-escape", "0"][..], "local_escape"),
         (
             &["--candidate-floor", "0"][..],
             "candidate_decay.min_per_dim",

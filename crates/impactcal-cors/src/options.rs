@@ -253,6 +253,14 @@ pub struct CorsOptions {
     /// 4... search the box around the best point and 1, 3, 5... the whole box). Default
     /// `false`. No effect without `local_region`.
     pub local_first: bool,
+    /// Local-basin escape: once the run has gone this many evaluations after its initial
+    /// set without improving its best value by more than 0.1 %, the local cycles search
+    /// around the best point of the next basin instead (successes grouped by value into
+    /// boxes of half-width `local_region`), moving on to the next basin after every further
+    /// `local_escape` evaluations without improvement; an improvement brings them back to
+    /// the best point. Unlike a restart, the surrogate keeps every point of the run.
+    /// `None`: always around the best point.
+    pub local_escape: Option<usize>,
     /// DYCORS-style perturbation of the candidates around the best point in the local
     /// cycles (`None`: every coordinate of every such candidate moves).
     pub perturbation: Option<Perturbation>,
@@ -289,6 +297,7 @@ impl Default for CorsOptions {
             restart: None,
             local_region: Some(0.3),
             local_first: false,
+            local_escape: None,
             perturbation: None,
             candidate_decay: None,
             merit_weights: None,
@@ -383,6 +392,9 @@ impl ParamGuard for CorsOptions {
             && !(h.is_finite() && h > 0.0)
         {
             return bad("local_region", h.to_string(), "must be finite and positive");
+        }
+        if self.local_escape == Some(0) {
+            return bad("local_escape", "0".into(), "must be positive");
         }
         if let Some(p) = &self.perturbation
             && p.horizon < 2

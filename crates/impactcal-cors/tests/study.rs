@@ -380,6 +380,11 @@ fn search_variants_resume_and_replay_exactly() {
             merit_weights: Some(vec![0.3, 0.5, 0.8, 0.95]),
             ..CorsOptions::with_seed(6)
         },
+        CorsOptions {
+            local_escape: Some(3),
+            local_first: true,
+            ..CorsOptions::with_seed(7)
+        },
     ];
     for options in variants {
         let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
@@ -631,6 +636,10 @@ fn options_are_validated() {
                 min_improvement: f64::NAN,
                 ..Restart::default()
             }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            local_escape: Some(0),
             ..CorsOptions::default()
         },
         CorsOptions {
