@@ -494,6 +494,7 @@ mod tests {
     /// The DYCORS schedule: 1 at the first adaptive point, `1 - ln 2 / ln H` at the second,
     /// 0 from `m = H - 1` on; the probability is capped by `20 / d` above 20 dimensions.
     #[test]
+    #[allow(clippy::float_cmp)] // exact values by construction
     fn dycors_schedules() {
         assert_eq!(dycors_decay(0, 300), 1.0);
         let second = 1.0 - 2f64.ln() / 300f64.ln();

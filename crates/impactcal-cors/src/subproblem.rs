@@ -564,6 +564,7 @@ mod tests {
     /// With a perturbation probability each candidate moves at least one coordinate and,
     /// at probability 0, exactly one; without it every coordinate moves.
     #[test]
+    #[allow(clippy::float_cmp)] // exact values by construction
     fn perturbation_masks_coordinates() {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let centre = vec![0.5; 6];
@@ -583,6 +584,7 @@ mod tests {
     /// SRBF's merit: weight 1 takes the lowest surrogate value, weight 0 the candidate
     /// farthest from the points, among those at the floor distance.
     #[test]
+    #[allow(clippy::float_cmp)] // exact values by construction
     fn merit_weights_trade_value_for_distance() {
         let cands = vec![0.0, 1.0, 2.0, 3.0];
         // ((distance to ok points, to failed points), surrogate value)
