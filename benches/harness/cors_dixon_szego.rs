@@ -4,7 +4,7 @@
 //! `cargo run --release -p impactcal-cors --example cors_dixon_szego -- [--seeds 30] [--budget 300]
 //! [--functions branin,hartmann3] [--transform identity|log|shifted-log|median-cap]
 //! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]
-//! [--restart-patience N | --restart | --no-restart] [--global-only] [--local-first] [--escape N]
+//! [--restart-patience N | --restart | --no-restart] [--global-only] [--local-first] [--escape N | --no-escape]
 //! [--perturb-horizon H | --no-perturb] [--candidate-floor N [--candidate-horizon H] |
 //! --no-candidate-decay] [--merit-weights 0.3,0.5,0.8,0.95] [--points]`
 //!
@@ -154,6 +154,9 @@ fn main() {
             }
             if let Some(p) = get("--escape") {
                 options.local_escape = Some(p.parse().unwrap());
+            }
+            if args.iter().any(|a| a == "--no-escape") {
+                options.local_escape = None;
             }
             if args.iter().any(|a| a == "--local-first") {
                 options.local_first = true;

@@ -129,14 +129,20 @@ struct SuggestArgs {
     #[arg(long, conflicts_with = "global_only")]
     local_first: bool,
     /// Move the local cycles to the next basin after this many evaluations without
-    /// improvement (off by default).
-    #[arg(long, conflicts_with = "global_only")]
+    /// improvement (default 60).
+    #[arg(long, conflicts_with_all = ["global_only", "no_local_escape"])]
     local_escape: Option<usize>,
+    /// Keep the local cycles around the best point (no basin escape).
+    #[arg(long)]
+    no_local_escape: bool,
     /// DYCORS-style coordinate perturbation in the local cycles: each coordinate of a
     /// candidate around the best point moves with a probability that falls over this many
-    /// evaluations after the initial set (off by default).
-    #[arg(long)]
+    /// evaluations after the initial set (default 300).
+    #[arg(long, conflicts_with = "no_perturbation")]
     perturb_horizon: Option<usize>,
+    /// Move every coordinate of the candidates around the best point.
+    #[arg(long)]
+    no_perturbation: bool,
     /// Let the number of quasi-random candidates fall from 300 d to this many per dimension
     /// over `--candidate-horizon` evaluations after the initial set (off by default).
     #[arg(long)]
@@ -301,8 +307,18 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
             ..Restart::default()
         }),
         local_first: args.local_first,
-        local_escape: args.local_escape,
-        perturbation: args.perturb_horizon.map(|horizon| Perturbation { horizon }),
+        local_escape: if args.no_local_escape {
+            None
+        } else {
+            args.local_escape.or(options.local_escape)
+        },
+        perturbation: if args.no_perturbation {
+            None
+        } else {
+            args.perturb_horizon
+                .map(|horizon| Perturbation { horizon })
+                .or(options.perturbation)
+        },
         candidate_decay: args.candidate_floor.map(|min_per_dim| CandidateDecay {
             min_per_dim,
             horizon: args.candidate_horizon,

@@ -89,7 +89,7 @@ fn shell_loop_reproduces_the_library_loop() {
 #[test]
 fn search_options_reproduce_the_library_loop() {
     let f = test_functions::by_name("branin").unwrap();
-    let cases: [(&[&str], CorsOptions); 8] = [
+    let cases: [(&[&str], CorsOptions); 10] = [
         (
             &["--local-half-width", "0.15"],
             CorsOptions {
@@ -125,6 +125,20 @@ fn search_options_reproduce_the_library_loop() {
             &["--local-escape", "4"],
             CorsOptions {
                 local_escape: Some(4),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--no-local-escape"],
+            CorsOptions {
+                local_escape: None,
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--no-perturbation"],
+            CorsOptions {
+                perturbation: None,
                 ..CorsOptions::with_seed(3)
             },
         ),

@@ -259,10 +259,11 @@ pub struct CorsOptions {
     /// boxes of half-width `local_region`), moving on to the next basin after every further
     /// `local_escape` evaluations without improvement; an improvement brings them back to
     /// the best point. Unlike a restart, the surrogate keeps every point of the run.
-    /// `None`: always around the best point.
+    /// `None`: always around the best point. Default 60.
     pub local_escape: Option<usize>,
     /// DYCORS-style perturbation of the candidates around the best point in the local
-    /// cycles (`None`: every coordinate of every such candidate moves).
+    /// cycles (`None`: every coordinate of every such candidate moves). Default: a horizon
+    /// of 300 evaluations.
     pub perturbation: Option<Perturbation>,
     /// A quasi-random candidate count that falls as the run proceeds (`None`: always
     /// `candidates_per_dim d`).
@@ -297,8 +298,8 @@ impl Default for CorsOptions {
             restart: None,
             local_region: Some(0.3),
             local_first: false,
-            local_escape: None,
-            perturbation: None,
+            local_escape: Some(60),
+            perturbation: Some(Perturbation { horizon: 300 }),
             candidate_decay: None,
             merit_weights: None,
             seed: 0,
