@@ -208,10 +208,10 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
     })
 }
 
-/// Which basin the local cycles search ([`CorsOptions::local_escape`]
-/// (crate::CorsOptions::local_escape)): 0 (the best point's) until the run has stalled for
-/// `patience` evaluations after its initial set, then 1, 2, ... for every further
-/// `patience` evaluations without improvement.
+/// Which basin the local cycles search
+/// ([`CorsOptions::local_escape`](crate::CorsOptions::local_escape)): 0 (the best point's)
+/// until the run has stalled for `patience` evaluations after its initial set, then 1, 2,
+/// ... for every further `patience` evaluations without improvement.
 fn escape_rank(state: &CorsState, plan: &Plan) -> usize {
     let Some(patience) = state.options.local_escape else {
         return 0;

@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use impactcal_core::points::{from_rows, to_rows};
-use impactcal_core::test_functions;
+use impactcal_core::test_functions::{self, TestFunction};
 use impactcal_core::{CoreError, Parameter, ParameterSpace};
 use impactcal_cors::design::{affine_rank, symmetric_design};
 use impactcal_cors::{
@@ -156,13 +156,24 @@ fn restarts_start_a_new_design_and_keep_the_history() {
     let mut resumed = Cors::from_json(&first.to_json().unwrap(), "state").unwrap();
     resumed.minimize(|x| f.eval(x), 70 - start - 3).unwrap();
     assert_eq!(resumed.evaluations(), whole.evaluations());
+    assert_replays(
+        &f,
+        &options,
+        &whole,
+        &[start - 1, start, start + 4, start + 12, 69],
+    );
+}
+
+/// A study rebuilt from the first `n` rows of `whole`'s history suggests `whole`'s next
+/// point, for every `n` in `rows`.
+fn assert_replays(f: &TestFunction, options: &CorsOptions, whole: &Cors, rows: &[usize]) {
     let xs: Vec<Vec<f64>> = whole.evaluations().iter().map(|e| e.x.clone()).collect();
     let fs: Vec<f64> = whole
         .evaluations()
         .iter()
         .map(|e| e.value.unwrap())
         .collect();
-    for n in [start - 1, start, start + 4, start + 12, 69] {
+    for &n in rows {
         let mut rebuilt = Cors::from_history_rows(
             f.space().unwrap(),
             options.clone(),
@@ -341,24 +352,7 @@ fn from_history_matches_the_library_loop() {
     let options = CorsOptions::with_seed(21);
     let mut study = Cors::new(f.space().unwrap(), options.clone()).unwrap();
     study.minimize(|x| f.eval(x), 25).unwrap();
-    let xs: Vec<Vec<f64>> = study.evaluations().iter().map(|e| e.x.clone()).collect();
-    let fs: Vec<f64> = study
-        .evaluations()
-        .iter()
-        .map(|e| e.value.unwrap())
-        .collect();
-    for n in [0, 3, 10, 11, 24] {
-        let mut rebuilt = Cors::from_history_rows(
-            f.space().unwrap(),
-            options.clone(),
-            &xs[..n],
-            &fs[..n],
-            None,
-        )
-        .unwrap();
-        let next = rebuilt.suggest(1).unwrap().pop().unwrap();
-        assert_eq!(next.x, xs[n], "after {n} rows");
-    }
+    assert_replays(&f, &options, &study, &[0, 3, 10, 11, 24]);
 }
 
 /// The search options of the DYCORS and SRBF variants (coordinate perturbation, falling
@@ -406,24 +400,7 @@ fn search_variants_resume_and_replay_exactly() {
         let mut resumed = Cors::from_json(&first.to_json().unwrap(), "state").unwrap();
         resumed.minimize(|x| f.eval(x), 17).unwrap();
         assert_eq!(resumed.evaluations(), whole.evaluations());
-        let xs: Vec<Vec<f64>> = whole.evaluations().iter().map(|e| e.x.clone()).collect();
-        let fs: Vec<f64> = whole
-            .evaluations()
-            .iter()
-            .map(|e| e.value.unwrap())
-            .collect();
-        for n in [14, 21, 39] {
-            let mut rebuilt = Cors::from_history_rows(
-                f.space().unwrap(),
-                options.clone(),
-                &xs[..n],
-                &fs[..n],
-                None,
-            )
-            .unwrap();
-            let next = rebuilt.suggest(1).unwrap().pop().unwrap();
-            assert_eq!(next.x, xs[n], "after {n} rows");
-        }
+        assert_replays(&f, &options, &whole, &[14, 21, 39]);
     }
 }
 
