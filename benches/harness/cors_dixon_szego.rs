@@ -4,7 +4,9 @@
 //! `cargo run --release -p impactcal-cors --example cors_dixon_szego -- [--seeds 30] [--budget 300]
 //! [--functions branin,hartmann3] [--transform identity|log|shifted-log|median-cap]
 //! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]
-//! [--restart-patience N | --no-restart] [--points]`
+//! [--restart-patience N | --restart | --no-restart] [--global-only] [--local-first] [--escape N | --no-escape]
+//! [--perturb-horizon H | --no-perturb] [--candidate-floor N [--candidate-horizon H] |
+//! --no-candidate-decay] [--merit-weights 0.3,0.5,0.8,0.95] [--points]`
 //!
 //! `--noise LEVEL --noise-file FILE` runs the whole budget on `f(x) + LEVEL * range * z_k`,
 //! with the range of each function and the draws `z_k` of each seed read from the table
@@ -22,7 +24,9 @@ use std::time::Instant;
 use std::collections::HashMap;
 
 use impactcal_core::test_functions::{self, TestFunction};
-use impactcal_cors::{Cors, CorsOptions, Restart, SurrogateKernel, Transform};
+use impactcal_cors::{
+    CandidateDecay, Cors, CorsOptions, Perturbation, Restart, SurrogateKernel, Transform,
+};
 
 /// The noise table of `cors_pysot.py --write-noise`: range per function, draws per seed.
 struct Noise {
@@ -148,6 +152,38 @@ fn main() {
             if let Some(h) = get("--local-region") {
                 options.local_region = Some(h.parse().unwrap());
             }
+            if let Some(p) = get("--escape") {
+                options.local_escape = Some(p.parse().unwrap());
+            }
+            if args.iter().any(|a| a == "--no-escape") {
+                options.local_escape = None;
+            }
+            if args.iter().any(|a| a == "--local-first") {
+                options.local_first = true;
+            }
+            if args.iter().any(|a| a == "--global-only") {
+                options.local_region = None;
+            }
+            if let Some(h) = get("--perturb-horizon") {
+                options.perturbation = Some(Perturbation {
+                    horizon: h.parse().unwrap(),
+                });
+            }
+            if args.iter().any(|a| a == "--no-perturb") {
+                options.perturbation = None;
+            }
+            if let Some(c) = get("--candidate-floor") {
+                options.candidate_decay = Some(CandidateDecay {
+                    min_per_dim: c.parse().unwrap(),
+                    horizon: get("--candidate-horizon").map_or(300, |h| h.parse().unwrap()),
+                });
+            }
+            if args.iter().any(|a| a == "--no-candidate-decay") {
+                options.candidate_decay = None;
+            }
+            if let Some(w) = get("--merit-weights") {
+                options.merit_weights = Some(w.split(',').map(|v| v.parse().unwrap()).collect());
+            }
             if args.iter().any(|a| a == "--no-restart") {
                 options.restart = None;
             } else if let Some(p) = get("--restart-patience") {
@@ -155,6 +191,8 @@ fn main() {
                     patience: Some(p.parse().unwrap()),
                     ..Restart::default()
                 });
+            } else if args.iter().any(|a| a == "--restart") {
+                options.restart = Some(Restart::default());
             }
             if let Some(level) = get("--noise") {
                 let path = get("--noise-file").expect("--noise-file with --noise");

@@ -10,7 +10,10 @@ use clap::{Args as ClapArgs, Subcommand, ValueEnum};
 use faer::Mat;
 use impactcal::core::ParamGuard;
 use impactcal::core::{CoreError, ParameterSpace, Table, TableOptions, read_samples};
-use impactcal::cors::{Cors, CorsOptions, InitialDesign, Restart, SurrogateKernel, Transform};
+use impactcal::cors::{
+    CandidateDecay, Cors, CorsOptions, InitialDesign, Perturbation, Restart, SurrogateKernel,
+    Transform,
+};
 
 use crate::error::CliError;
 use crate::output::writer;
@@ -122,6 +125,35 @@ struct SuggestArgs {
     /// Turn the restart rule on with its default patience.
     #[arg(long)]
     restart: bool,
+    /// Start each run with a local cycle (around the best point) instead of a whole-box one.
+    #[arg(long, conflicts_with = "global_only")]
+    local_first: bool,
+    /// Move the local cycles to the next basin after this many evaluations without
+    /// improvement (default 60).
+    #[arg(long, conflicts_with_all = ["global_only", "no_local_escape"])]
+    local_escape: Option<usize>,
+    /// Keep the local cycles around the best point (no basin escape).
+    #[arg(long)]
+    no_local_escape: bool,
+    /// DYCORS-style coordinate perturbation in the local cycles: each coordinate of a
+    /// candidate around the best point moves with a probability that falls over this many
+    /// evaluations after the initial set (default 300).
+    #[arg(long, conflicts_with = "no_perturbation")]
+    perturb_horizon: Option<usize>,
+    /// Move every coordinate of the candidates around the best point.
+    #[arg(long)]
+    no_perturbation: bool,
+    /// Let the number of quasi-random candidates fall from 300 d to this many per dimension
+    /// over `--candidate-horizon` evaluations after the initial set (off by default).
+    #[arg(long)]
+    candidate_floor: Option<usize>,
+    /// The horizon of `--candidate-floor` (default 300).
+    #[arg(long, requires = "candidate_floor", default_value_t = 300)]
+    candidate_horizon: usize,
+    /// SRBF's weight cycle (comma-separated weights in [0, 1], e.g. 0.3,0.5,0.8,0.95) in
+    /// place of the distance constraint (off by default).
+    #[arg(long, value_delimiter = ',')]
+    merit_weights: Option<Vec<f64>>,
     /// Write the points here instead of stdout.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -274,6 +306,24 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
             patience: args.restart_patience,
             ..Restart::default()
         }),
+        local_first: args.local_first,
+        local_escape: if args.no_local_escape {
+            None
+        } else {
+            args.local_escape.or(options.local_escape)
+        },
+        perturbation: if args.no_perturbation {
+            None
+        } else {
+            args.perturb_horizon
+                .map(|horizon| Perturbation { horizon })
+                .or(options.perturbation)
+        },
+        candidate_decay: args.candidate_floor.map(|min_per_dim| CandidateDecay {
+            min_per_dim,
+            horizon: args.candidate_horizon,
+        }),
+        merit_weights: args.merit_weights,
         ..options
     };
     let options = options

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use impactcal::core::points::to_rows;
 use impactcal::core::{Table, TableOptions, test_functions};
-use impactcal::cors::{Cors, CorsOptions, Restart};
+use impactcal::cors::{CandidateDecay, Cors, CorsOptions, Perturbation, Restart};
 
 /// Runs `impactcal optimize suggest` on the files with extra arguments.
 fn run_suggest(bounds: &Path, history: &Path, extra: &[&str]) -> std::process::Output {
@@ -89,7 +89,7 @@ fn shell_loop_reproduces_the_library_loop() {
 #[test]
 fn search_options_reproduce_the_library_loop() {
     let f = test_functions::by_name("branin").unwrap();
-    let cases: [(&[&str], CorsOptions); 3] = [
+    let cases: [(&[&str], CorsOptions); 10] = [
         (
             &["--local-half-width", "0.15"],
             CorsOptions {
@@ -111,6 +111,58 @@ fn search_options_reproduce_the_library_loop() {
                     patience: Some(4),
                     ..Restart::default()
                 }),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--local-first"],
+            CorsOptions {
+                local_first: true,
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--local-escape", "4"],
+            CorsOptions {
+                local_escape: Some(4),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--no-local-escape"],
+            CorsOptions {
+                local_escape: None,
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--no-perturbation"],
+            CorsOptions {
+                perturbation: None,
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--perturb-horizon", "20"],
+            CorsOptions {
+                perturbation: Some(Perturbation { horizon: 20 }),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--candidate-floor", "50", "--candidate-horizon", "20"],
+            CorsOptions {
+                candidate_decay: Some(CandidateDecay {
+                    min_per_dim: 50,
+                    horizon: 20,
+                }),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--merit-weights", "0.3,0.5,0.8,0.95"],
+            CorsOptions {
+                merit_weights: Some(vec![0.3, 0.5, 0.8, 0.95]),
                 ..CorsOptions::with_seed(3)
             },
         ),
@@ -268,6 +320,13 @@ fn bad_search_options_are_input_errors() {
     for (flags, expected) in [
         (&["--local-half-width", "0"][..], "local_region"),
         (&["--restart-patience", "0"][..], "patience"),
+        (&["--perturb-horizon", "1"][..], "perturbation.horizon"),
+        (&["--local-escape", "0"][..], "local_escape"),
+        (
+            &["--candidate-floor", "0"][..],
+            "candidate_decay.min_per_dim",
+        ),
+        (&["--merit-weights", "0.5,2"][..], "merit_weights"),
         (
             &["--local-half-width", "0.2", "--global-only"][..],
             "cannot be used",

@@ -58,7 +58,7 @@ pub use answer::SurrogateAnswer;
 pub use error::{CorsError, Result};
 pub use optimizer::{Cors, Outcome, StopReason};
 pub use options::{
-    CorsOptions, DEFAULT_PATTERN, InitialDesign, Restart, Stopping, SurrogateKernel, Transform,
-    ValidCorsOptions,
+    CandidateDecay, CorsOptions, DEFAULT_PATTERN, InitialDesign, Perturbation, Restart, Stopping,
+    SurrogateKernel, Transform, ValidCorsOptions, dycors_decay,
 };
 pub use state::{CorsState, Evaluation, FillReason, Mode, Origin, Suggestion};

@@ -135,6 +135,61 @@ impl Default for Restart {
     }
 }
 
+/// The decay of the DYCORS schedules (Regis & Shoemaker, INFORMS J. Comput. 25:32-47,
+/// 2013): `phi(m) = 1 - ln(m + 1) / ln(horizon)` for the `m`-th evaluation after the run's
+/// initial set (`m = 0, 1, ...`), clamped to `[0, 1]`: 1 at the first adaptive point, 0 at
+/// and after `m = horizon - 1`. DYCORS takes `horizon` = budget minus the initial set.
+pub fn dycors_decay(m: usize, horizon: usize) -> f64 {
+    if horizon < 2 {
+        return 0.0;
+    }
+    (1.0 - ((m + 1) as f64).ln() / (horizon as f64).ln()).clamp(0.0, 1.0)
+}
+
+/// DYCORS-style coordinate perturbation of the candidates around the best point in the
+/// local cycles (Regis & Shoemaker 2013): each coordinate of such a candidate is perturbed
+/// with probability `p(m) = min(20 / d, 1) phi(m)` ([`dycors_decay`]), and one coordinate
+/// drawn uniformly when none is; the other coordinates keep the best point's values. Early
+/// in a run every coordinate moves; later, in many dimensions, a few at a time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Perturbation {
+    /// Evaluations after the run's initial set over which `p` falls to its floor (DYCORS:
+    /// the budget less the initial set); at least 2.
+    pub horizon: usize,
+}
+
+impl Perturbation {
+    /// The probability of perturbing a coordinate at the `m`-th evaluation after the run's
+    /// initial set in `dim` dimensions.
+    pub fn probability(&self, m: usize, dim: usize) -> f64 {
+        (20.0 / dim.max(1) as f64).min(1.0) * dycors_decay(m, self.horizon)
+    }
+}
+
+/// A number of quasi-random candidates that falls as the run proceeds:
+/// `max(min_per_dim, round(candidates_per_dim phi(m))) d` at the `m`-th evaluation after the
+/// run's initial set ([`dycors_decay`]). Late steps, whose surrogate is dense and whose
+/// search is mostly local, screen fewer candidates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CandidateDecay {
+    /// The floor, per dimension; at least 1 and at most `candidates_per_dim`.
+    pub min_per_dim: usize,
+    /// Evaluations after the run's initial set over which the count falls to its floor; at
+    /// least 2.
+    pub horizon: usize,
+}
+
+impl CandidateDecay {
+    /// Quasi-random candidates per dimension at the `m`-th evaluation after the run's
+    /// initial set, from `per_dim` at `m = 0`.
+    pub fn per_dim(&self, per_dim: usize, m: usize) -> usize {
+        let scaled = (per_dim as f64 * dycors_decay(m, self.horizon)).round() as usize;
+        scaled
+            .max(self.min_per_dim)
+            .min(per_dim.max(self.min_per_dim))
+    }
+}
+
 impl Restart {
     /// The default patience in `dim` dimensions: `6 max(5, d)`, i.e. five cycles of the
     /// default pattern in up to 5 dimensions.
@@ -194,6 +249,31 @@ pub struct CorsOptions {
     /// `Delta` the maximin distance within it. `None`: every cycle searches the whole box
     /// (the 2005 method). Default 0.3.
     pub local_region: Option<f64>,
+    /// Whether the first cycle after a run's initial set is a local one (then cycles 0, 2,
+    /// 4... search the box around the best point and 1, 3, 5... the whole box). Default
+    /// `false`. No effect without `local_region`.
+    pub local_first: bool,
+    /// Local-basin escape: once the run has gone this many evaluations after its initial
+    /// set without improving its best value by more than 0.1 %, the local cycles search
+    /// around the best point of the next basin instead (successes grouped by value into
+    /// boxes of half-width `local_region`), moving on to the next basin after every further
+    /// `local_escape` evaluations without improvement; an improvement brings them back to
+    /// the best point. Unlike a restart, the surrogate keeps every point of the run.
+    /// `None`: always around the best point. Default 60.
+    pub local_escape: Option<usize>,
+    /// DYCORS-style perturbation of the candidates around the best point in the local
+    /// cycles (`None`: every coordinate of every such candidate moves). Default: a horizon
+    /// of 300 evaluations.
+    pub perturbation: Option<Perturbation>,
+    /// A quasi-random candidate count that falls as the run proceeds (`None`: always
+    /// `candidates_per_dim d`).
+    pub candidate_decay: Option<CandidateDecay>,
+    /// SRBF's weight cycle (Regis & Shoemaker 2007) in place of the distance constraint:
+    /// step `m` after the run's initial set takes the candidate minimising
+    /// `w V_S + (1 - w) V_D` with `w` the `m`-th weight (cyclically), each in `[0, 1]`
+    /// (pySOT: `[0.3, 0.5, 0.8, 0.95]`); the pattern then only counts the steps of a cycle
+    /// for the local cycles. `None`: CORS's constrained step.
+    pub merit_weights: Option<Vec<f64>>,
     /// Seed of the design and of every candidate set.
     pub seed: u64,
 }
@@ -217,6 +297,11 @@ impl Default for CorsOptions {
             stopping: Stopping::default(),
             restart: None,
             local_region: Some(0.3),
+            local_first: false,
+            local_escape: Some(60),
+            perturbation: Some(Perturbation { horizon: 300 }),
+            candidate_decay: None,
+            merit_weights: None,
             seed: 0,
         }
     }
@@ -246,7 +331,8 @@ impl ParamGuard for CorsOptions {
     /// [`CoreError::InvalidOption`] for an empty pattern or a `beta` outside `[0, 1]`, a
     /// design of fewer than 2 points, no candidates, no polishing start, a distance that is
     /// negative or not finite, a zero patience (stopping or restart) or a negative or
-    /// non-finite improvement threshold.
+    /// non-finite improvement threshold, a decay horizon below 2, or a candidate floor of 0
+    /// or above `candidates_per_dim`.
     fn check_ref(&self) -> impactcal_core::Result<()> {
         let bad = |name: &'static str, value: String, message: &str| {
             Err(CoreError::invalid_option(name, value, message))
@@ -308,6 +394,46 @@ impl ParamGuard for CorsOptions {
         {
             return bad("local_region", h.to_string(), "must be finite and positive");
         }
+        if self.local_escape == Some(0) {
+            return bad("local_escape", "0".into(), "must be positive");
+        }
+        if let Some(p) = &self.perturbation
+            && p.horizon < 2
+        {
+            return bad(
+                "perturbation.horizon",
+                p.horizon.to_string(),
+                "must be at least 2",
+            );
+        }
+        if let Some(c) = &self.candidate_decay {
+            if c.horizon < 2 {
+                return bad(
+                    "candidate_decay.horizon",
+                    c.horizon.to_string(),
+                    "must be at least 2",
+                );
+            }
+            if c.min_per_dim == 0 || c.min_per_dim > self.candidates_per_dim {
+                return bad(
+                    "candidate_decay.min_per_dim",
+                    c.min_per_dim.to_string(),
+                    "must lie in [1, candidates_per_dim]",
+                );
+            }
+        }
+        if let Some(w) = &self.merit_weights {
+            if w.is_empty() {
+                return bad("merit_weights", "[]".into(), "needs at least one weight");
+            }
+            if let Some(v) = w.iter().find(|v| !(**v >= 0.0 && **v <= 1.0)) {
+                return bad(
+                    "merit_weights",
+                    v.to_string(),
+                    "every weight must lie in [0, 1]",
+                );
+            }
+        }
         if let Some(r) = &self.restart {
             if r.patience == Some(0) {
                 return bad("restart.patience", "0".into(), "must be positive");
@@ -359,5 +485,35 @@ impl Default for ValidCorsOptions {
     /// The defaults of [`CorsOptions::default`], which are valid.
     fn default() -> Self {
         ValidCorsOptions(CorsOptions::default())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The DYCORS schedule: 1 at the first adaptive point, `1 - ln 2 / ln H` at the second,
+    /// 0 from `m = H - 1` on; the probability is capped by `20 / d` above 20 dimensions.
+    #[test]
+    #[allow(clippy::float_cmp)] // exact values by construction
+    fn dycors_schedules() {
+        assert_eq!(dycors_decay(0, 300), 1.0);
+        let second = 1.0 - 2f64.ln() / 300f64.ln();
+        assert!((dycors_decay(1, 300) - second).abs() < 1e-15);
+        assert_eq!(dycors_decay(299, 300), 0.0);
+        assert_eq!(dycors_decay(1000, 300), 0.0);
+        assert_eq!(dycors_decay(0, 1), 0.0);
+        let p = Perturbation { horizon: 300 };
+        assert_eq!(p.probability(0, 6), 1.0);
+        assert!((p.probability(0, 40) - 0.5).abs() < 1e-15);
+        assert!((p.probability(1, 40) - 0.5 * second).abs() < 1e-15);
+        let c = CandidateDecay {
+            min_per_dim: 100,
+            horizon: 300,
+        };
+        assert_eq!(c.per_dim(400, 0), 400);
+        // 400 (1 - ln 11 / ln 300) = 231.9...
+        assert_eq!(c.per_dim(400, 10), 232);
+        assert_eq!(c.per_dim(400, 200), 100);
     }
 }

@@ -10,6 +10,7 @@ use crate::design::affine_rank_of_rows;
 use crate::error::Result;
 use crate::geometry::{distance, stream};
 use crate::options::InitialDesign;
+use crate::stall::StallRule;
 use crate::state::{
     CorsState, DUPLICATE_TOL, FillReason, MATCH_TOL, Mode, Origin, Plan, Suggestion,
 };
@@ -130,17 +131,30 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
             suggestions: out,
         });
     }
-    let fitted = fit_surrogate(state, plan.run_start)?;
+    let fitted = fit_surrogate(state, plan.run_start, escape_rank(state, &plan))?;
     let root_d = (d as f64).sqrt();
     while out.len() < q {
         let index = evaluated + state.pending.len() + out.len();
         let mut rng = stream(state.options.seed, index);
         let blockers = blockers(state, plan.run_start, &out)?;
-        let n_cand = state.options.candidates_per_dim * d;
+        // Evaluations after the run's initial set before this one.
+        let m = index.saturating_sub(plan.cycle_origin);
+        let per_dim = match &state.options.candidate_decay {
+            Some(decay) => decay.per_dim(state.options.candidates_per_dim, m),
+            None => state.options.candidates_per_dim,
+        };
+        let n_cand = per_dim * d;
         let s = match &fitted {
-            Ok((surrogate, best)) => {
+            Ok((surrogate, best, centre)) => {
                 let k = state.options.pattern.len();
-                let beta = state.options.pattern[index.saturating_sub(plan.cycle_origin) % k];
+                let beta = state.options.pattern[m % k];
+                let cycle = m / k;
+                let phase = usize::from(state.options.local_first);
+                let local = state.options.local_region.is_some() && (cycle + phase) % 2 == 1;
+                let (region, best) = match state.options.local_region {
+                    Some(half) if local => (Region::around(centre, half), centre),
+                    _ => (Region::unit(d), best),
+                };
                 let settings = StepSettings {
                     beta,
                     floor: state.options.min_distance * root_d,
@@ -148,11 +162,12 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
                     candidates: n_cand,
                     local_candidates: state.options.local_candidates_per_dim * d,
                     polish_starts: state.options.polish_starts,
-                };
-                let cycle = index.saturating_sub(plan.cycle_origin) / k;
-                let region = match state.options.local_region {
-                    Some(half) if cycle % 2 == 1 => Region::around(best, half),
-                    _ => Region::unit(d),
+                    perturb: state
+                        .options
+                        .perturbation
+                        .filter(|_| local)
+                        .map(|p| p.probability(m, d)),
+                    merit_weight: state.options.merit_weights.as_ref().map(|w| w[m % w.len()]),
                 };
                 let c = cors_step(surrogate, best, &blockers, &settings, &region, &mut rng);
                 Suggestion {
@@ -190,16 +205,67 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
     })
 }
 
+/// Which basin the local cycles search
+/// ([`CorsOptions::local_escape`](crate::CorsOptions::local_escape)): 0 (the best point's)
+/// until the run has stalled for `patience` evaluations after its initial set, then 1, 2,
+/// ... for every further `patience` evaluations without improvement.
+fn escape_rank(state: &CorsState, plan: &Plan) -> usize {
+    let Some(patience) = state.options.local_escape else {
+        return 0;
+    };
+    let end = state.evaluations.len();
+    let start = plan.run_start.min(end);
+    let rule = StallRule {
+        min_improvement: ESCAPE_IMPROVEMENT,
+        floor: 0.0,
+    };
+    let stall = rule.stall_length(
+        &state.evaluations[start..end],
+        plan.cycle_origin.saturating_sub(start),
+    );
+    stall / patience.max(1)
+}
+
+/// Relative improvement that ends a stall for [`escape_rank`] (pySOT's success threshold).
+const ESCAPE_IMPROVEMENT: f64 = 1e-3;
+
+/// The centre of the local cycles for `rank` ([`escape_rank`]): the successes sorted by
+/// value (ties by order) are grouped greedily into basins, a point opening a new basin when
+/// it lies outside the box of half-width `half` around every earlier basin's first point;
+/// the centre is the first point of basin `rank` (cyclically).
+fn basin_centre<'a>(pts: &'a [Vec<f64>], vals: &[f64], half: f64, rank: usize) -> &'a [f64] {
+    let mut order: Vec<usize> = (0..pts.len()).collect();
+    order.sort_by(|&a, &b| vals[a].total_cmp(&vals[b]).then(a.cmp(&b)));
+    let mut basins: Vec<usize> = Vec::new();
+    for k in order {
+        let apart = |j: &usize| {
+            pts[k]
+                .iter()
+                .zip(&pts[*j])
+                .any(|(a, b)| (a - b).abs() > half)
+        };
+        if basins.iter().all(apart) {
+            basins.push(k);
+        }
+    }
+    &pts[basins[rank % basins.len()]]
+}
+
+/// The fitted surrogate, the best successful point and the centre of the local cycles.
+type Fitted = (RbfSurrogate, Vec<f64>, Vec<f64>);
+
 /// The surrogate fitted to the successes of the run starting at `run_start` (near-duplicates
-/// merged, lower value kept, values transformed) and the best successful point in the unit
-/// box; or why none can be fitted.
+/// merged, lower value kept, values transformed), the best successful point in the unit
+/// box and the centre of the local cycles (the best point, or with `escape_rank > 0` the
+/// first point of another basin, [`basin_centre`]); or why none can be fitted.
 ///
 /// # Errors
 /// Mapping errors of the parameter space (not expected).
 fn fit_surrogate(
     state: &CorsState,
     run_start: usize,
-) -> Result<std::result::Result<(RbfSurrogate, Vec<f64>), FillReason>> {
+    escape_rank: usize,
+) -> Result<std::result::Result<Fitted, FillReason>> {
     let d = state.space.dim();
     let tol = DUPLICATE_TOL * (d as f64).sqrt();
     let mut pts: Vec<Vec<f64>> = Vec::new();
@@ -227,13 +293,17 @@ fn fit_surrogate(
         .enumerate()
         .fold(0, |k, (i, v)| if *v < vals[k] { i } else { k });
     let best_x = pts[best].clone();
+    let centre = match state.options.local_region {
+        Some(half) if escape_rank > 0 => basin_centre(&pts, &vals, half, escape_rank).to_vec(),
+        _ => best_x.clone(),
+    };
     state.options.transform.apply(&mut vals);
     if vals.iter().any(|v| !v.is_finite()) {
         return Ok(Err(FillReason::TransformNotFinite));
     }
     Ok(
         match state.fit_cache.fit(&pts, &vals, state.options.kernel) {
-            Ok(s) => Ok((s, best_x)),
+            Ok(s) => Ok((s, best_x, centre)),
             Err(e) => Err(FillReason::SurrogateFailed {
                 message: e.to_string(),
             }),
@@ -258,4 +328,30 @@ fn blockers(state: &CorsState, run_start: usize, proposed: &[Suggestion]) -> Res
         b.ok.extend(state.space.to_unit(&p.x)?);
     }
     Ok(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Basins: sorted by value, a point opens a basin when it lies outside the box of
+    /// half-width `half` around every earlier basin's best point.
+    #[test]
+    fn basins_are_ranked_by_their_best_point() {
+        let pts = vec![
+            vec![0.10, 0.10],
+            vec![0.15, 0.12], // in the first basin
+            vec![0.90, 0.10],
+            vec![0.50, 0.90],
+            vec![0.85, 0.20], // in the second basin
+        ];
+        let vals = [1.0, 2.0, 3.0, 5.0, 2.5];
+        let centre = |rank| basin_centre(&pts, &vals, 0.2, rank).to_vec();
+        assert_eq!(centre(0), pts[0]);
+        // 0.85 is within 0.2 of 0.10? No: |0.85 - 0.10| > 0.2, so it opens basin 2 before
+        // 0.90 (value 2.5 < 3.0); 0.90 then lies in its box.
+        assert_eq!(centre(1), pts[4]);
+        assert_eq!(centre(2), pts[3]);
+        assert_eq!(centre(3), pts[0]);
+    }
 }

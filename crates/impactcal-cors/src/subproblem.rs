@@ -182,6 +182,12 @@ pub struct StepSettings {
     pub local_candidates: usize,
     /// Number of polished starts.
     pub polish_starts: usize,
+    /// Probability of perturbing each coordinate of a candidate around the best point
+    /// (`None`: all coordinates move).
+    pub perturb: Option<f64>,
+    /// The weight `w` of SRBF's merit function for this step (`None`: CORS's constrained
+    /// minimisation). See [`merit_choice`].
+    pub merit_weight: Option<f64>,
 }
 
 /// What a step chose.
@@ -223,17 +229,37 @@ fn global_candidates(dim: usize, n: usize, rng: &mut impl Rng) -> Vec<f64> {
 }
 
 /// Gaussian perturbations of `centre`, clipped to the box, with the standard deviation
-/// cycling through 0.1, 0.02, 0.004.
-fn local_candidates(centre: &[f64], n: usize, region: &Region, rng: &mut impl Rng) -> Vec<f64> {
+/// cycling through 0.1, 0.02, 0.004. With `perturb = Some(p)` only a subset of the
+/// coordinates moves: each with probability `p`, one drawn uniformly when none is (DYCORS).
+fn local_candidates(
+    centre: &[f64],
+    n: usize,
+    region: &Region,
+    perturb: Option<f64>,
+    rng: &mut impl Rng,
+) -> Vec<f64> {
     const SIGMAS: [f64; 3] = [0.1, 0.02, 0.004];
-    let mut out = Vec::with_capacity(n * centre.len());
+    let dim = centre.len();
+    let mut out = Vec::with_capacity(n * dim);
+    let mut mask = vec![true; dim];
     for k in 0..n {
         let sigma = SIGMAS[k % SIGMAS.len()];
+        if let Some(p) = perturb {
+            mask.iter_mut().for_each(|m| *m = rng.random::<f64>() < p);
+            if !mask.iter().any(|m| *m) && dim > 0 {
+                mask[rng.random_range(0..dim)] = true;
+            }
+        }
         let mut x: Vec<f64> = centre
             .iter()
-            .map(|c| {
-                let z: f64 = StandardNormal.sample(rng);
-                c + sigma * z
+            .zip(&mask)
+            .map(|(c, moves)| {
+                if *moves {
+                    let z: f64 = StandardNormal.sample(rng);
+                    c + sigma * z
+                } else {
+                    *c
+                }
             })
             .collect();
         region.clip(&mut x);
@@ -313,6 +339,7 @@ pub fn cors_step(
         best,
         settings.local_candidates,
         region,
+        settings.perturb,
         rng,
     ));
     let near = BlockerColumns::new(blockers);
@@ -345,6 +372,9 @@ pub fn cors_step(
     let h = 0.5 / (n_global.max(2) as f64).powf(1.0 / dim as f64);
     let (maximin_x, delta) =
         refine_maximin(&near, region, cands[i * dim..(i + 1) * dim].to_vec(), h);
+    if let Some(w) = settings.merit_weight {
+        return merit_choice(&cands, &screened, settings, w, delta);
+    }
     let r = settings.beta * delta;
     let radii = Radii {
         ok: r.max(settings.floor),
@@ -405,6 +435,62 @@ pub fn cors_step(
                 predicted,
             }
         }
+    }
+}
+
+/// SRBF's choice (Regis & Shoemaker, INFORMS J. Comput. 19:497-509, 2007): among the
+/// candidates at least the floor from every point (and the failure radius from failed
+/// ones), the minimiser of `w V_S + (1 - w) V_D`, with `V_S = (s - s_min)/(s_max - s_min)`
+/// and `V_D = (d_max - d)/(d_max - d_min)` scaled over those candidates (`d` the distance
+/// to the nearest successful or pending point; a constant criterion scores 1). No
+/// polishing: the candidates are the search. Falls back to the candidate of largest slack
+/// when none is at the floor.
+fn merit_choice(
+    cands: &[f64],
+    screened: &[((f64, f64), f64)],
+    settings: &StepSettings,
+    w: f64,
+    delta: f64,
+) -> Choice {
+    let dim = cands.len() / screened.len().max(1);
+    let radii = Radii {
+        ok: settings.floor,
+        failed: settings.failure_radius.max(settings.floor),
+    };
+    let ok: Vec<usize> = (0..screened.len())
+        .filter(|&k| radii.slack(screened[k].0) >= 0.0)
+        .collect();
+    let k = if ok.is_empty() {
+        argmax(
+            &screened
+                .iter()
+                .map(|(d, _)| radii.slack(*d))
+                .collect::<Vec<_>>(),
+        )
+    } else {
+        let range = |f: &dyn Fn(usize) -> f64| {
+            ok.iter()
+                .map(|&k| f(k))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(v), b.max(v))
+                })
+        };
+        let (s_lo, s_hi) = range(&|k| screened[k].1);
+        let (d_lo, d_hi) = range(&|k| screened[k].0.0);
+        let scale = |v: f64, lo: f64, hi: f64| if hi > lo { (v - lo) / (hi - lo) } else { 1.0 };
+        let score = |k: usize| {
+            w * scale(screened[k].1, s_lo, s_hi)
+                + (1.0 - w) * (1.0 - scale(screened[k].0.0, d_lo, d_hi))
+        };
+        ok.iter()
+            .copied()
+            .fold(ok[0], |b, k| if score(k) < score(b) { k } else { b })
+    };
+    Choice {
+        x: cands[k * dim..(k + 1) * dim].to_vec(),
+        delta,
+        radius: radii.ok,
+        predicted: screened[k].1,
     }
 }
 
@@ -529,6 +615,57 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
+
+    /// With a perturbation probability each candidate moves at least one coordinate and,
+    /// at probability 0, exactly one; without it every coordinate moves.
+    #[test]
+    #[allow(clippy::float_cmp)] // exact values by construction
+    fn perturbation_masks_coordinates() {
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let centre = vec![0.5; 6];
+        let region = Region::unit(6);
+        let moved = |c: &[f64]| c.iter().filter(|v| **v != 0.5).count();
+        let none = local_candidates(&centre, 300, &region, Some(0.0), &mut rng);
+        assert!(none.chunks_exact(6).all(|c| moved(c) == 1));
+        let half = local_candidates(&centre, 300, &region, Some(0.5), &mut rng);
+        let counts: Vec<usize> = half.chunks_exact(6).map(moved).collect();
+        assert!(counts.iter().all(|n| *n >= 1));
+        let mean = counts.iter().sum::<usize>() as f64 / 300.0;
+        assert!((mean - 3.0).abs() < 0.4, "{mean}");
+        let all = local_candidates(&centre, 300, &region, None, &mut rng);
+        assert!(all.chunks_exact(6).all(|c| moved(c) == 6));
+    }
+
+    /// SRBF's merit: weight 1 takes the lowest surrogate value, weight 0 the candidate
+    /// farthest from the points, among those at the floor distance.
+    #[test]
+    #[allow(clippy::float_cmp)] // exact values by construction
+    fn merit_weights_trade_value_for_distance() {
+        let cands = vec![0.0, 1.0, 2.0, 3.0];
+        // ((distance to ok points, to failed points), surrogate value)
+        let screened = vec![
+            ((0.0005, 9.0), -5.0),
+            ((0.1, 9.0), 1.0),
+            ((0.2, 9.0), 2.0),
+            ((0.4, 9.0), 3.0),
+        ];
+        let settings = StepSettings {
+            beta: 0.0,
+            floor: 0.001,
+            failure_radius: 0.0,
+            candidates: 4,
+            local_candidates: 0,
+            polish_starts: 1,
+            perturb: None,
+            merit_weight: None,
+        };
+        let pick = |w| merit_choice(&cands, &screened, &settings, w, 0.5).x[0];
+        assert_eq!(pick(1.0), 1.0);
+        assert_eq!(pick(0.0), 3.0);
+        // w = 0.4: scores 0.4 (0, 1/2, 1) + 0.6 (1, 2/3, 0) = (0.6, 0.6, 0.4).
+        assert_eq!(pick(0.4), 3.0);
+        assert_eq!(pick(0.8), 1.0);
+    }
 
     /// The column-wise screening distance equals the row-wise one bit for bit, for point
     /// counts below, at and above the block size and for no points at all.

@@ -4,12 +4,12 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use impactcal_core::points::{from_rows, to_rows};
-use impactcal_core::test_functions;
+use impactcal_core::test_functions::{self, TestFunction};
 use impactcal_core::{CoreError, Parameter, ParameterSpace};
 use impactcal_cors::design::{affine_rank, symmetric_design};
 use impactcal_cors::{
-    Cors, CorsError, CorsOptions, FillReason, InitialDesign, Mode, Origin, Restart, StopReason,
-    Stopping, Transform,
+    CandidateDecay, Cors, CorsError, CorsOptions, FillReason, InitialDesign, Mode, Origin,
+    Perturbation, Restart, StopReason, Stopping, Transform,
 };
 
 fn unit_distance(space: &ParameterSpace, a: &[f64], b: &[f64]) -> f64 {
@@ -156,13 +156,24 @@ fn restarts_start_a_new_design_and_keep_the_history() {
     let mut resumed = Cors::from_json(&first.to_json().unwrap(), "state").unwrap();
     resumed.minimize(|x| f.eval(x), 70 - start - 3).unwrap();
     assert_eq!(resumed.evaluations(), whole.evaluations());
+    assert_replays(
+        &f,
+        &options,
+        &whole,
+        &[start - 1, start, start + 4, start + 12, 69],
+    );
+}
+
+/// A study rebuilt from the first `n` rows of `whole`'s history suggests `whole`'s next
+/// point, for every `n` in `rows`.
+fn assert_replays(f: &TestFunction, options: &CorsOptions, whole: &Cors, rows: &[usize]) {
     let xs: Vec<Vec<f64>> = whole.evaluations().iter().map(|e| e.x.clone()).collect();
     let fs: Vec<f64> = whole
         .evaluations()
         .iter()
         .map(|e| e.value.unwrap())
         .collect();
-    for n in [start - 1, start, start + 4, start + 12, 69] {
+    for &n in rows {
         let mut rebuilt = Cors::from_history_rows(
             f.space().unwrap(),
             options.clone(),
@@ -341,23 +352,55 @@ fn from_history_matches_the_library_loop() {
     let options = CorsOptions::with_seed(21);
     let mut study = Cors::new(f.space().unwrap(), options.clone()).unwrap();
     study.minimize(|x| f.eval(x), 25).unwrap();
-    let xs: Vec<Vec<f64>> = study.evaluations().iter().map(|e| e.x.clone()).collect();
-    let fs: Vec<f64> = study
-        .evaluations()
-        .iter()
-        .map(|e| e.value.unwrap())
-        .collect();
-    for n in [0, 3, 10, 11, 24] {
-        let mut rebuilt = Cors::from_history_rows(
-            f.space().unwrap(),
-            options.clone(),
-            &xs[..n],
-            &fs[..n],
-            None,
-        )
-        .unwrap();
-        let next = rebuilt.suggest(1).unwrap().pop().unwrap();
-        assert_eq!(next.x, xs[n], "after {n} rows");
+    assert_replays(&f, &options, &study, &[0, 3, 10, 11, 24]);
+}
+
+/// The search options of the DYCORS and SRBF variants (coordinate perturbation, falling
+/// candidate count, weight cycle) keep a study a function of its history: resuming from
+/// JSON and rebuilding from the rows give the library loop's points bit for bit.
+#[test]
+fn search_variants_resume_and_replay_exactly() {
+    let f = test_functions::by_name("hartmann6").unwrap();
+    let variants = [
+        CorsOptions {
+            perturbation: Some(Perturbation { horizon: 40 }),
+            candidate_decay: Some(CandidateDecay {
+                min_per_dim: 50,
+                horizon: 40,
+            }),
+            ..CorsOptions::with_seed(5)
+        },
+        CorsOptions {
+            merit_weights: Some(vec![0.3, 0.5, 0.8, 0.95]),
+            ..CorsOptions::with_seed(6)
+        },
+        CorsOptions {
+            local_escape: Some(3),
+            local_first: true,
+            ..CorsOptions::with_seed(7)
+        },
+    ];
+    for options in variants {
+        let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
+        whole.minimize(|x| f.eval(x), 40).unwrap();
+        let default = {
+            let o = CorsOptions {
+                seed: options.seed,
+                ..CorsOptions::default()
+            };
+            let mut s = Cors::new(f.space().unwrap(), o).unwrap();
+            s.minimize(|x| f.eval(x), 40).unwrap();
+            s
+        };
+        // The variant changes the search (after the common design of 14 points).
+        assert_eq!(whole.evaluations()[..14], default.evaluations()[..14]);
+        assert_ne!(whole.evaluations(), default.evaluations());
+        let mut first = Cors::new(f.space().unwrap(), options.clone()).unwrap();
+        first.minimize(|x| f.eval(x), 23).unwrap();
+        let mut resumed = Cors::from_json(&first.to_json().unwrap(), "state").unwrap();
+        resumed.minimize(|x| f.eval(x), 17).unwrap();
+        assert_eq!(resumed.evaluations(), whole.evaluations());
+        assert_replays(&f, &options, &whole, &[14, 21, 39]);
     }
 }
 
@@ -570,6 +613,43 @@ fn options_are_validated() {
                 min_improvement: f64::NAN,
                 ..Restart::default()
             }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            local_escape: Some(0),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            perturbation: Some(Perturbation { horizon: 1 }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            candidate_decay: Some(CandidateDecay {
+                min_per_dim: 0,
+                horizon: 300,
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            candidate_decay: Some(CandidateDecay {
+                min_per_dim: 301,
+                horizon: 300,
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            candidate_decay: Some(CandidateDecay {
+                min_per_dim: 100,
+                horizon: 0,
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            merit_weights: Some(vec![]),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            merit_weights: Some(vec![0.5, f64::NAN]),
             ..CorsOptions::default()
         },
     ];
