@@ -20,15 +20,25 @@
 //! one-run share is measured at the calibrated point, where declared parameters may
 //! already imitate part of the missing effect; the recalibration frees them together.
 //!
+//! Every addition must also move its quantity away from the held value by more than the
+//! noise can: the recalibrated value `v` is kept only when
+//! `(v - held)^2 > z^2 (c se^2 + v_model)`, `z^2` the `1 - alpha` quantile of `chi2_1`, `se`
+//! the linearised standard error, `c` the noise's inflation and `v_model` the variance the
+//! model's own noise adds, counted coherently from the jitter ensemble
+//! (`closeloop::model_noise`). A crash model recalibrated with one more quantity can reach a
+//! point where its own noise happens to match the test better; a change of the quantity no
+//! larger than that noise makes is not evidence of the effect.
+//!
 //! Selection stops when no model-form error remains, when no candidate is eligible or
-//! realises its share, when BIC does not fall by more than 2, or after `max_added`
+//! realises its share, when an addition is within the noise, when BIC does not fall by more than 2, or after `max_added`
 //! additions.
 
 use impactcal_core::{Enrichable, Parameter};
 
 use super::attribution::attribute;
-use super::detection::{Detection, detect};
+use super::detection::{Detection, chi2_quantile, detect};
 use super::fit::{Ctx, Fit, calibrate};
+use super::model_noise::largest_chi2;
 use super::options::LoopOptions;
 use super::result::{ModelScore, Round};
 use crate::error::Result;
@@ -95,15 +105,19 @@ pub(crate) fn forward<M: Enrichable>(
     let labels = ctx.frame.labels.clone();
     let t = ctx.frame.samples;
     let detect_fit = |fit: &Fit| -> Result<Detection> {
-        detect(
-            &labels,
-            &fit.residual,
-            t,
-            fit.point.len() + n_nuisance,
+        let p = fit.point.len() + n_nuisance;
+        let d = detect(&labels, &fit.residual, t, p, noise_lag1, options.alpha)?;
+        let floor = largest_chi2(
+            &ctx.model_noise,
+            fit,
+            &ctx.frame,
+            p,
             noise_lag1,
             options.alpha,
-        )
+        )?;
+        Ok(d.with_model_noise(floor))
     };
+    let z2 = chi2_quantile(1.0, options.alpha)?;
     let mut fit = fit0;
     let mut det = detect_fit(&fit)?;
     let mut runs = fit.runs;
@@ -204,6 +218,36 @@ pub(crate) fn forward<M: Enrichable>(
                 "`{}` scored first but explains too little: {:.3} of the residual linearised, \
                  {:.3} once recalibrated with it (min_explained {})",
                 p.name, best.explained_fraction, realised, options.min_explained
+            );
+            break;
+        }
+        let last = fit_n.point.len() - 1;
+        let value = fit_n.point[last];
+        let noise_var =
+            ctx.model_noise
+                .parameter_variances(&fit_n, &ctx.frame, fit_n.point.len())?[last];
+        let sd = (fit_n.se[last].powi(2) * inflation + noise_var).sqrt();
+        let change = (value - p.nominal).abs() * best.response_per_unit;
+        let by_itself = ctx.model_noise.largest_draw(&fit_n, &ctx.frame)?;
+        if change <= by_itself {
+            models.push(ModelScore { kept: false, ..s });
+            stopped = format!(
+                "`{}` recalibrated to {value:.6e} from its held {:.6e}: that change moves the \
+                 whitened response by {change:.3e}, no more than the model moves it by itself \
+                 under a jitter of its parameters ({by_itself:.3e})",
+                p.name, p.nominal
+            );
+            break;
+        }
+        if (value - p.nominal).powi(2) <= z2 * sd * sd {
+            models.push(ModelScore { kept: false, ..s });
+            stopped = format!(
+                "`{}` recalibrated to {value:.6e} from its held {:.6e}: a change within what \
+                 the measurement noise and the model's own noise make (standard deviation \
+                 {sd:.3e}, of which the model's noise {:.3e})",
+                p.name,
+                p.nominal,
+                noise_var.sqrt()
             );
             break;
         }
