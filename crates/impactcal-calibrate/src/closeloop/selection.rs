@@ -209,18 +209,30 @@ pub(crate) fn forward<M: Enrichable>(
             options.recalibrate,
             options.polish,
         )?;
+        // The control: the same recalibration without the candidate. A recalibration that
+        // goes on from the previous optimum may lower the residual by itself (a search
+        // that had not converged, or a point whose own noise matches the test better);
+        // the addition is judged against what the control reaches.
+        ctx.runner
+            .observer
+            .step(&format!("recalibration without `{}` (control)", p.name));
+        let control = calibrate(
+            ctx,
+            &cur,
+            &format!("r{}-control", r + 1),
+            std::slice::from_ref(&fit.point),
+            options.recalibrate,
+            options.polish,
+        )?;
         let s = score(&fit_n, &trial_added, n_nuisance, inflation, true);
+        let control_score = score(&control, &added, n_nuisance, inflation, true);
         let prev_bic = models.last().map_or(f64::INFINITY, |m| m.bic);
-        let realised = 1.0 - fit_n.rss / fit.rss;
-        if trial && (realised.is_nan() || realised < options.min_explained) {
-            models.push(ModelScore { kept: false, ..s });
-            stopped = format!(
-                "`{}` scored first but explains too little: {:.3} of the residual linearised, \
-                 {:.3} once recalibrated with it (min_explained {})",
-                p.name, best.explained_fraction, realised, options.min_explained
-            );
-            break;
-        }
+        let (base_rss, base_bic) = if control.rss < fit.rss {
+            (control.rss, control_score.bic.min(prev_bic))
+        } else {
+            (fit.rss, prev_bic)
+        };
+        let realised = 1.0 - fit_n.rss / base_rss;
         let last = fit_n.point.len() - 1;
         let value = fit_n.point[last];
         let noise_var =
@@ -229,36 +241,58 @@ pub(crate) fn forward<M: Enrichable>(
         let sd = (fit_n.se[last].powi(2) * inflation + noise_var).sqrt();
         let change = (value - p.nominal).abs() * best.response_per_unit;
         let by_itself = ctx.model_noise.largest_draw(&fit_n, &ctx.frame)?;
-        if change <= by_itself {
-            models.push(ModelScore { kept: false, ..s });
-            stopped = format!(
+        let refusal = if trial && (realised.is_nan() || realised < options.min_explained) {
+            Some(format!(
+                "`{}` scored first but explains too little: {:.3} of the residual linearised, \
+                 {:.3} once recalibrated with it, against the recalibration without it \
+                 (min_explained {})",
+                p.name, best.explained_fraction, realised, options.min_explained
+            ))
+        } else if change <= by_itself {
+            Some(format!(
                 "`{}` recalibrated to {value:.6e} from its held {:.6e}: that change moves the \
                  whitened response by {change:.3e}, no more than the model moves it by itself \
                  under a jitter of its parameters ({by_itself:.3e})",
                 p.name, p.nominal
-            );
-            break;
-        }
-        if (value - p.nominal).powi(2) <= z2 * sd * sd {
-            models.push(ModelScore { kept: false, ..s });
-            stopped = format!(
+            ))
+        } else if (value - p.nominal).powi(2) <= z2 * sd * sd {
+            Some(format!(
                 "`{}` recalibrated to {value:.6e} from its held {:.6e}: a change within what \
                  the measurement noise and the model's own noise make (standard deviation \
                  {sd:.3e}, of which the model's noise {:.3e})",
                 p.name,
                 p.nominal,
                 noise_var.sqrt()
-            );
-            break;
-        }
-        if s.bic > prev_bic - 2.0 {
+            ))
+        } else if s.bic > base_bic - 2.0 {
+            Some(format!(
+                "adding `{}` did not lower BIC by more than 2 against the recalibration \
+                 without it ({base_bic:.1} -> {:.1})",
+                p.name, s.bic
+            ))
+        } else {
+            None
+        };
+        if let Some(why) = refusal {
             models.push(ModelScore { kept: false, ..s });
-            stopped = format!(
-                "adding `{}` did not lower BIC by more than 2 ({:.1} -> {:.1})",
-                p.name,
-                prev_bic,
-                models.last().map_or(f64::NAN, |m| m.bic)
-            );
+            stopped = why;
+            if control.rss < fit.rss {
+                // The control is the better fit of the model as it stands: it is the result.
+                // Recorded as one more round, without an attribution.
+                models.push(control_score);
+                rounds.push(Round {
+                    added: added.iter().map(|p| p.name.clone()).collect(),
+                    calibrated: names
+                        .iter()
+                        .zip(&control.point)
+                        .map(|(n, v)| (n.to_string(), *v))
+                        .collect(),
+                    detection: detect_fit(&control)?,
+                    attribution: None,
+                    runs: control.runs,
+                });
+                fit = control;
+            }
             break;
         }
         models.push(s);
