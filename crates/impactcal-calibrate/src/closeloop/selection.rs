@@ -20,6 +20,11 @@
 //! one-run share is measured at the calibrated point, where declared parameters may
 //! already imitate part of the missing effect; the recalibration frees them together.
 //!
+//! Each addition is judged against a control: the same recalibration (budget, starting
+//! optimum) without the candidate. The realised share and the BIC margin are measured
+//! against the better of the previous fit and the control; a refused addition leaves the
+//! control as the result when it fits better (one more round, without attribution).
+//!
 //! Every addition must also move its quantity away from the held value by more than the
 //! noise can: the recalibrated value `v` is kept only when
 //! `(v - held)^2 > z^2 (c se^2 + v_model)`, `z^2` the `1 - alpha` quantile of `chi2_1`, `se`
