@@ -17,6 +17,12 @@
 //!   `c_k = <g~_k, r>^2 / (<g~_k, g~_k> <r, r>)`; score statistic
 //!   `LM_k = <g~_k, r>^2 / (<g~_k, g~_k> c)`, `chi2_1` under "effect absent", significant
 //!   above the `1 - alpha / K` quantile (Bonferroni over the `K` directions);
+//! - the model's own noise, counted coherently (`closeloop::model_noise`): the jitter
+//!   ensemble's whitened draws `d_j` give the amplitude the model's noise alone produces,
+//!   `a_j = <g~_k, d_j> / <g~_k, g~_k>`, of variance `v_k = sum_j a_j^2 / m`; the interval
+//!   is `phi_k +- 1.96 sqrt(c / <g~_k, g~_k> + v_k)`, and a significant candidate whose
+//!   `phi_k^2 / (c / <g~_k, g~_k> + v_k)` does not pass the same quantile is *within the
+//!   model's noise* and never added (on a smooth model `v_k = 0`);
 //! - admissibility: the interval must meet the candidate's admissible range (a damping that
 //!   only a negative coefficient would explain is rejected);
 //! - mutual coherence `|<g~_i, g~_j>| / (||g~_i|| ||g~_j||)` above 0.9 names pairs these
@@ -35,6 +41,7 @@ use serde::{Deserialize, Serialize};
 use super::detection::chi2_quantile;
 use super::fit::{Ctx, Fit};
 use super::linalg::{Lsq, dot};
+use super::model_noise::{amplitude_variance, unfitted_energy};
 use super::nuisance;
 use crate::error::Result;
 use crate::study::execute::histories_of;
@@ -74,12 +81,27 @@ pub struct Score {
     pub score: f64,
     /// Above the Bonferroni-corrected `chi2_1` quantile.
     pub significant: bool,
-    /// Amplitude (none when not identifiable).
+    /// Amplitude (none when not identifiable); its interval counts the measurement noise
+    /// and the model's own noise (see `model_noise_sd`).
     pub amplitude: Option<Amplitude>,
+    /// Standard deviation of the amplitude the model's own noise alone produces: the
+    /// jitter ensemble's draws regressed on the direction (`closeloop::model_noise`).
+    #[serde(default)]
+    pub model_noise_sd: f64,
+    /// Norm of the part of the whitened direction no fitted quantity can mimic, per unit of
+    /// the quantity, with the model's own noise taken out: `sqrt(||g~_k||^2 - E / h_k^2)`,
+    /// `E` the mean energy of the jitter draws outside the fitted span and `h_k` the finite
+    /// step (the candidate's run carries one draw of the model's noise, divided by the
+    /// step); 0 for a signature or a candidate that is not identifiable. A change `a` of the
+    /// quantity changes the whitened response beyond what re-tuning can undo by about
+    /// `|a|` times this.
+    #[serde(default)]
+    pub response_per_unit: f64,
     /// The interval meets the admissible range.
     pub admissible: bool,
     /// What the loop makes of it: `best`, `eligible`, `not identifiable`, `inadmissible
-    /// sign`, `not significant`, `explains too little`, `signature`.
+    /// sign`, `not significant`, `within the model's noise`, `explains too little`,
+    /// `signature`.
     pub status: String,
     /// Share of `<g~, r>` per channel.
     pub sensor_pattern: BTreeMap<String, f64>,
@@ -231,6 +253,8 @@ pub(crate) fn attribute<M: Enrichable>(
     }
 
     let lsq = Lsq::new(&fit.jac)?;
+    let draws = ctx.model_noise.whitened(fit, frame);
+    let draws_energy = unfitted_energy(&lsq, &draws);
     let r = &fit.residual;
     let rr = dot(r, r);
     let crit = chi2_quantile(1.0, alpha / dirs.len() as f64)?;
@@ -253,10 +277,20 @@ pub(crate) fn attribute<M: Enrichable>(
         } else {
             (0.0, 0.0)
         };
+        let noise_var = if identifiable {
+            amplitude_variance(&gt, &draws)
+        } else {
+            0.0
+        };
+        let total_var = if identifiable {
+            inflation / gtt + noise_var
+        } else {
+            f64::INFINITY
+        };
         let amplitude = (identifiable).then(|| {
             let held = range.map_or(0.0, |r| r.0);
             let v = held + gr / gtt;
-            let se = (inflation / gtt).sqrt();
+            let se = total_var.sqrt();
             Amplitude {
                 value: v,
                 lower: v - 1.96 * se,
@@ -273,6 +307,7 @@ pub(crate) fn attribute<M: Enrichable>(
             pattern.insert(l.clone(), if gr != 0.0 { part / gr } else { 0.0 });
         }
         let significant = lm > crit;
+        let above_model_noise = identifiable && (gr / gtt).powi(2) / total_var > crit;
         let status = if kind == "signature" {
             "signature"
         } else if !identifiable {
@@ -281,6 +316,8 @@ pub(crate) fn attribute<M: Enrichable>(
             "inadmissible sign"
         } else if !significant {
             "not significant"
+        } else if !above_model_noise {
+            "within the model's noise"
         } else if explained < min_explained {
             "explains too little"
         } else {
@@ -299,6 +336,13 @@ pub(crate) fn attribute<M: Enrichable>(
             score: lm,
             significant,
             amplitude,
+            model_noise_sd: noise_var.sqrt(),
+            response_per_unit: match range {
+                Some((_, _, _, h)) if identifiable => {
+                    (gtt - draws_energy / (h * h)).max(0.0).sqrt()
+                }
+                _ => 0.0,
+            },
             admissible,
             status: status.into(),
             sensor_pattern: pattern,

@@ -17,7 +17,8 @@
 //!   edge the residual has a coherent pattern: `u_1` says on which sensors, `v_1` when.
 //!
 //! Model-form error is declared when `chi2_red` exceeds its threshold **and** `sigma_1`
-//! exceeds the edge.
+//! exceeds the edge. Inside the loop the threshold is raised by what the model's own noise
+//! gives when counted as a whole-trajectory change ([`Detection::with_model_noise`]).
 
 use std::collections::BTreeMap;
 
@@ -59,12 +60,35 @@ pub struct Detection {
     pub coherent_rank: usize,
     /// Whether `sigma1` exceeds the edge.
     pub coherent: bool,
-    /// The verdict: `chi2_red > threshold` and coherent.
+    /// The verdict: `chi2_red > threshold + model_noise_chi2` and coherent.
     pub model_form_error: bool,
+    /// The largest reduced chi-square the model's own noise gives on its own: each draw
+    /// of the jitter ensemble (a whole-trajectory change, `closeloop::model_noise`) taken
+    /// as a residual, with what the fit can absorb removed. 0 for a smooth model, and
+    /// when not measured (the detection of a response that was not fitted).
+    #[serde(default)]
+    pub model_noise_chi2: f64,
     /// Sensor pattern `u_1` (label -> entry).
     pub u1: BTreeMap<String, f64>,
     /// Time pattern `v_1` (one entry per sample; unit norm).
     pub v1: Vec<f64>,
+}
+
+impl Detection {
+    /// The same detection with the model's own noise counted coherently: `model_noise_chi2`
+    /// (the largest reduced chi-square of the jitter ensemble's draws taken as residuals)
+    /// is added to the threshold. The whitening holds the model's noise as if it were
+    /// independent from sample to sample, where a jitter moves the whole trajectory: a
+    /// residual made of such a change has few degrees of freedom and its chi-square is not
+    /// the sum of independent squares the threshold assumes. Reduced chi-squares of
+    /// independent parts add (their sums of squares do), so a residual whose chi-square
+    /// stays below the threshold plus the largest the ensemble produced is at the floor of
+    /// measurement noise plus model noise.
+    pub fn with_model_noise(mut self, model_noise_chi2: f64) -> Self {
+        self.model_noise_chi2 = model_noise_chi2;
+        self.model_form_error = self.coherent && self.chi2_red > self.threshold + model_noise_chi2;
+        self
+    }
 }
 
 /// The `1 - alpha` quantile of `chi2_nu`.
@@ -155,6 +179,7 @@ pub fn detect(
         coherent_rank,
         coherent,
         model_form_error: chi2_red > threshold && coherent,
+        model_noise_chi2: 0.0,
         u1: labels
             .iter()
             .enumerate()

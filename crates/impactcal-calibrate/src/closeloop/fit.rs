@@ -19,6 +19,7 @@ use std::path::Path;
 use impactcal_core::{Cfc, Histories, Model, ParameterSpace};
 
 use super::linalg::{Lsq, dot};
+use super::model_noise::ModelNoise;
 use super::nuisance::{self, Frame, Terms};
 use crate::error::{CalibrateError, Result};
 use crate::study::execute::{Dispatch, Observer, RunOutcome, Runs, Worker, histories_of};
@@ -96,6 +97,8 @@ pub(crate) struct Ctx<'a> {
     pub runner: Journaled<'a>,
     pub seed: u64,
     pub batch: usize,
+    /// The jitter ensemble's draws of the model's own noise.
+    pub model_noise: ModelNoise,
 }
 
 /// A calibrated point with everything the loop reads from it.

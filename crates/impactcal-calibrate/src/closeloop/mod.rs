@@ -58,6 +58,7 @@ pub mod discrepancy;
 pub mod document;
 mod fit;
 mod linalg;
+mod model_noise;
 pub mod noise_floor;
 pub mod nuisance;
 pub mod options;
@@ -86,6 +87,7 @@ pub use result::{Added, ErrorSummary, Errors, LoopResult, ModelScore, Round, Sta
 
 use agreement::Posterior;
 use fit::{Ctx, Journaled};
+use model_noise::ModelNoise;
 use nuisance::{Frame, Terms};
 
 /// A holdout test: the measured histories and the condition they were taken at, as held
@@ -222,7 +224,7 @@ pub fn run_loop_on<M: Enrichable>(
     let unit_gains = (!options.fit_gains).then(|| vec![1.0; labels.len()]);
 
     // The model's own noise and the noise floor.
-    let spread = model_spread(
+    let (spread, model_noise) = model_spread(
         runner,
         model,
         &nominal,
@@ -253,6 +255,7 @@ pub fn run_loop_on<M: Enrichable>(
         runner,
         seed: options.seed,
         batch: options.batch,
+        model_noise,
     };
     let inflation = floor.inflation();
     let onset = noise_floor::onset(&y_nominal, samples);
@@ -316,18 +319,22 @@ pub fn run_loop_on<M: Enrichable>(
     } else {
         None
     };
+    let noise_var = ctx
+        .model_noise
+        .parameter_variances(fit, &ctx.frame, fit.point.len())?;
     let added: Vec<Added> = outcome
         .added
         .iter()
         .enumerate()
         .map(|(i, p)| {
             let v = fit.point[d0 + i];
-            let se = fit.se[d0 + i] * inflation.sqrt();
+            let se = (fit.se[d0 + i].powi(2) * inflation + noise_var[d0 + i]).sqrt();
             Added {
                 name: p.name.clone(),
                 value: v,
                 lower: v - 1.96 * se,
                 upper: v + 1.96 * se,
+                model_noise_sd: noise_var[d0 + i].sqrt(),
             }
         })
         .collect();
@@ -394,7 +401,7 @@ pub fn run_loop_on<M: Enrichable>(
                 )?[0],
                 "the holdout's enriched run",
             )?;
-            let spread_h = model_spread(
+            let (spread_h, _) = model_spread(
                 runner.at(h.set),
                 &declared_at,
                 &nominal,
@@ -489,7 +496,9 @@ pub fn run_loop_on<M: Enrichable>(
     })
 }
 
-/// The jitter spread of `model` about `point` on `labels`, `S x T` (filtered like the test).
+/// The jitter spread of `model` about `point` on `labels`, `S x T` (filtered like the test),
+/// and the ensemble's draws of the model's noise (each run minus the nominal run, with the
+/// jitter it was given).
 #[allow(clippy::too_many_arguments)]
 fn model_spread<M: Model>(
     runner: Journaled<'_>,
@@ -500,7 +509,7 @@ fn model_spread<M: Model>(
     labels: &[String],
     cfc: Option<Cfc>,
     name: &str,
-) -> Result<Vec<f64>> {
+) -> Result<(Vec<f64>, ModelNoise)> {
     let jitter = JitterOptions::new(options.ensemble, options.jitter, options.seed);
     let pts = jitter_points(model.space(), point, &jitter)?;
     let prep = |h: &Histories| -> Result<Histories> {
@@ -509,20 +518,33 @@ fn model_spread<M: Model>(
             None => h.select(labels)?,
         })
     };
-    let runs: Vec<Histories> = runner
-        .stage(model, name, &pts)?
-        .iter()
-        .filter_map(|o| o.as_ref().ok())
-        .map(&prep)
-        .collect::<Result<_>>()?;
+    let mut runs = Vec::new();
+    let mut shifts = Vec::new();
+    for (o, x) in runner.stage(model, name, &pts)?.iter().zip(&pts) {
+        if let Ok(h) = o {
+            runs.push(prep(h)?);
+            shifts.push(x.iter().zip(point).map(|(a, b)| a - b).collect());
+        }
+    }
     if runs.len() < 2 {
         return Err(CalibrateError::study(
             name,
             "fewer than 2 jitter runs succeeded; the model's noise cannot be measured",
         ));
     }
-    let noise = SimulationNoise::from_runs(&prep(nominal)?, &runs)?;
-    Ok(noise.spread.concat())
+    let nominal = prep(nominal)?;
+    let noise = SimulationNoise::from_runs(&nominal, &runs)?;
+    let deviations = runs
+        .iter()
+        .map(|r| {
+            r.data()
+                .iter()
+                .zip(nominal.data())
+                .map(|(a, b)| a - b)
+                .collect()
+        })
+        .collect();
+    Ok((noise.spread.concat(), ModelNoise { deviations, shifts }))
 }
 
 /// The whitened frame of a test and its noise floor.

@@ -24,7 +24,8 @@ pub enum Verdict {
     Unattributed,
 }
 
-/// A candidate added to the model, with its recalibrated value and 95 % interval.
+/// A candidate added to the model, with its recalibrated value and 95 % interval (the
+/// measurement noise's and the model's own noise's).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Added {
     /// The candidate.
@@ -35,6 +36,11 @@ pub struct Added {
     pub lower: f64,
     /// Upper end of the interval.
     pub upper: f64,
+    /// The part of the standard error the model's own noise contributes, counted
+    /// coherently from the jitter ensemble (`closeloop::model_noise`); the interval is
+    /// `value +- 1.96 sqrt(c se^2 + model_noise_sd^2)`.
+    #[serde(default)]
+    pub model_noise_sd: f64,
 }
 
 /// Information criteria of one model of the sequence (known-noise forms, in effective

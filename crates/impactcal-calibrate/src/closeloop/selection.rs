@@ -20,15 +20,30 @@
 //! one-run share is measured at the calibrated point, where declared parameters may
 //! already imitate part of the missing effect; the recalibration frees them together.
 //!
+//! Each addition is judged against a control: the same recalibration (budget, starting
+//! optimum) without the candidate. The realised share and the BIC margin are measured
+//! against the better of the previous fit and the control; a refused addition leaves the
+//! control as the result when it fits better (one more round, without attribution).
+//!
+//! Every addition must also move its quantity away from the held value by more than the
+//! noise can: the recalibrated value `v` is kept only when
+//! `(v - held)^2 > z^2 (c se^2 + v_model)`, `z^2` the `1 - alpha` quantile of `chi2_1`, `se`
+//! the linearised standard error, `c` the noise's inflation and `v_model` the variance the
+//! model's own noise adds, counted coherently from the jitter ensemble
+//! (`closeloop::model_noise`). A crash model recalibrated with one more quantity can reach a
+//! point where its own noise happens to match the test better; a change of the quantity no
+//! larger than that noise makes is not evidence of the effect.
+//!
 //! Selection stops when no model-form error remains, when no candidate is eligible or
-//! realises its share, when BIC does not fall by more than 2, or after `max_added`
+//! realises its share, when an addition is within the noise, when BIC does not fall by more than 2, or after `max_added`
 //! additions.
 
 use impactcal_core::{Enrichable, Parameter};
 
 use super::attribution::attribute;
-use super::detection::{Detection, detect};
+use super::detection::{Detection, chi2_quantile, detect};
 use super::fit::{Ctx, Fit, calibrate};
+use super::model_noise::largest_chi2;
 use super::options::LoopOptions;
 use super::result::{ModelScore, Round};
 use crate::error::Result;
@@ -95,15 +110,19 @@ pub(crate) fn forward<M: Enrichable>(
     let labels = ctx.frame.labels.clone();
     let t = ctx.frame.samples;
     let detect_fit = |fit: &Fit| -> Result<Detection> {
-        detect(
-            &labels,
-            &fit.residual,
-            t,
-            fit.point.len() + n_nuisance,
+        let p = fit.point.len() + n_nuisance;
+        let d = detect(&labels, &fit.residual, t, p, noise_lag1, options.alpha)?;
+        let floor = largest_chi2(
+            &ctx.model_noise,
+            fit,
+            &ctx.frame,
+            p,
             noise_lag1,
             options.alpha,
-        )
+        )?;
+        Ok(d.with_model_noise(floor))
     };
+    let z2 = chi2_quantile(1.0, options.alpha)?;
     let mut fit = fit0;
     let mut det = detect_fit(&fit)?;
     let mut runs = fit.runs;
@@ -195,26 +214,90 @@ pub(crate) fn forward<M: Enrichable>(
             options.recalibrate,
             options.polish,
         )?;
+        // The control: the same recalibration without the candidate. A recalibration that
+        // goes on from the previous optimum may lower the residual by itself (a search
+        // that had not converged, or a point whose own noise matches the test better);
+        // the addition is judged against what the control reaches.
+        ctx.runner
+            .observer
+            .step(&format!("recalibration without `{}` (control)", p.name));
+        let control = calibrate(
+            ctx,
+            &cur,
+            &format!("r{}-control", r + 1),
+            std::slice::from_ref(&fit.point),
+            options.recalibrate,
+            options.polish,
+        )?;
         let s = score(&fit_n, &trial_added, n_nuisance, inflation, true);
+        let control_score = score(&control, &added, n_nuisance, inflation, true);
         let prev_bic = models.last().map_or(f64::INFINITY, |m| m.bic);
-        let realised = 1.0 - fit_n.rss / fit.rss;
-        if trial && (realised.is_nan() || realised < options.min_explained) {
-            models.push(ModelScore { kept: false, ..s });
-            stopped = format!(
+        let (base_rss, base_bic) = if control.rss < fit.rss {
+            (control.rss, control_score.bic.min(prev_bic))
+        } else {
+            (fit.rss, prev_bic)
+        };
+        let realised = 1.0 - fit_n.rss / base_rss;
+        let last = fit_n.point.len() - 1;
+        let value = fit_n.point[last];
+        let noise_var =
+            ctx.model_noise
+                .parameter_variances(&fit_n, &ctx.frame, fit_n.point.len())?[last];
+        let sd = (fit_n.se[last].powi(2) * inflation + noise_var).sqrt();
+        let change = (value - p.nominal).abs() * best.response_per_unit;
+        let by_itself = ctx.model_noise.largest_draw(&fit_n, &ctx.frame)?;
+        let refusal = if trial && (realised.is_nan() || realised < options.min_explained) {
+            Some(format!(
                 "`{}` scored first but explains too little: {:.3} of the residual linearised, \
-                 {:.3} once recalibrated with it (min_explained {})",
+                 {:.3} once recalibrated with it, against the recalibration without it \
+                 (min_explained {})",
                 p.name, best.explained_fraction, realised, options.min_explained
-            );
-            break;
-        }
-        if s.bic > prev_bic - 2.0 {
-            models.push(ModelScore { kept: false, ..s });
-            stopped = format!(
-                "adding `{}` did not lower BIC by more than 2 ({:.1} -> {:.1})",
+            ))
+        } else if change <= by_itself {
+            Some(format!(
+                "`{}` recalibrated to {value:.6e} from its held {:.6e}: that change moves the \
+                 whitened response by {change:.3e}, no more than the model moves it by itself \
+                 under a jitter of its parameters ({by_itself:.3e})",
+                p.name, p.nominal
+            ))
+        } else if (value - p.nominal).powi(2) <= z2 * sd * sd {
+            Some(format!(
+                "`{}` recalibrated to {value:.6e} from its held {:.6e}: a change within what \
+                 the measurement noise and the model's own noise make (standard deviation \
+                 {sd:.3e}, of which the model's noise {:.3e})",
                 p.name,
-                prev_bic,
-                models.last().map_or(f64::NAN, |m| m.bic)
-            );
+                p.nominal,
+                noise_var.sqrt()
+            ))
+        } else if s.bic > base_bic - 2.0 {
+            Some(format!(
+                "adding `{}` did not lower BIC by more than 2 against the recalibration \
+                 without it ({base_bic:.1} -> {:.1})",
+                p.name, s.bic
+            ))
+        } else {
+            None
+        };
+        if let Some(why) = refusal {
+            models.push(ModelScore { kept: false, ..s });
+            stopped = why;
+            if control.rss < fit.rss {
+                // The control is the better fit of the model as it stands: it is the result.
+                // Recorded as one more round, without an attribution.
+                models.push(control_score);
+                rounds.push(Round {
+                    added: added.iter().map(|p| p.name.clone()).collect(),
+                    calibrated: names
+                        .iter()
+                        .zip(&control.point)
+                        .map(|(n, v)| (n.to_string(), *v))
+                        .collect(),
+                    detection: detect_fit(&control)?,
+                    attribution: None,
+                    runs: control.runs,
+                });
+                fit = control;
+            }
             break;
         }
         models.push(s);
