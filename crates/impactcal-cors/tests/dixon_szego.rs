@@ -63,7 +63,9 @@ fn hartmann6() {
 
 #[test]
 fn shekel5() {
-    check("shekel5", Transform::Identity, &[(0, 130)]);
+    // Seed 0 needs 136 in the record of 2026-11-24 (bordered factorisation, perturbation and
+    // basin escape on); the Shekel runs are sensitive to the last bits of the fit.
+    check("shekel5", Transform::Identity, &[(0, 140)]);
 }
 
 #[test]
