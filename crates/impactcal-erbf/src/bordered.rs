@@ -42,7 +42,7 @@
 
 use faer::Mat;
 use impactcal_core::CoreError;
-use impactcal_core::error::dimension_mismatch;
+use impactcal_core::error::{check_finite, dimension_mismatch};
 
 use crate::error::{ErbfError, Result};
 use crate::radial::RadialFunction;
@@ -181,12 +181,7 @@ impl BorderedRbf {
             .zip(upper)
             .map(|(l, u)| 0.5 * (u - l))
             .fold(0.0, f64::max);
-        let diameter = lower
-            .iter()
-            .zip(upper)
-            .map(|(l, u)| (u - l) * (u - l))
-            .sum::<f64>()
-            .sqrt();
+        let diameter = distance(lower, upper);
         Ok(BorderedRbf {
             radial,
             dim,
@@ -243,7 +238,7 @@ impl BorderedRbf {
         if x.len() != self.dim {
             return Err(dimension_mismatch("point: coordinates", self.dim, x.len()));
         }
-        check_finite("point", "coordinate", x)?;
+        check_finite("point coordinates", x)?;
         let column = self.column(x);
         self.points.extend_from_slice(x);
         let bordered = self.factors.as_ref().and_then(|f| {
@@ -281,7 +276,7 @@ impl BorderedRbf {
         if values.len() != n {
             return Err(dimension_mismatch("values: one per point", n, values.len()));
         }
-        check_finite("values", "row", values)?;
+        check_finite("values (one per point)", values)?;
         let Some(f) = &self.factors else {
             return Err(ErbfError::Singular {
                 ratio: 0.0,
@@ -377,20 +372,6 @@ impl BorderedRbf {
             size: m,
             max_pivot,
         })
-    }
-}
-
-/// [`CoreError::NonFinite`] naming the first NaN or infinite entry of `v` (`what`, then
-/// `"<unit> <index>"`).
-fn check_finite(what: &str, unit: &str, v: &[f64]) -> Result<()> {
-    match v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
-        Some((i, x)) => Err(CoreError::NonFinite {
-            what: what.into(),
-            location: format!("{unit} {i}"),
-            value: *x,
-        }
-        .into()),
-        None => Ok(()),
     }
 }
 

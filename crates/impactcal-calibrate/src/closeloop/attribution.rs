@@ -40,8 +40,7 @@ use serde::{Deserialize, Serialize};
 
 use super::detection::chi2_quantile;
 use super::fit::{Ctx, Fit};
-use super::linalg::{Lsq, dot};
-use super::model_noise::{amplitude_variance, unfitted_energy};
+use super::linalg::dot;
 use super::nuisance;
 use crate::error::Result;
 use crate::study::execute::histories_of;
@@ -252,9 +251,9 @@ pub(crate) fn attribute<M: Enrichable>(
         ));
     }
 
-    let lsq = Lsq::new(&fit.jac)?;
-    let draws = ctx.model_noise.whitened(fit, frame);
-    let draws_energy = unfitted_energy(&lsq, &draws);
+    let draws = ctx.model_noise.draws(fit, frame)?;
+    let lsq = draws.lsq();
+    let draws_energy = draws.unfitted_energy();
     let r = &fit.residual;
     let rr = dot(r, r);
     let crit = chi2_quantile(1.0, alpha / dirs.len() as f64)?;
@@ -278,7 +277,7 @@ pub(crate) fn attribute<M: Enrichable>(
             (0.0, 0.0)
         };
         let noise_var = if identifiable {
-            amplitude_variance(&gt, &draws)
+            draws.amplitude_variance(&gt)
         } else {
             0.0
         };

@@ -321,7 +321,8 @@ pub fn run_loop_on<M: Enrichable>(
     };
     let noise_var = ctx
         .model_noise
-        .parameter_variances(fit, &ctx.frame, fit.point.len())?;
+        .draws(fit, &ctx.frame)?
+        .parameter_variances(fit.point.len());
     let added: Vec<Added> = outcome
         .added
         .iter()

@@ -62,101 +62,109 @@ impl ModelNoise {
             .collect()
     }
 
+    /// The draws whitened under the nuisance terms of `fit`, with the least-squares solver
+    /// of its Jacobian that every statistic of them needs: built once per fit.
+    ///
+    /// # Errors
+    /// When the Jacobian's SVD fails.
+    pub fn draws(&self, fit: &Fit, frame: &Frame) -> Result<Draws<'_>> {
+        Ok(Draws {
+            shifts: &self.shifts,
+            lsq: Lsq::new(&fit.jac)?,
+            whitened: self.whitened(fit, frame),
+        })
+    }
+}
+
+/// The model's noise draws whitened under one fit ([`ModelNoise::draws`]), and that fit's
+/// least-squares solver.
+pub(crate) struct Draws<'a> {
+    shifts: &'a [Vec<f64>],
+    lsq: Lsq,
+    whitened: Vec<Vec<f64>>,
+}
+
+impl Draws<'_> {
+    /// The least-squares solver of the fit's Jacobian.
+    pub fn lsq(&self) -> &Lsq {
+        &self.lsq
+    }
+
     /// The largest whitened draw outside the span of the fit's Jacobian,
     /// `max_j ||(I - P_J) d_j||`: how far the model's response moves by itself under a
     /// jitter, in a way re-tuning cannot undo; 0 without draws.
-    ///
-    /// # Errors
-    /// When the Jacobian's SVD fails.
-    pub fn largest_draw(&self, fit: &Fit, frame: &Frame) -> Result<f64> {
-        if self.deviations.is_empty() {
-            return Ok(0.0);
-        }
-        let lsq = Lsq::new(&fit.jac)?;
-        Ok(self
-            .whitened(fit, frame)
+    pub fn largest(&self) -> f64 {
+        self.whitened
             .iter()
-            .map(|d| unfitted(&lsq, d).sqrt())
-            .fold(0.0, f64::max))
+            .map(|d| unfitted(&self.lsq, d).sqrt())
+            .fold(0.0, f64::max)
     }
 
-    /// The variance the model's noise adds to each of the first `p` parameters of `fit`
+    /// The variance the model's noise adds to each of the first `p` parameters of the fit
     /// (`v_i` of the module docs); zeros without draws.
-    ///
-    /// # Errors
-    /// When the Jacobian's SVD fails.
-    pub fn parameter_variances(&self, fit: &Fit, frame: &Frame, p: usize) -> Result<Vec<f64>> {
+    pub fn parameter_variances(&self, p: usize) -> Vec<f64> {
         let mut var = vec![0.0; p];
-        if self.deviations.is_empty() {
-            return Ok(var);
+        if self.whitened.is_empty() {
+            return var;
         }
-        let lsq = Lsq::new(&fit.jac)?;
-        for (d, s) in self.whitened(fit, frame).iter().zip(&self.shifts) {
-            let x = lsq.solve(d);
+        for (d, s) in self.whitened.iter().zip(self.shifts) {
+            let x = self.lsq.solve(d);
             for (i, v) in var.iter_mut().enumerate() {
                 let given = s.get(i).copied().unwrap_or(0.0);
                 *v += (x[i] - given).powi(2);
             }
         }
-        let m = self.deviations.len() as f64;
-        Ok(var.into_iter().map(|v| v / m).collect())
+        let m = self.whitened.len() as f64;
+        var.into_iter().map(|v| v / m).collect()
     }
-}
 
-/// The largest reduced chi-square of the draws taken as residuals of `fit`: each whitened
-/// draw with its projection on the fit's Jacobian removed, scored by `detect` (labels,
-/// samples, fitted quantities `p`, noise correlation `lag1`, level `alpha`); 0 without
-/// draws.
-///
-/// # Errors
-/// When an SVD fails.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn largest_chi2(
-    noise: &ModelNoise,
-    fit: &Fit,
-    frame: &Frame,
-    p: usize,
-    lag1: f64,
-    alpha: f64,
-) -> Result<f64> {
-    if noise.deviations.is_empty() {
-        return Ok(0.0);
+    /// The largest reduced chi-square of the draws taken as residuals of the fit: each
+    /// whitened draw with its projection on the fit's Jacobian removed, scored by `detect`
+    /// (the frame's labels and samples, fitted quantities `p`, noise correlation `lag1`,
+    /// level `alpha`); 0 without draws.
+    ///
+    /// # Errors
+    /// When `detect` fails.
+    pub fn largest_chi2(&self, frame: &Frame, p: usize, lag1: f64, alpha: f64) -> Result<f64> {
+        let mut worst: f64 = 0.0;
+        for d in &self.whitened {
+            let fitted = self.lsq.project(d);
+            let r: Vec<f64> = d.iter().zip(&fitted).map(|(a, b)| a - b).collect();
+            let det = detect(&frame.labels, &r, frame.samples, p, lag1, alpha)?;
+            worst = worst.max(det.chi2_red);
+        }
+        Ok(worst)
     }
-    let lsq = Lsq::new(&fit.jac)?;
-    let mut worst: f64 = 0.0;
-    for d in noise.whitened(fit, frame) {
-        let fitted = lsq.project(&d);
-        let r: Vec<f64> = d.iter().zip(&fitted).map(|(a, b)| a - b).collect();
-        let det = detect(&frame.labels, &r, frame.samples, p, lag1, alpha)?;
-        worst = worst.max(det.chi2_red);
+
+    /// The mean of `||(I - P) d_j||^2` over the draws (0 without draws).
+    pub fn unfitted_energy(&self) -> f64 {
+        if self.whitened.is_empty() {
+            return 0.0;
+        }
+        self.whitened
+            .iter()
+            .map(|d| unfitted(&self.lsq, d))
+            .sum::<f64>()
+            / self.whitened.len() as f64
     }
-    Ok(worst)
+
+    /// The variance of the amplitude the draws attribute to the direction `gt` (orthogonal
+    /// to the fitted Jacobian): `sum_j (<gt, d_j> / <gt, gt>)^2 / m`.
+    pub fn amplitude_variance(&self, gt: &[f64]) -> f64 {
+        let gg = dot(gt, gt);
+        if self.whitened.is_empty() || gg <= 0.0 {
+            return 0.0;
+        }
+        self.whitened
+            .iter()
+            .map(|d| (dot(gt, d) / gg).powi(2))
+            .sum::<f64>()
+            / self.whitened.len() as f64
+    }
 }
 
 /// `||(I - P) d||^2` for the projector `P` of `lsq`.
 fn unfitted(lsq: &Lsq, d: &[f64]) -> f64 {
     let fitted = lsq.project(d);
     d.iter().zip(&fitted).map(|(a, b)| (a - b).powi(2)).sum()
-}
-
-/// The mean of `||(I - P) d_j||^2` over the draws (0 without draws).
-pub(crate) fn unfitted_energy(lsq: &Lsq, whitened: &[Vec<f64>]) -> f64 {
-    if whitened.is_empty() {
-        return 0.0;
-    }
-    whitened.iter().map(|d| unfitted(lsq, d)).sum::<f64>() / whitened.len() as f64
-}
-
-/// The variance of the amplitude the draws `whitened` attribute to the direction `gt`
-/// (orthogonal to the fitted Jacobian): `sum_j (<gt, d_j> / <gt, gt>)^2 / m`.
-pub(crate) fn amplitude_variance(gt: &[f64], whitened: &[Vec<f64>]) -> f64 {
-    let gg = dot(gt, gt);
-    if whitened.is_empty() || gg <= 0.0 {
-        return 0.0;
-    }
-    whitened
-        .iter()
-        .map(|d| (dot(gt, d) / gg).powi(2))
-        .sum::<f64>()
-        / whitened.len() as f64
 }

@@ -43,7 +43,6 @@ use impactcal_core::{Enrichable, Parameter};
 use super::attribution::attribute;
 use super::detection::{Detection, chi2_quantile, detect};
 use super::fit::{Ctx, Fit, calibrate};
-use super::model_noise::largest_chi2;
 use super::options::LoopOptions;
 use super::result::{ModelScore, Round};
 use crate::error::Result;
@@ -112,9 +111,7 @@ pub(crate) fn forward<M: Enrichable>(
     let detect_fit = |fit: &Fit| -> Result<Detection> {
         let p = fit.point.len() + n_nuisance;
         let d = detect(&labels, &fit.residual, t, p, noise_lag1, options.alpha)?;
-        let floor = largest_chi2(
-            &ctx.model_noise,
-            fit,
+        let floor = ctx.model_noise.draws(fit, &ctx.frame)?.largest_chi2(
             &ctx.frame,
             p,
             noise_lag1,
@@ -240,12 +237,11 @@ pub(crate) fn forward<M: Enrichable>(
         let realised = 1.0 - fit_n.rss / base_rss;
         let last = fit_n.point.len() - 1;
         let value = fit_n.point[last];
-        let noise_var =
-            ctx.model_noise
-                .parameter_variances(&fit_n, &ctx.frame, fit_n.point.len())?[last];
+        let draws = ctx.model_noise.draws(&fit_n, &ctx.frame)?;
+        let noise_var = draws.parameter_variances(fit_n.point.len())[last];
         let sd = (fit_n.se[last].powi(2) * inflation + noise_var).sqrt();
         let change = (value - p.nominal).abs() * best.response_per_unit;
-        let by_itself = ctx.model_noise.largest_draw(&fit_n, &ctx.frame)?;
+        let by_itself = draws.largest();
         let refusal = if trial && (realised.is_nan() || realised < options.min_explained) {
             Some(format!(
                 "`{}` scored first but explains too little: {:.3} of the residual linearised, \
