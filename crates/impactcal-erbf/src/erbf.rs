@@ -300,8 +300,9 @@ impl Erbf {
     /// `V = R^{-1} W` solved; one product `V^T F` then gives all `T` outputs. Cost about
     /// `Q (N^2 (1 + 2 gamma m) + N T)`; memory `Q N` besides the result. When the model
     /// stores `c` (few outputs) each chunk multiplies `B^T c` directly. The product is taken
-    /// in fixed blocks of 512 output columns, one task each. The result does not depend on
-    /// the number of threads.
+    /// in fixed blocks of 512 output columns, one task each, which also adds the mean and
+    /// writes its block of the result once. The result does not depend on the number of
+    /// threads.
     ///
     /// # Errors
     /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) or
@@ -311,9 +312,9 @@ impl Erbf {
         let q = points.nrows();
         let m = self.dim();
         let unit = row_major(self.space.to_unit_matrix(points)?.as_ref());
-        let mut out = buffer::zeros(q, self.n_outputs());
-        match &self.coef {
+        let out = match &self.coef {
             Some(c) => {
+                let mut out = buffer::zeros(q, self.n_outputs());
                 let centres = row_major(self.unit.as_ref());
                 out.par_row_chunks_mut(CHUNK)
                     .enumerate()
@@ -331,6 +332,12 @@ impl Erbf {
                             Par::Seq,
                         );
                     });
+                for (c, &mean) in self.mean.iter().enumerate() {
+                    if mean != 0.0 {
+                        out.col_mut(c).iter_mut().for_each(|v| *v += mean);
+                    }
+                }
+                out
             }
             None => {
                 // V = R^{-1} Q_1^T B chunk by chunk, then out = V^T F: the same as
@@ -344,32 +351,31 @@ impl Erbf {
                         self.projection.project(u, cols.as_mut());
                         solve_r(self.r.as_ref(), self.smoother.as_deref(), cols);
                     });
-                // out = V^T F in fixed blocks of output columns, one rayon task each with a
-                // sequential product: no thread waits for another at a barrier (which on a
-                // loaded machine costs more than the product), and the result does not
-                // depend on the number of threads.
+                // out = V^T F + 1 mean^T in fixed blocks of output columns, one rayon task
+                // each with a sequential product: no thread waits for another at a barrier
+                // (which on a loaded machine costs more than the product), each block is
+                // written once while in cache, and the result does not depend on the
+                // number of threads.
                 let f = self.responses();
-                out.par_col_chunks_mut(PRODUCT_COLUMNS)
-                    .enumerate()
-                    .for_each(|(b, mut cols)| {
-                        let block = f.subcols(b * PRODUCT_COLUMNS, cols.ncols());
-                        matmul(
-                            cols.as_mut(),
-                            Accum::Replace,
-                            v.transpose(),
-                            block,
-                            1.0,
-                            Par::Seq,
-                        );
-                    });
+                buffer::by_column_blocks(q, self.n_outputs(), PRODUCT_COLUMNS, |b, mut cols| {
+                    let (first, len) = (b * PRODUCT_COLUMNS, cols.ncols());
+                    matmul(
+                        cols.as_mut(),
+                        Accum::Replace,
+                        v.transpose(),
+                        f.subcols(first, len),
+                        1.0,
+                        Par::Seq,
+                    );
+                    for (j, col) in cols.col_iter_mut().enumerate() {
+                        let mean = self.mean[first + j];
+                        if mean != 0.0 {
+                            col.iter_mut().for_each(|v| *v += mean);
+                        }
+                    }
+                })
             }
-        }
-        for c in 0..self.n_outputs() {
-            let m = self.mean[c];
-            if m != 0.0 {
-                out.col_mut(c).iter_mut().for_each(|v| *v += m);
-            }
-        }
+        };
         Ok(out)
     }
 

@@ -497,35 +497,56 @@ impl RbfInterpolant {
     /// coefficients solved at fit time. For long histories (`T > n`) the same product is
     /// taken the other way round, `(S^{-T} B^T)^T [F; 0]`: a solve with `Q` right-hand
     /// sides instead of `T`, then one `Q x N x T` product with the training values, so the
-    /// coefficients (`n x T`) are never formed. Basis rows are built in parallel and the
-    /// queries processed in blocks of 4096; the result does not depend on the number of
-    /// threads.
+    /// coefficients (`n x T`) are never formed; that product is written once, in blocks of
+    /// 512 output columns, one task each. Basis rows are built in parallel and the queries
+    /// processed in blocks of 4096; the result does not depend on the number of threads.
     ///
     /// # Errors
     /// [`CoreError::DimensionMismatch`] or [`CoreError::NonFinite`] for bad points.
     pub fn predict_batch(&self, points: MatRef<'_, f64>) -> Result<Mat<f64>> {
         check_queries(points, self.dim())?;
-        let n = self.system.nrows();
+        let q = points.nrows();
         let t = self.n_outputs();
-        let mut out = buffer::zeros(points.nrows(), t);
-        let par = faer::get_global_parallelism();
-        let mut start = 0;
-        while start < points.nrows() {
-            let len = BLOCK.min(points.nrows() - start);
-            // Column i of `basis_t` is the basis row of query start + i.
-            let mut basis_t = Mat::<f64>::zeros(n, len);
-            basis_t
-                .par_col_chunks_mut(1)
-                .enumerate()
-                .for_each(|(i, mut col)| {
-                    let x: Vec<f64> = points.row(start + i).iter().copied().collect();
-                    let mut buf = vec![0.0; n];
-                    self.basis_row(&x, &mut buf);
-                    for (k, v) in buf.into_iter().enumerate() {
-                        col[(k, 0)] = v;
+        if t > self.system.nrows() {
+            // Long histories: the left operands of every block of queries (`N x Q` in all,
+            // less than the result), then the result written once, block of output
+            // columns by block, while in cache.
+            let parts: Vec<(usize, Mat<f64>)> = (0..q)
+                .step_by(BLOCK)
+                .map(|start| {
+                    let len = BLOCK.min(q - start);
+                    (
+                        start,
+                        self.apply_operands(self.basis_columns(points, start, len))
+                            .0,
+                    )
+                })
+                .collect();
+            let f = self.values.as_ref();
+            return Ok(buffer::by_column_blocks(
+                q,
+                t,
+                PRODUCT_COLUMNS,
+                |b, mut cols| {
+                    let (first, width) = (b * PRODUCT_COLUMNS, cols.ncols());
+                    for (start, lhs) in &parts {
+                        matmul(
+                            cols.as_mut().subrows_mut(*start, lhs.ncols()),
+                            Accum::Replace,
+                            lhs.transpose(),
+                            f.subcols(first, width),
+                            1.0,
+                            Par::Seq,
+                        );
                     }
-                });
-            let (lhs, rhs) = self.apply_operands(basis_t);
+                },
+            ));
+        }
+        let mut out = buffer::zeros(q, t);
+        let par = faer::get_global_parallelism();
+        for start in (0..q).step_by(BLOCK) {
+            let len = BLOCK.min(q - start);
+            let (lhs, rhs) = self.apply_operands(self.basis_columns(points, start, len));
             matmul(
                 out.as_mut().subrows_mut(start, len),
                 Accum::Replace,
@@ -534,9 +555,27 @@ impl RbfInterpolant {
                 1.0,
                 par,
             );
-            start += len;
         }
         Ok(out)
+    }
+
+    /// The basis rows of queries `start .. start + len` as columns (`n x len`), built in
+    /// parallel.
+    fn basis_columns(&self, points: MatRef<'_, f64>, start: usize, len: usize) -> Mat<f64> {
+        let n = self.system.nrows();
+        let mut basis_t = Mat::<f64>::zeros(n, len);
+        basis_t
+            .par_col_chunks_mut(1)
+            .enumerate()
+            .for_each(|(i, mut col)| {
+                let x: Vec<f64> = points.row(start + i).iter().copied().collect();
+                let mut buf = vec![0.0; n];
+                self.basis_row(&x, &mut buf);
+                for (k, v) in buf.into_iter().enumerate() {
+                    col[(k, 0)] = v;
+                }
+            });
+        basis_t
     }
 
     /// For basis columns `basis_t` (`n x k`), the operands `(L, R)` with
@@ -709,6 +748,9 @@ impl RbfInterpolant {
 
 /// Query rows per block of batch prediction (bounds the basis matrix to `n x 4096`).
 const BLOCK: usize = 4096;
+
+/// Output columns per task when a long-history prediction writes its result.
+const PRODUCT_COLUMNS: usize = 512;
 
 /// Solves `S X = [F; 0]` for the `n x n` system `S` factorised as `P S = L U`, where `F`
 /// (`N x T`) fills the first `N` rows of the right-hand side: the permutation is applied

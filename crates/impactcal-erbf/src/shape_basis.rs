@@ -41,6 +41,9 @@ pub const GRAM_RATIO: usize = 2;
 /// unit of work of the Gram matrix and of the time functions.
 const BLOCK: usize = 1024;
 
+/// Output samples per task when histories are rebuilt.
+const REBUILD_COLUMNS: usize = 512;
+
 /// Most groups of blocks the Gram matrix is summed over (one partial `N x N` matrix each).
 const GRAM_GROUPS: usize = 8;
 
@@ -411,7 +414,8 @@ impl ShapeBasis {
     }
 
     /// Histories from coordinates: `f_bar + G a` for every row `a` of `coords`
-    /// (`Q x k`): a `Q x T` matrix, `O(Q k T)`.
+    /// (`Q x k`): a `Q x T` matrix, `O(Q k T)`, written once in blocks of 512 samples (the
+    /// result does not depend on the number of threads).
     pub fn rebuild(&self, coords: MatRef<'_, f64>) -> Mat<f64> {
         let q = coords.nrows();
         let k = coords.ncols().min(self.len());
@@ -430,16 +434,18 @@ impl ShapeBasis {
         let basis = fewer
             .as_ref()
             .map_or(self.functions.as_ref(), |b| b.as_ref());
-        let mut out = buffer::zeros(q, self.samples());
-        matmul(
-            out.as_mut(),
-            Accum::Replace,
-            ext.as_ref(),
-            basis.transpose(),
-            1.0,
-            faer::get_global_parallelism(),
-        );
-        out
+        // Written once, in blocks of output samples, one task each.
+        buffer::by_column_blocks(q, self.samples(), REBUILD_COLUMNS, |b, mut cols| {
+            let width = cols.ncols();
+            matmul(
+                cols.as_mut(),
+                Accum::Replace,
+                ext.as_ref(),
+                basis.subrows(b * REBUILD_COLUMNS, width).transpose(),
+                1.0,
+                Par::Seq,
+            );
+        })
     }
 
     /// The part of the training outputs that `k` shapes miss, `F - 1 f_bar^T - A_k G_k^T`
@@ -594,7 +600,13 @@ mod tests {
             pool.install(|| {
                 let s = ShapeSpectrum::new(f.as_ref()).unwrap();
                 let b = s.basis(f.as_ref(), 5).unwrap();
-                (s.singular_values().to_vec(), s.left.clone(), b.functions)
+                let rebuilt = b.rebuild(s.coordinates().as_ref());
+                (
+                    s.singular_values().to_vec(),
+                    s.left.clone(),
+                    b.functions,
+                    rebuilt,
+                )
             })
         };
         let one = run(1);
@@ -603,6 +615,7 @@ mod tests {
             assert_eq!(one.0, other.0);
             assert_eq!(one.1, other.1);
             assert_eq!(one.2, other.2);
+            assert_eq!(one.3, other.3);
         }
     }
 

@@ -102,6 +102,42 @@ fn long_outputs_predict_as_their_columns_fitted_alone() {
     }
 }
 
+/// Long histories over more queries than one block of 4096 and more outputs than one
+/// block of 512: every row and column lands where it belongs (against columns fitted
+/// alone, which take the coefficient route), on any number of threads.
+#[test]
+fn long_outputs_over_several_blocks_land_in_place_on_any_thread_count() {
+    let x = random_points(30, 3, 21);
+    let q = random_points(4100, 3, 22);
+    let f = Mat::from_fn(30, 1300, |i, t| {
+        let p: Vec<f64> = x.row(i).iter().copied().collect();
+        smooth(&p) * (0.01 * t as f64).cos() + t as f64 * 1e-3 * p[1]
+    });
+    let all = RbfInterpolant::fit(x.as_ref(), f.as_ref(), RbfOptions::cubic()).unwrap();
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| all.predict_batch(q.as_ref()).unwrap())
+    };
+    let p_all = run(1);
+    assert_eq!(p_all, run(3));
+    for t in [0, 511, 512, 1299] {
+        let one =
+            RbfInterpolant::fit(x.as_ref(), f.as_ref().subcols(t, 1), RbfOptions::cubic()).unwrap();
+        let p = one.predict_batch(q.as_ref()).unwrap();
+        for i in [0, 1, 4095, 4096, 4099] {
+            assert_relative_eq!(
+                p_all[(i, t)],
+                p[(i, 0)],
+                epsilon = 1e-10,
+                max_relative = 1e-10
+            );
+        }
+    }
+}
+
 #[test]
 fn linear_tail_reproduces_affine_functions() {
     let x = random_points(25, 3, 2);
