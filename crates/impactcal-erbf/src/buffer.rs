@@ -56,7 +56,8 @@ pub fn copy(a: MatRef<'_, f64>) -> Mat<f64> {
 
 /// A `nrows x ncols` matrix written block by block in parallel: the columns are cut into
 /// blocks of `block` (the last one shorter; `block` is at least 1) and `fill(b, cols)`
-/// writes block `b`, columns `b block ..`, as one rayon task. Each block is zero when
+/// writes block `b`, columns `b block ..`, as one rayon task (on the calling thread when
+/// there is only one block). Each block is zero when
 /// `fill` sees it: the task zeroes it right before, so a product written with
 /// [`Accum::Replace`](faer::Accum::Replace) touches the memory once, in cache, instead of
 /// after a separate zero-fill of the whole matrix. Buffers of 32 MiB or more are advised
@@ -93,7 +94,7 @@ pub fn by_column_blocks(
         advise_huge_pages(m.as_ptr_mut().cast::<u8>(), bytes);
     }
     let storage = Storage(m.as_ptr_mut());
-    (0..ncols.div_ceil(block)).into_par_iter().for_each(|b| {
+    let write = |b: usize| {
         let start = b * block;
         let len = block.min(ncols - start);
         // SAFETY: `with_capacity` allocated `stride >= nrows` rows for each of the `ncols`
@@ -109,9 +110,16 @@ pub fn by_column_blocks(
             MatMut::from_raw_parts_mut(first, nrows, len, 1, stride as isize)
         };
         fill(b, cols);
-    });
-    // SAFETY: every column `0 .. ncols` was zeroed by its block's task above (the parallel
-    // loop has returned), and `nrows x ncols` is within the capacity reserved.
+    };
+    let blocks = ncols.div_ceil(block);
+    if blocks <= 1 {
+        // One block (a single prediction, say): no task for the pool.
+        (0..blocks).for_each(write);
+    } else {
+        (0..blocks).into_par_iter().for_each(write);
+    }
+    // SAFETY: every column `0 .. ncols` was zeroed by its block's `write` above (the loop
+    // has returned), and `nrows x ncols` is within the capacity reserved.
     #[allow(unsafe_code)]
     unsafe {
         m.set_dims(nrows, ncols);
