@@ -9,7 +9,8 @@
 use crate::design::affine_rank_of_rows;
 use crate::error::Result;
 use crate::geometry::{distance, stream};
-use crate::options::InitialDesign;
+use crate::options::{Converged, InitialDesign};
+use crate::region::{LocalWidth, SUCCESS_IMPROVEMENT, adaptive_width};
 use crate::stall::StallRule;
 use crate::state::{
     CorsState, DUPLICATE_TOL, FillReason, MATCH_TOL, Mode, Origin, Plan, Suggestion,
@@ -131,7 +132,8 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
             suggestions: out,
         });
     }
-    let fitted = fit_surrogate(state, plan.run_start, escape_rank(state, &plan))?;
+    let width = local_width(state, &plan);
+    let fitted = fit_surrogate(state, plan.run_start, width.rank)?;
     let root_d = (d as f64).sqrt();
     while out.len() < q {
         let index = evaluated + state.pending.len() + out.len();
@@ -151,9 +153,13 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
                 let cycle = m / k;
                 let phase = usize::from(state.options.local_first);
                 let local = state.options.local_region.is_some() && (cycle + phase) % 2 == 1;
-                let (region, best) = match state.options.local_region {
-                    Some(half) if local => (Region::around(centre, half), centre),
-                    _ => (Region::unit(d), best),
+                let (region, best, sigma_scale) = match state.options.local_region {
+                    Some(initial) if local => (
+                        Region::around(centre, width.boxed),
+                        centre,
+                        width.half / initial,
+                    ),
+                    _ => (Region::unit(d), best, 1.0),
                 };
                 let settings = StepSettings {
                     beta,
@@ -168,6 +174,7 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
                         .filter(|_| local)
                         .map(|p| p.probability(m, d)),
                     merit_weight: state.options.merit_weights.as_ref().map(|w| w[m % w.len()]),
+                    sigma_scale,
                 };
                 let c = cors_step(surrogate, best, &blockers, &settings, &region, &mut rng);
                 Suggestion {
@@ -205,6 +212,34 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
     })
 }
 
+/// The local region of the next step: its half-width (`local_region`, or under
+/// [`CorsOptions::adaptive_region`](crate::CorsOptions::adaptive_region) as the step-size
+/// rule has made it) and the basin its centre lies in ([`escape_rank`], or the
+/// convergences under [`Converged::Escape`]).
+fn local_width(state: &CorsState, plan: &Plan) -> LocalWidth {
+    let initial = state.options.local_region.unwrap_or(1.0);
+    let Some(rule) = &state.options.adaptive_region else {
+        return LocalWidth {
+            half: initial,
+            boxed: initial,
+            rank: escape_rank(state, plan),
+        };
+    };
+    let end = state.evaluations.len();
+    let start = plan.run_start.min(end);
+    let mut width = adaptive_width(
+        rule,
+        initial,
+        &state.evaluations[start..end],
+        plan.cycle_origin.saturating_sub(start),
+        state.space.dim(),
+    );
+    if rule.on_converged == Converged::Restore {
+        width.rank = escape_rank(state, plan);
+    }
+    width
+}
+
 /// Which basin the local cycles search
 /// ([`CorsOptions::local_escape`](crate::CorsOptions::local_escape)): 0 (the best point's)
 /// until the run has stalled for `patience` evaluations after its initial set, then 1, 2,
@@ -216,7 +251,7 @@ fn escape_rank(state: &CorsState, plan: &Plan) -> usize {
     let end = state.evaluations.len();
     let start = plan.run_start.min(end);
     let rule = StallRule {
-        min_improvement: ESCAPE_IMPROVEMENT,
+        min_improvement: SUCCESS_IMPROVEMENT,
         floor: 0.0,
     };
     let stall = rule.stall_length(
@@ -225,9 +260,6 @@ fn escape_rank(state: &CorsState, plan: &Plan) -> usize {
     );
     stall / patience.max(1)
 }
-
-/// Relative improvement that ends a stall for [`escape_rank`] (pySOT's success threshold).
-const ESCAPE_IMPROVEMENT: f64 = 1e-3;
 
 /// The centre of the local cycles for `rank` ([`escape_rank`]): the successes sorted by
 /// value (ties by order) are grouped greedily into basins, a point opening a new basin when
