@@ -252,6 +252,9 @@ pub enum Converged {
     /// escape triggered by convergence rather than by a fixed idle count. An improvement of
     /// the run's best brings them back to the best point.
     Escape,
+    /// The run ends and a new one starts, as by the restart rule ([`Restart`]; DYCORS's
+    /// own restart): a new design and a surrogate of the new run's points only.
+    Restart,
 }
 
 impl Restart {

@@ -22,6 +22,8 @@ pub(crate) struct LocalWidth {
     /// Convergences since the run's last improvement (only counted under
     /// [`Converged::Escape`]).
     pub(crate) rank: usize,
+    /// Convergences in the run.
+    pub(crate) converged: usize,
 }
 
 /// Applies `rule` to the run's `evaluations`, counting successes and failures from index
@@ -45,6 +47,7 @@ pub(crate) fn adaptive_width(
         half: initial,
         boxed: initial,
         rank: 0,
+        converged: 0,
     };
     for (k, e) in evaluations.iter().enumerate() {
         let improved = stall.improves(e.value, &mut best);
@@ -68,6 +71,7 @@ pub(crate) fn adaptive_width(
             failures = 0;
             if width.half < floor {
                 width.half = initial;
+                width.converged += 1;
                 if rule.on_converged == Converged::Escape {
                     width.rank += 1;
                 }
@@ -130,7 +134,7 @@ mod tests {
         // Nine failures: 0.2, 0.1, then below the floor: restored and escaped once.
         v.extend([4.0; 9]);
         let w = adaptive_width(&rule, 0.4, &evals(&v), 1, 1);
-        assert_eq!((w.half, w.rank), (0.4, 1));
+        assert_eq!((w.half, w.rank, w.converged), (0.4, 1, 1));
         // An improvement of less than 0.1 % is a failure; a larger one resets the rank.
         v.push(3.999);
         assert_eq!(adaptive_width(&rule, 0.4, &evals(&v), 1, 1).rank, 1);

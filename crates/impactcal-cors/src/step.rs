@@ -73,9 +73,9 @@ pub(crate) fn advance_plan(
 ) -> Result<bool> {
     let due =
         index >= plan.cycle_origin
-            && state.options.restart.as_ref().is_some_and(|rule| {
+            && (state.options.restart.as_ref().is_some_and(|rule| {
                 plan.stagnates(&state.evaluations, upto, rule, state.space.dim())
-            });
+            }) || converged_restart(state, plan, upto));
     if due {
         plan.restarts += 1;
         plan.design = state.run_design(plan.restarts)?;
@@ -84,6 +84,29 @@ pub(crate) fn advance_plan(
         plan.cycle_origin = index + plan.design.len();
     }
     Ok(due)
+}
+
+/// Whether the local region of the run, seeing the first `upto` evaluations, has converged
+/// under [`Converged::Restart`].
+fn converged_restart(state: &CorsState, plan: &Plan, upto: usize) -> bool {
+    let Some(rule) = state
+        .options
+        .adaptive_region
+        .as_ref()
+        .filter(|r| r.on_converged == Converged::Restart)
+    else {
+        return false;
+    };
+    let end = upto.min(state.evaluations.len());
+    let start = plan.run_start.min(end);
+    let width = adaptive_width(
+        rule,
+        state.options.local_region.unwrap_or(1.0),
+        &state.evaluations[start..end],
+        plan.cycle_origin.saturating_sub(start),
+        state.space.dim(),
+    );
+    width.converged > 0
 }
 
 /// Proposes `q` distinct points to evaluate next (see [`Cors::suggest`](crate::Cors::suggest)).
@@ -223,6 +246,7 @@ fn local_width(state: &CorsState, plan: &Plan) -> LocalWidth {
             half: initial,
             boxed: initial,
             rank: escape_rank(state, plan),
+            converged: 0,
         };
     };
     let end = state.evaluations.len();
@@ -234,7 +258,7 @@ fn local_width(state: &CorsState, plan: &Plan) -> LocalWidth {
         plan.cycle_origin.saturating_sub(start),
         state.space.dim(),
     );
-    if rule.on_converged == Converged::Restore {
+    if rule.on_converged != Converged::Escape {
         width.rank = escape_rank(state, plan);
     }
     width

@@ -398,10 +398,24 @@ fn search_variants_resume_and_replay_exactly() {
             }),
             ..CorsOptions::with_seed(9)
         },
+        CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                grow_after: 2,
+                shrink_after: Some(2),
+                halvings: 1,
+                on_converged: Converged::Restart,
+                shrink_box: false,
+            }),
+            ..CorsOptions::with_seed(10)
+        },
     ];
     for options in variants {
         let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
         whole.minimize(|x| f.eval(x), 40).unwrap();
+        let restarts_on_convergence = options
+            .adaptive_region
+            .is_some_and(|a| a.on_converged == Converged::Restart);
+        assert_eq!(whole.restarts() > 0, restarts_on_convergence);
         let default = {
             let o = CorsOptions {
                 seed: options.seed,
