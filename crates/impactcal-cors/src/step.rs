@@ -9,7 +9,7 @@
 use crate::design::affine_rank_of_rows;
 use crate::error::Result;
 use crate::geometry::{distance, stream};
-use crate::options::{Converged, InitialDesign};
+use crate::options::{AdaptiveRegion, Converged, InitialDesign};
 use crate::region::{LocalWidth, SUCCESS_IMPROVEMENT, adaptive_width};
 use crate::stall::StallRule;
 use crate::state::{
@@ -97,16 +97,20 @@ fn converged_restart(state: &CorsState, plan: &Plan, upto: usize) -> bool {
     else {
         return false;
     };
+    run_width(state, plan, rule, upto).converged > 0
+}
+
+/// The adaptive width of the current run after its evaluations before index `upto`.
+fn run_width(state: &CorsState, plan: &Plan, rule: &AdaptiveRegion, upto: usize) -> LocalWidth {
     let end = upto.min(state.evaluations.len());
     let start = plan.run_start.min(end);
-    let width = adaptive_width(
+    adaptive_width(
         rule,
         state.options.local_region.unwrap_or(1.0),
         &state.evaluations[start..end],
         plan.cycle_origin.saturating_sub(start),
         state.space.dim(),
-    );
-    width.converged > 0
+    )
 }
 
 /// Proposes `q` distinct points to evaluate next (see [`Cors::suggest`](crate::Cors::suggest)).
@@ -249,15 +253,7 @@ fn local_width(state: &CorsState, plan: &Plan) -> LocalWidth {
             converged: 0,
         };
     };
-    let end = state.evaluations.len();
-    let start = plan.run_start.min(end);
-    let mut width = adaptive_width(
-        rule,
-        initial,
-        &state.evaluations[start..end],
-        plan.cycle_origin.saturating_sub(start),
-        state.space.dim(),
-    );
+    let mut width = run_width(state, plan, rule, state.evaluations.len());
     if rule.on_converged != Converged::Escape {
         width.rank = escape_rank(state, plan);
     }
