@@ -7,7 +7,7 @@
 //! [--restart-patience N | --restart | --no-restart] [--global-only] [--local-first] [--escape N | --no-escape]
 //! [--perturb-horizon H | --no-perturb] [--candidate-floor N [--candidate-horizon H] |
 //! --no-candidate-decay] [--merit-weights 0.3,0.5,0.8,0.95]
-//! [--adaptive-region restore|escape|restart [--grow-after 3] [--shrink-after N] [--halvings 6] [--sigma-only] |
+//! [--adaptive-region restore|escape|restart|restart-outside [--grow-after 3] [--shrink-after N] [--halvings 6] [--sigma-only] |
 //! --no-adaptive-region] [--points]`
 //!
 //! `--noise LEVEL --noise-file FILE` runs the whole budget on `f(x) + LEVEL * range * z_k`,
@@ -189,6 +189,7 @@ fn main() {
                     "restore" => Converged::Restore,
                     "escape" => Converged::Escape,
                     "restart" => Converged::Restart,
+                    "restart-outside" => Converged::RestartOutside,
                     other => panic!("unknown --adaptive-region {other}"),
                 };
                 let base = AdaptiveRegion::default();

@@ -75,6 +75,7 @@ enum ConvergedArg {
     Restore,
     Escape,
     Restart,
+    RestartOutside,
 }
 
 /// Initial-set choices on the command line.
@@ -165,7 +166,8 @@ struct SuggestArgs {
     /// DYCORS's adaptive step on the local region's half-width (doubled after 3
     /// improvements, halved after max(5, d) evaluations without, converged below 2^-6 of
     /// its start), and what its convergence does: restore the width, move to the next basin,
-    /// or restart the run (off by default).
+    /// restart the run, or restart keeping the earlier points outside the converged basins
+    /// (off by default).
     #[arg(long, value_enum, conflicts_with = "global_only")]
     adaptive_region: Option<ConvergedArg>,
     /// Evaluations without improvement that halve the adaptive width (default max(5, d)).
@@ -354,6 +356,7 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
                 ConvergedArg::Restore => Converged::Restore,
                 ConvergedArg::Escape => Converged::Escape,
                 ConvergedArg::Restart => Converged::Restart,
+                ConvergedArg::RestartOutside => Converged::RestartOutside,
             },
             shrink_box: !args.adaptive_sigma_only,
             ..AdaptiveRegion::default()

@@ -190,7 +190,7 @@ fn search_options_reproduce_the_library_loop() {
         (
             &[
                 "--adaptive-region",
-                "restart",
+                "restart-outside",
                 "--adaptive-shrink-after",
                 "2",
                 "--adaptive-halvings",
@@ -201,7 +201,7 @@ fn search_options_reproduce_the_library_loop() {
                 adaptive_region: Some(AdaptiveRegion {
                     shrink_after: Some(2),
                     halvings: 1,
-                    on_converged: Converged::Restart,
+                    on_converged: Converged::RestartOutside,
                     shrink_box: false,
                     ..AdaptiveRegion::default()
                 }),

@@ -408,13 +408,26 @@ fn search_variants_resume_and_replay_exactly() {
             }),
             ..CorsOptions::with_seed(10)
         },
+        CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                grow_after: 2,
+                shrink_after: Some(2),
+                halvings: 1,
+                on_converged: Converged::RestartOutside,
+                shrink_box: false,
+            }),
+            ..CorsOptions::with_seed(10)
+        },
     ];
     for options in variants {
         let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
         whole.minimize(|x| f.eval(x), 40).unwrap();
-        let restarts_on_convergence = options
-            .adaptive_region
-            .is_some_and(|a| a.on_converged == Converged::Restart);
+        let restarts_on_convergence = options.adaptive_region.is_some_and(|a| {
+            matches!(
+                a.on_converged,
+                Converged::Restart | Converged::RestartOutside
+            )
+        });
         assert_eq!(whole.restarts() > 0, restarts_on_convergence);
         let default = {
             let o = CorsOptions {
@@ -435,6 +448,26 @@ fn search_variants_resume_and_replay_exactly() {
         assert_eq!(resumed.evaluations(), whole.evaluations());
         assert_replays(&f, &options, &whole, &[14, 21, 39]);
     }
+    // Keeping the earlier runs' points outside their basins changes the restarted runs.
+    let after_restarts = |on_converged| {
+        let options = CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                grow_after: 2,
+                shrink_after: Some(2),
+                halvings: 1,
+                on_converged,
+                shrink_box: false,
+            }),
+            ..CorsOptions::with_seed(10)
+        };
+        let mut s = Cors::new(f.space().unwrap(), options).unwrap();
+        s.minimize(|x| f.eval(x), 60).unwrap();
+        s.evaluations().to_vec()
+    };
+    assert_ne!(
+        after_restarts(Converged::Restart),
+        after_restarts(Converged::RestartOutside)
+    );
 }
 
 #[test]
