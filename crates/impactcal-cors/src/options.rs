@@ -339,8 +339,10 @@ pub struct CorsOptions {
     /// of 300 evaluations.
     pub perturbation: Option<Perturbation>,
     /// DYCORS's adaptive step applied to the local region's half-width, with what follows
-    /// its convergence (`None`: the half-width stays `local_region`). No effect without
-    /// `local_region`.
+    /// its convergence (`None`: the half-width stays `local_region`). Without
+    /// `local_region` there are no local cycles to adapt and only a convergence restart
+    /// ([`Converged::Restart`], [`Converged::RestartOutside`]) acts, the width starting
+    /// at 1. Default `None`.
     pub adaptive_region: Option<AdaptiveRegion>,
     /// A quasi-random candidate count that falls as the run proceeds (`None`: always
     /// `candidates_per_dim d`).
