@@ -256,8 +256,8 @@ pub enum Converged {
     /// own restart): a new design and a surrogate of the new run's points only.
     Restart,
     /// A restart whose surrogate (and distance constraints) keep the successes of the
-    /// earlier runs that lie outside the box of half-width `local_region` around each
-    /// earlier run's best point: the converged basins are left out, the rest of what is
+    /// earlier runs that lie outside the box of half-width `local_region` (0.3 without one)
+    /// around each earlier run's best point: the converged basins are left out, the rest of what is
     /// known stays. The new run's best point, from its own evaluations, centres its local
     /// cycles.
     RestartOutside,
