@@ -6,7 +6,9 @@
 //! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]
 //! [--restart-patience N | --restart | --no-restart] [--global-only] [--local-first] [--escape N | --no-escape]
 //! [--perturb-horizon H | --no-perturb] [--candidate-floor N [--candidate-horizon H] |
-//! --no-candidate-decay] [--merit-weights 0.3,0.5,0.8,0.95] [--points]`
+//! --no-candidate-decay] [--merit-weights 0.3,0.5,0.8,0.95]
+//! [--adaptive-region restore|escape|restart|restart-outside [--grow-after 3] [--shrink-after N] [--halvings 6] [--sigma-only] |
+//! --no-adaptive-region] [--points]`
 //!
 //! `--noise LEVEL --noise-file FILE` runs the whole budget on `f(x) + LEVEL * range * z_k`,
 //! with the range of each function and the draws `z_k` of each seed read from the table
@@ -25,7 +27,8 @@ use std::collections::HashMap;
 
 use impactcal_core::test_functions::{self, TestFunction};
 use impactcal_cors::{
-    CandidateDecay, Cors, CorsOptions, Perturbation, Restart, SurrogateKernel, Transform,
+    AdaptiveRegion, CandidateDecay, Converged, Cors, CorsOptions, Perturbation, Restart,
+    SurrogateKernel, Transform,
 };
 
 /// The noise table of `cors_pysot.py --write-noise`: range per function, draws per seed.
@@ -180,6 +183,26 @@ fn main() {
             }
             if args.iter().any(|a| a == "--no-candidate-decay") {
                 options.candidate_decay = None;
+            }
+            if let Some(a) = get("--adaptive-region") {
+                let on_converged = match a.as_str() {
+                    "restore" => Converged::Restore,
+                    "escape" => Converged::Escape,
+                    "restart" => Converged::Restart,
+                    "restart-outside" => Converged::RestartOutside,
+                    other => panic!("unknown --adaptive-region {other}"),
+                };
+                let base = AdaptiveRegion::default();
+                options.adaptive_region = Some(AdaptiveRegion {
+                    grow_after: get("--grow-after").map_or(base.grow_after, |v| v.parse().unwrap()),
+                    shrink_after: get("--shrink-after").map(|v| v.parse().unwrap()),
+                    halvings: get("--halvings").map_or(base.halvings, |v| v.parse().unwrap()),
+                    on_converged,
+                    shrink_box: !args.iter().any(|a| a == "--sigma-only"),
+                });
+            }
+            if args.iter().any(|a| a == "--no-adaptive-region") {
+                options.adaptive_region = None;
             }
             if let Some(w) = get("--merit-weights") {
                 options.merit_weights = Some(w.split(',').map(|v| v.parse().unwrap()).collect());

@@ -11,8 +11,8 @@ use faer::Mat;
 use impactcal::core::ParamGuard;
 use impactcal::core::{CoreError, ParameterSpace, Table, TableOptions, read_samples};
 use impactcal::cors::{
-    CandidateDecay, Cors, CorsOptions, InitialDesign, Perturbation, Restart, SurrogateKernel,
-    Transform,
+    AdaptiveRegion, CandidateDecay, Converged, Cors, CorsOptions, InitialDesign, Perturbation,
+    Restart, SurrogateKernel, Transform,
 };
 
 use crate::error::CliError;
@@ -67,6 +67,15 @@ enum TransformArg {
     Log,
     ShiftedLog,
     MedianCap,
+}
+
+/// What a converged adaptive local region does, on the command line.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum ConvergedArg {
+    Restore,
+    Escape,
+    Restart,
+    RestartOutside,
 }
 
 /// Initial-set choices on the command line.
@@ -154,6 +163,22 @@ struct SuggestArgs {
     /// place of the distance constraint (off by default).
     #[arg(long, value_delimiter = ',')]
     merit_weights: Option<Vec<f64>>,
+    /// DYCORS's adaptive step on the local region's half-width (doubled after 3
+    /// improvements, halved after max(5, d) evaluations without, converged below 2^-6 of
+    /// its start), and what its convergence does: restore the width, move to the next basin,
+    /// restart the run, or restart keeping the earlier points outside the converged basins
+    /// (off by default).
+    #[arg(long, value_enum, conflicts_with = "global_only")]
+    adaptive_region: Option<ConvergedArg>,
+    /// Evaluations without improvement that halve the adaptive width (default max(5, d)).
+    #[arg(long, requires = "adaptive_region")]
+    adaptive_shrink_after: Option<usize>,
+    /// Halvings after which the adaptive width has converged (default 6).
+    #[arg(long, requires = "adaptive_region", default_value_t = 6)]
+    adaptive_halvings: u32,
+    /// Keep the local box at its half-width and adapt only the Gaussian candidates' widths.
+    #[arg(long, requires = "adaptive_region")]
+    adaptive_sigma_only: bool,
     /// Write the points here instead of stdout.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -324,6 +349,18 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
             horizon: args.candidate_horizon,
         }),
         merit_weights: args.merit_weights,
+        adaptive_region: args.adaptive_region.map(|on| AdaptiveRegion {
+            shrink_after: args.adaptive_shrink_after,
+            halvings: args.adaptive_halvings,
+            on_converged: match on {
+                ConvergedArg::Restore => Converged::Restore,
+                ConvergedArg::Escape => Converged::Escape,
+                ConvergedArg::Restart => Converged::Restart,
+                ConvergedArg::RestartOutside => Converged::RestartOutside,
+            },
+            shrink_box: !args.adaptive_sigma_only,
+            ..AdaptiveRegion::default()
+        }),
         ..options
     };
     let options = options

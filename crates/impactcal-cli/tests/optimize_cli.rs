@@ -11,7 +11,9 @@ use std::path::Path;
 
 use impactcal::core::points::to_rows;
 use impactcal::core::{Table, TableOptions, test_functions};
-use impactcal::cors::{CandidateDecay, Cors, CorsOptions, Perturbation, Restart};
+use impactcal::cors::{
+    AdaptiveRegion, CandidateDecay, Converged, Cors, CorsOptions, Perturbation, Restart,
+};
 
 /// Runs `impactcal optimize suggest` on the files with extra arguments.
 fn run_suggest(bounds: &Path, history: &Path, extra: &[&str]) -> std::process::Output {
@@ -89,7 +91,7 @@ fn shell_loop_reproduces_the_library_loop() {
 #[test]
 fn search_options_reproduce_the_library_loop() {
     let f = test_functions::by_name("branin").unwrap();
-    let cases: [(&[&str], CorsOptions); 10] = [
+    let cases: [(&[&str], CorsOptions); 12] = [
         (
             &["--local-half-width", "0.15"],
             CorsOptions {
@@ -163,6 +165,46 @@ fn search_options_reproduce_the_library_loop() {
             &["--merit-weights", "0.3,0.5,0.8,0.95"],
             CorsOptions {
                 merit_weights: Some(vec![0.3, 0.5, 0.8, 0.95]),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &[
+                "--adaptive-region",
+                "escape",
+                "--adaptive-shrink-after",
+                "2",
+                "--adaptive-halvings",
+                "2",
+            ],
+            CorsOptions {
+                adaptive_region: Some(AdaptiveRegion {
+                    shrink_after: Some(2),
+                    halvings: 2,
+                    on_converged: Converged::Escape,
+                    ..AdaptiveRegion::default()
+                }),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &[
+                "--adaptive-region",
+                "restart-outside",
+                "--adaptive-shrink-after",
+                "2",
+                "--adaptive-halvings",
+                "1",
+                "--adaptive-sigma-only",
+            ],
+            CorsOptions {
+                adaptive_region: Some(AdaptiveRegion {
+                    shrink_after: Some(2),
+                    halvings: 1,
+                    on_converged: Converged::RestartOutside,
+                    shrink_box: false,
+                    ..AdaptiveRegion::default()
+                }),
                 ..CorsOptions::with_seed(3)
             },
         ),
@@ -327,6 +369,11 @@ fn bad_search_options_are_input_errors() {
             "candidate_decay.min_per_dim",
         ),
         (&["--merit-weights", "0.5,2"][..], "merit_weights"),
+        (
+            &["--adaptive-region", "restore", "--adaptive-halvings", "0"][..],
+            "adaptive_region.halvings",
+        ),
+        (&["--adaptive-halvings", "3"][..], "--adaptive-region"),
         (
             &["--local-half-width", "0.2", "--global-only"][..],
             "cannot be used",

@@ -48,6 +48,7 @@ pub mod error;
 mod geometry;
 pub mod optimizer;
 pub mod options;
+mod region;
 mod stall;
 pub mod state;
 mod step;
@@ -58,7 +59,7 @@ pub use answer::SurrogateAnswer;
 pub use error::{CorsError, Result};
 pub use optimizer::{Cors, Outcome, StopReason};
 pub use options::{
-    CandidateDecay, CorsOptions, DEFAULT_PATTERN, InitialDesign, Perturbation, Restart, Stopping,
-    SurrogateKernel, Transform, ValidCorsOptions, dycors_decay,
+    AdaptiveRegion, CandidateDecay, Converged, CorsOptions, DEFAULT_PATTERN, InitialDesign,
+    Perturbation, Restart, Stopping, SurrogateKernel, Transform, ValidCorsOptions, dycors_decay,
 };
 pub use state::{CorsState, Evaluation, FillReason, Mode, Origin, Suggestion};

@@ -330,6 +330,7 @@ impl Cors {
             cycle_origin,
             run_start: 0,
             restarts: 0,
+            excluded: Vec::new(),
         };
         // The restart decision the step makes before each suggestion, at every row.
         let mut k = plan.cycle_origin;

@@ -190,6 +190,79 @@ impl CandidateDecay {
     }
 }
 
+/// DYCORS's step-size rule (Regis & Shoemaker 2013; pySOT's `DYCORSStrategy`) applied to
+/// the half-width of the local region ([`CorsOptions::local_region`]).
+///
+/// Walking the run's evaluations after its initial set, an evaluation *succeeds* when it
+/// lowers the run's best value by more than 0.1 % of `|best|` and *fails* otherwise. The
+/// half-width `h` starts at `local_region`; after `grow_after` consecutive successes it
+/// doubles (never above `local_region`), after `shrink_after` consecutive failures it
+/// halves, and each change restarts both counts. Once `h` falls below
+/// `local_region 2^-halvings` the region has *converged*, and [`Converged`] says what
+/// follows. In the local cycles the box has half-width `h` (with `shrink_box`) and the
+/// Gaussian candidates scale their standard deviations by `h / local_region`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct AdaptiveRegion {
+    /// Consecutive successes that double the half-width (DYCORS: 3); at least 1.
+    pub grow_after: usize,
+    /// Consecutive failures that halve it; `None` is `max(5, d)` (DYCORS's rule).
+    pub shrink_after: Option<usize>,
+    /// Halvings below which the region has converged (DYCORS: 6, its floor
+    /// `0.2 * 0.5^6`); at least 1.
+    pub halvings: u32,
+    /// What a converged region does.
+    pub on_converged: Converged,
+    /// Whether the box of the local cycles shrinks with `h` (DYCORS's trust-region
+    /// reading); `false` keeps the box at `local_region` and scales only the Gaussian
+    /// candidates (DYCORS's own step: the perturbation width).
+    pub shrink_box: bool,
+}
+
+impl Default for AdaptiveRegion {
+    /// DYCORS's constants: grow after 3 successes, shrink after `max(5, d)` failures,
+    /// converged after 6 halvings; then restore the width around the best point.
+    fn default() -> Self {
+        AdaptiveRegion {
+            grow_after: 3,
+            shrink_after: None,
+            halvings: 6,
+            on_converged: Converged::Restore,
+            shrink_box: true,
+        }
+    }
+}
+
+impl AdaptiveRegion {
+    /// The failures that halve the half-width in `dim` dimensions.
+    pub fn shrink_after_for(&self, dim: usize) -> usize {
+        self.shrink_after.unwrap_or(dim.max(5))
+    }
+}
+
+/// What the local region does once its half-width has converged ([`AdaptiveRegion`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Converged {
+    /// The half-width returns to `local_region` around the same (best) point, as DYCORS's
+    /// restart would, but keeping every point in the surrogate.
+    #[default]
+    Restore,
+    /// The half-width returns to `local_region` and the local cycles move on to the next
+    /// basin (as [`CorsOptions::local_escape`] does, which this trigger replaces): the basin
+    /// escape triggered by convergence rather than by a fixed idle count. An improvement of
+    /// the run's best brings them back to the best point.
+    Escape,
+    /// The run ends and a new one starts, as by the restart rule ([`Restart`]; DYCORS's
+    /// own restart): a new design and a surrogate of the new run's points only.
+    Restart,
+    /// A restart whose surrogate (and distance constraints) keep the successes of the
+    /// earlier runs that lie outside the box of half-width `local_region` (0.3 without one)
+    /// around each earlier run's best point: the converged basins are left out, the rest of what is
+    /// known stays. The new run's best point, from its own evaluations, centres its local
+    /// cycles.
+    RestartOutside,
+}
+
 impl Restart {
     /// The default patience in `dim` dimensions: `6 max(5, d)`, i.e. five cycles of the
     /// default pattern in up to 5 dimensions.
@@ -265,6 +338,12 @@ pub struct CorsOptions {
     /// cycles (`None`: every coordinate of every such candidate moves). Default: a horizon
     /// of 300 evaluations.
     pub perturbation: Option<Perturbation>,
+    /// DYCORS's adaptive step applied to the local region's half-width, with what follows
+    /// its convergence (`None`: the half-width stays `local_region`). Without
+    /// `local_region` there are no local cycles to adapt and only a convergence restart
+    /// ([`Converged::Restart`], [`Converged::RestartOutside`]) acts, the width starting
+    /// at 1. Default `None`.
+    pub adaptive_region: Option<AdaptiveRegion>,
     /// A quasi-random candidate count that falls as the run proceeds (`None`: always
     /// `candidates_per_dim d`).
     pub candidate_decay: Option<CandidateDecay>,
@@ -300,6 +379,7 @@ impl Default for CorsOptions {
             local_first: false,
             local_escape: Some(60),
             perturbation: Some(Perturbation { horizon: 300 }),
+            adaptive_region: None,
             candidate_decay: None,
             merit_weights: None,
             seed: 0,
@@ -331,8 +411,9 @@ impl ParamGuard for CorsOptions {
     /// [`CoreError::InvalidOption`] for an empty pattern or a `beta` outside `[0, 1]`, a
     /// design of fewer than 2 points, no candidates, no polishing start, a distance that is
     /// negative or not finite, a zero patience (stopping or restart) or a negative or
-    /// non-finite improvement threshold, a decay horizon below 2, or a candidate floor of 0
-    /// or above `candidates_per_dim`.
+    /// non-finite improvement threshold, a decay horizon below 2, a candidate floor of 0
+    /// or above `candidates_per_dim`, or an adaptive region with a zero count or halvings
+    /// outside `[1, 30]`.
     fn check_ref(&self) -> impactcal_core::Result<()> {
         let bad = |name: &'static str, value: String, message: &str| {
             Err(CoreError::invalid_option(name, value, message))
@@ -405,6 +486,25 @@ impl ParamGuard for CorsOptions {
                 p.horizon.to_string(),
                 "must be at least 2",
             );
+        }
+        if let Some(a) = &self.adaptive_region {
+            if a.grow_after == 0 {
+                return bad("adaptive_region.grow_after", "0".into(), "must be positive");
+            }
+            if a.shrink_after == Some(0) {
+                return bad(
+                    "adaptive_region.shrink_after",
+                    "0".into(),
+                    "must be positive",
+                );
+            }
+            if !(1..=30).contains(&a.halvings) {
+                return bad(
+                    "adaptive_region.halvings",
+                    a.halvings.to_string(),
+                    "must lie in [1, 30]",
+                );
+            }
         }
         if let Some(c) = &self.candidate_decay {
             if c.horizon < 2 {

@@ -20,20 +20,27 @@ pub(crate) struct StallRule {
 }
 
 impl StallRule {
+    /// Whether a result `value` (`None`: failed) improves on the best value so far, which
+    /// it then updates.
+    pub(crate) fn improves(&self, value: Option<f64>, best: &mut Option<f64>) -> bool {
+        let improved = match (value, *best) {
+            (Some(_), None) => true,
+            (Some(v), Some(b)) => v < b - self.min_improvement * b.abs().max(self.floor),
+            (None, _) => false,
+        };
+        if let Some(v) = value {
+            *best = Some(best.map_or(v, |b| b.min(v)));
+        }
+        improved
+    }
+
     /// The stall length of `evaluations` (see the module documentation): evaluations since
     /// the last improvement, counting those at index `count_from` or later.
     pub(crate) fn stall_length(&self, evaluations: &[Evaluation], count_from: usize) -> usize {
         let mut best: Option<f64> = None;
         let mut since = 0;
         for (k, e) in evaluations.iter().enumerate() {
-            let improved = match (e.value, best) {
-                (Some(_), None) => true,
-                (Some(v), Some(b)) => v < b - self.min_improvement * b.abs().max(self.floor),
-                (None, _) => false,
-            };
-            if let Some(v) = e.value {
-                best = Some(best.map_or(v, |b| b.min(v)));
-            }
+            let improved = self.improves(e.value, &mut best);
             if improved {
                 since = 0;
             } else if k >= count_from {

@@ -152,6 +152,10 @@ pub(crate) struct Plan {
     /// Number of restarts so far.
     #[serde(default)]
     pub(crate) restarts: usize,
+    /// The best points (unit box) of the earlier runs whose basins the surrogate leaves out
+    /// ([`Converged::RestartOutside`](crate::Converged::RestartOutside)); empty otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(crate) excluded: Vec<Vec<f64>>,
 }
 
 impl Plan {

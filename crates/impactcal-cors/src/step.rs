@@ -9,7 +9,8 @@
 use crate::design::affine_rank_of_rows;
 use crate::error::Result;
 use crate::geometry::{distance, stream};
-use crate::options::InitialDesign;
+use crate::options::{AdaptiveRegion, Converged, InitialDesign};
+use crate::region::{LocalWidth, SUCCESS_IMPROVEMENT, adaptive_width};
 use crate::stall::StallRule;
 use crate::state::{
     CorsState, DUPLICATE_TOL, FillReason, MATCH_TOL, Mode, Origin, Plan, Suggestion,
@@ -54,6 +55,7 @@ pub(crate) fn initial_plan(state: &CorsState) -> Result<Plan> {
         cycle_origin,
         run_start: 0,
         restarts: 0,
+        excluded: Vec::new(),
     })
 }
 
@@ -72,10 +74,13 @@ pub(crate) fn advance_plan(
 ) -> Result<bool> {
     let due =
         index >= plan.cycle_origin
-            && state.options.restart.as_ref().is_some_and(|rule| {
+            && (state.options.restart.as_ref().is_some_and(|rule| {
                 plan.stagnates(&state.evaluations, upto, rule, state.space.dim())
-            });
+            }) || converged_restart(state, plan, upto));
     if due {
+        if keeps_outside(state) {
+            plan.excluded.push(run_best(state, plan, upto)?);
+        }
         plan.restarts += 1;
         plan.design = state.run_design(plan.restarts)?;
         plan.mode = Mode::Design;
@@ -83,6 +88,73 @@ pub(crate) fn advance_plan(
         plan.cycle_origin = index + plan.design.len();
     }
     Ok(due)
+}
+
+/// Whether restarts keep the earlier runs' points outside their converged basins
+/// ([`Converged::RestartOutside`]).
+fn keeps_outside(state: &CorsState) -> bool {
+    state
+        .options
+        .adaptive_region
+        .is_some_and(|r| r.on_converged == Converged::RestartOutside)
+}
+
+/// The best successful point (unit box) of the current run among the first `upto`
+/// evaluations (ties to the earlier); the centre of the box when it has none.
+///
+/// # Errors
+/// Mapping errors of the parameter space (not expected).
+fn run_best(state: &CorsState, plan: &Plan, upto: usize) -> Result<Vec<f64>> {
+    let end = upto.min(state.evaluations.len());
+    let start = plan.run_start.min(end);
+    let mut best: Option<(f64, &[f64])> = None;
+    for e in &state.evaluations[start..end] {
+        if let Some(v) = e.value
+            && best.is_none_or(|(b, _)| v < b)
+        {
+            best = Some((v, &e.x));
+        }
+    }
+    match best {
+        Some((_, x)) => Ok(state.space.to_unit(x)?),
+        None => Ok(vec![0.5; state.space.dim()]),
+    }
+}
+
+/// Whether a success `u` (unit box) of an earlier run is kept in the current run's
+/// surrogate: outside every excluded box ([`Converged::RestartOutside`]).
+fn kept_from_earlier(state: &CorsState, plan: &Plan, u: &[f64]) -> bool {
+    let half = state.options.local_region.unwrap_or(0.3);
+    plan.excluded
+        .iter()
+        .all(|c| c.iter().zip(u).any(|(a, b)| (a - b).abs() > half))
+}
+
+/// Whether the local region of the run, seeing the first `upto` evaluations, has converged
+/// under [`Converged::Restart`] or [`Converged::RestartOutside`].
+fn converged_restart(state: &CorsState, plan: &Plan, upto: usize) -> bool {
+    let Some(rule) = state.options.adaptive_region.as_ref().filter(|r| {
+        matches!(
+            r.on_converged,
+            Converged::Restart | Converged::RestartOutside
+        )
+    }) else {
+        return false;
+    };
+    run_width(state, plan, rule, upto).converged > 0
+}
+
+/// The adaptive width of the current run after its evaluations before index `upto`.
+fn run_width(state: &CorsState, plan: &Plan, rule: &AdaptiveRegion, upto: usize) -> LocalWidth {
+    let end = upto.min(state.evaluations.len());
+    let start = plan.run_start.min(end);
+    adaptive_width(
+        rule,
+        state.options.local_region.unwrap_or(1.0),
+        &state.evaluations[start..end],
+        plan.cycle_origin.saturating_sub(start),
+        state.space.dim(),
+    )
 }
 
 /// Proposes `q` distinct points to evaluate next (see [`Cors::suggest`](crate::Cors::suggest)).
@@ -131,12 +203,13 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
             suggestions: out,
         });
     }
-    let fitted = fit_surrogate(state, plan.run_start, escape_rank(state, &plan))?;
+    let width = local_width(state, &plan);
+    let fitted = fit_surrogate(state, &plan, width.rank)?;
     let root_d = (d as f64).sqrt();
     while out.len() < q {
         let index = evaluated + state.pending.len() + out.len();
         let mut rng = stream(state.options.seed, index);
-        let blockers = blockers(state, plan.run_start, &out)?;
+        let blockers = blockers(state, &plan, &out)?;
         // Evaluations after the run's initial set before this one.
         let m = index.saturating_sub(plan.cycle_origin);
         let per_dim = match &state.options.candidate_decay {
@@ -151,9 +224,13 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
                 let cycle = m / k;
                 let phase = usize::from(state.options.local_first);
                 let local = state.options.local_region.is_some() && (cycle + phase) % 2 == 1;
-                let (region, best) = match state.options.local_region {
-                    Some(half) if local => (Region::around(centre, half), centre),
-                    _ => (Region::unit(d), best),
+                let (region, best, sigma_scale) = match state.options.local_region {
+                    Some(initial) if local => (
+                        Region::around(centre, width.boxed),
+                        centre,
+                        width.half / initial,
+                    ),
+                    _ => (Region::unit(d), best, 1.0),
                 };
                 let settings = StepSettings {
                     beta,
@@ -168,6 +245,7 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
                         .filter(|_| local)
                         .map(|p| p.probability(m, d)),
                     merit_weight: state.options.merit_weights.as_ref().map(|w| w[m % w.len()]),
+                    sigma_scale,
                 };
                 let c = cors_step(surrogate, best, &blockers, &settings, &region, &mut rng);
                 Suggestion {
@@ -205,6 +283,27 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
     })
 }
 
+/// The local region of the next step: its half-width (`local_region`, or under
+/// [`CorsOptions::adaptive_region`](crate::CorsOptions::adaptive_region) as the step-size
+/// rule has made it) and the basin its centre lies in ([`escape_rank`], or the
+/// convergences under [`Converged::Escape`]).
+fn local_width(state: &CorsState, plan: &Plan) -> LocalWidth {
+    let initial = state.options.local_region.unwrap_or(1.0);
+    let Some(rule) = &state.options.adaptive_region else {
+        return LocalWidth {
+            half: initial,
+            boxed: initial,
+            rank: escape_rank(state, plan),
+            converged: 0,
+        };
+    };
+    let mut width = run_width(state, plan, rule, state.evaluations.len());
+    if rule.on_converged != Converged::Escape {
+        width.rank = escape_rank(state, plan);
+    }
+    width
+}
+
 /// Which basin the local cycles search
 /// ([`CorsOptions::local_escape`](crate::CorsOptions::local_escape)): 0 (the best point's)
 /// until the run has stalled for `patience` evaluations after its initial set, then 1, 2,
@@ -216,7 +315,7 @@ fn escape_rank(state: &CorsState, plan: &Plan) -> usize {
     let end = state.evaluations.len();
     let start = plan.run_start.min(end);
     let rule = StallRule {
-        min_improvement: ESCAPE_IMPROVEMENT,
+        min_improvement: SUCCESS_IMPROVEMENT,
         floor: 0.0,
     };
     let stall = rule.stall_length(
@@ -225,9 +324,6 @@ fn escape_rank(state: &CorsState, plan: &Plan) -> usize {
     );
     stall / patience.max(1)
 }
-
-/// Relative improvement that ends a stall for [`escape_rank`] (pySOT's success threshold).
-const ESCAPE_IMPROVEMENT: f64 = 1e-3;
 
 /// The centre of the local cycles for `rank` ([`escape_rank`]): the successes sorted by
 /// value (ties by order) are grouped greedily into basins, a point opening a new basin when
@@ -263,14 +359,27 @@ type Fitted = (RbfSurrogate, Vec<f64>, Vec<f64>);
 /// Mapping errors of the parameter space (not expected).
 fn fit_surrogate(
     state: &CorsState,
-    run_start: usize,
+    plan: &Plan,
     escape_rank: usize,
 ) -> Result<std::result::Result<Fitted, FillReason>> {
     let d = state.space.dim();
     let tol = DUPLICATE_TOL * (d as f64).sqrt();
     let mut pts: Vec<Vec<f64>> = Vec::new();
     let mut vals: Vec<f64> = Vec::new();
-    let start = run_start.min(state.evaluations.len());
+    let start = plan.run_start.min(state.evaluations.len());
+    // Successes of earlier runs kept in this run's surrogate (RestartOutside only).
+    let mut kept = 0;
+    if keeps_outside(state) {
+        for e in &state.evaluations[..start] {
+            let Some(v) = e.value else { continue };
+            let u = state.space.to_unit(&e.x)?;
+            if kept_from_earlier(state, plan, &u) {
+                pts.push(u);
+                vals.push(v);
+                kept += 1;
+            }
+        }
+    }
     for e in &state.evaluations[start..] {
         let Some(v) = e.value else { continue };
         let u = state.space.to_unit(&e.x)?;
@@ -282,19 +391,20 @@ fn fit_surrogate(
             }
         }
     }
-    if pts.len() < d + 1 || affine_rank_of_rows(&pts) < d + 1 {
+    let own = pts.len() - kept;
+    if own < d + 1 || affine_rank_of_rows(&pts[kept..]) < d + 1 {
         return Ok(Err(FillReason::TooFewSuccesses {
-            successes: pts.len(),
+            successes: own,
             needed: d + 1,
         }));
     }
-    let best = vals
-        .iter()
-        .enumerate()
-        .fold(0, |k, (i, v)| if *v < vals[k] { i } else { k });
+    // The best point of the run's own evaluations.
+    let best = (kept..vals.len()).fold(kept, |k, i| if vals[i] < vals[k] { i } else { k });
     let best_x = pts[best].clone();
     let centre = match state.options.local_region {
-        Some(half) if escape_rank > 0 => basin_centre(&pts, &vals, half, escape_rank).to_vec(),
+        Some(half) if escape_rank > 0 => {
+            basin_centre(&pts[kept..], &vals[kept..], half, escape_rank).to_vec()
+        }
         _ => best_x.clone(),
     };
     state.options.transform.apply(&mut vals);
@@ -313,12 +423,18 @@ fn fit_surrogate(
 
 /// The points to keep away from: successes of the current run, pending points and the
 /// points already proposed, and failures of every run.
-fn blockers(state: &CorsState, run_start: usize, proposed: &[Suggestion]) -> Result<Blockers> {
+fn blockers(state: &CorsState, plan: &Plan, proposed: &[Suggestion]) -> Result<Blockers> {
     let mut b = Blockers::new(state.space.dim());
     for (k, e) in state.evaluations.iter().enumerate() {
         if e.is_success() {
-            if k >= run_start {
+            if k >= plan.run_start {
                 b.ok.extend(state.space.to_unit(&e.x)?);
+            } else if keeps_outside(state) {
+                // The earlier successes kept in the surrogate, first, as in its centres.
+                let u = state.space.to_unit(&e.x)?;
+                if kept_from_earlier(state, plan, &u) {
+                    b.ok.extend(u);
+                }
             }
         } else {
             b.failed.extend(state.space.to_unit(&e.x)?);

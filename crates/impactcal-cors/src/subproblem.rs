@@ -188,6 +188,10 @@ pub struct StepSettings {
     /// The weight `w` of SRBF's merit function for this step (`None`: CORS's constrained
     /// minimisation). See [`merit_choice`].
     pub merit_weight: Option<f64>,
+    /// Factor on the standard deviations of the candidates around the best point (1 but
+    /// in the local cycles of an adaptive region, where it is the half-width's ratio to its
+    /// initial value).
+    pub sigma_scale: f64,
 }
 
 /// What a step chose.
@@ -229,13 +233,14 @@ fn global_candidates(dim: usize, n: usize, rng: &mut impl Rng) -> Vec<f64> {
 }
 
 /// Gaussian perturbations of `centre`, clipped to the box, with the standard deviation
-/// cycling through 0.1, 0.02, 0.004. With `perturb = Some(p)` only a subset of the
-/// coordinates moves: each with probability `p`, one drawn uniformly when none is (DYCORS).
+/// cycling through 0.1, 0.02, 0.004 times `scale`. With `perturb = Some(p)` only a subset
+/// of the coordinates moves: each with probability `p`, one drawn uniformly when none is
+/// (DYCORS).
 fn local_candidates(
     centre: &[f64],
     n: usize,
     region: &Region,
-    perturb: Option<f64>,
+    (perturb, scale): (Option<f64>, f64),
     rng: &mut impl Rng,
 ) -> Vec<f64> {
     const SIGMAS: [f64; 3] = [0.1, 0.02, 0.004];
@@ -243,7 +248,7 @@ fn local_candidates(
     let mut out = Vec::with_capacity(n * dim);
     let mut mask = vec![true; dim];
     for k in 0..n {
-        let sigma = SIGMAS[k % SIGMAS.len()];
+        let sigma = SIGMAS[k % SIGMAS.len()] * scale;
         if let Some(p) = perturb {
             mask.iter_mut().for_each(|m| *m = rng.random::<f64>() < p);
             if !mask.iter().any(|m| *m) && dim > 0 {
@@ -339,7 +344,7 @@ pub fn cors_step(
         best,
         settings.local_candidates,
         region,
-        settings.perturb,
+        (settings.perturb, settings.sigma_scale),
         rng,
     ));
     let near = BlockerColumns::new(blockers);
@@ -625,14 +630,14 @@ mod tests {
         let centre = vec![0.5; 6];
         let region = Region::unit(6);
         let moved = |c: &[f64]| c.iter().filter(|v| **v != 0.5).count();
-        let none = local_candidates(&centre, 300, &region, Some(0.0), &mut rng);
+        let none = local_candidates(&centre, 300, &region, (Some(0.0), 1.0), &mut rng);
         assert!(none.chunks_exact(6).all(|c| moved(c) == 1));
-        let half = local_candidates(&centre, 300, &region, Some(0.5), &mut rng);
+        let half = local_candidates(&centre, 300, &region, (Some(0.5), 1.0), &mut rng);
         let counts: Vec<usize> = half.chunks_exact(6).map(moved).collect();
         assert!(counts.iter().all(|n| *n >= 1));
         let mean = counts.iter().sum::<usize>() as f64 / 300.0;
         assert!((mean - 3.0).abs() < 0.4, "{mean}");
-        let all = local_candidates(&centre, 300, &region, None, &mut rng);
+        let all = local_candidates(&centre, 300, &region, (None, 1.0), &mut rng);
         assert!(all.chunks_exact(6).all(|c| moved(c) == 6));
     }
 
@@ -658,6 +663,7 @@ mod tests {
             polish_starts: 1,
             perturb: None,
             merit_weight: None,
+            sigma_scale: 1.0,
         };
         let pick = |w| merit_choice(&cands, &screened, &settings, w, 0.5).x[0];
         assert_eq!(pick(1.0), 1.0);

@@ -8,8 +8,8 @@ use impactcal_core::test_functions::{self, TestFunction};
 use impactcal_core::{CoreError, Parameter, ParameterSpace};
 use impactcal_cors::design::{affine_rank, symmetric_design};
 use impactcal_cors::{
-    CandidateDecay, Cors, CorsError, CorsOptions, FillReason, InitialDesign, Mode, Origin,
-    Perturbation, Restart, StopReason, Stopping, Transform,
+    AdaptiveRegion, CandidateDecay, Converged, Cors, CorsError, CorsOptions, FillReason,
+    InitialDesign, Mode, Origin, Perturbation, Restart, StopReason, Stopping, Transform,
 };
 
 fn unit_distance(space: &ParameterSpace, a: &[f64], b: &[f64]) -> f64 {
@@ -379,10 +379,56 @@ fn search_variants_resume_and_replay_exactly() {
             local_first: true,
             ..CorsOptions::with_seed(7)
         },
+        // Short counts, so that the width shrinks, converges and escapes within 40 points.
+        CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                grow_after: 2,
+                shrink_after: Some(2),
+                halvings: 2,
+                on_converged: Converged::Escape,
+                shrink_box: true,
+            }),
+            ..CorsOptions::with_seed(8)
+        },
+        CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                shrink_after: Some(3),
+                shrink_box: false,
+                ..AdaptiveRegion::default()
+            }),
+            ..CorsOptions::with_seed(9)
+        },
+        CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                grow_after: 2,
+                shrink_after: Some(2),
+                halvings: 1,
+                on_converged: Converged::Restart,
+                shrink_box: false,
+            }),
+            ..CorsOptions::with_seed(10)
+        },
+        CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                grow_after: 2,
+                shrink_after: Some(2),
+                halvings: 1,
+                on_converged: Converged::RestartOutside,
+                shrink_box: false,
+            }),
+            ..CorsOptions::with_seed(10)
+        },
     ];
     for options in variants {
         let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
         whole.minimize(|x| f.eval(x), 40).unwrap();
+        let restarts_on_convergence = options.adaptive_region.is_some_and(|a| {
+            matches!(
+                a.on_converged,
+                Converged::Restart | Converged::RestartOutside
+            )
+        });
+        assert_eq!(whole.restarts() > 0, restarts_on_convergence);
         let default = {
             let o = CorsOptions {
                 seed: options.seed,
@@ -402,6 +448,26 @@ fn search_variants_resume_and_replay_exactly() {
         assert_eq!(resumed.evaluations(), whole.evaluations());
         assert_replays(&f, &options, &whole, &[14, 21, 39]);
     }
+    // Keeping the earlier runs' points outside their basins changes the restarted runs.
+    let after_restarts = |on_converged| {
+        let options = CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                grow_after: 2,
+                shrink_after: Some(2),
+                halvings: 1,
+                on_converged,
+                shrink_box: false,
+            }),
+            ..CorsOptions::with_seed(10)
+        };
+        let mut s = Cors::new(f.space().unwrap(), options).unwrap();
+        s.minimize(|x| f.eval(x), 60).unwrap();
+        s.evaluations().to_vec()
+    };
+    assert_ne!(
+        after_restarts(Converged::Restart),
+        after_restarts(Converged::RestartOutside)
+    );
 }
 
 #[test]
@@ -641,6 +707,27 @@ fn options_are_validated() {
             candidate_decay: Some(CandidateDecay {
                 min_per_dim: 100,
                 horizon: 0,
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                grow_after: 0,
+                ..AdaptiveRegion::default()
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                shrink_after: Some(0),
+                ..AdaptiveRegion::default()
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            adaptive_region: Some(AdaptiveRegion {
+                halvings: 0,
+                ..AdaptiveRegion::default()
             }),
             ..CorsOptions::default()
         },
