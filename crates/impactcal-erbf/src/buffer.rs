@@ -54,9 +54,13 @@ pub fn copy(a: MatRef<'_, f64>) -> Mat<f64> {
     m
 }
 
+/// Output columns per task when a prediction writes its result with [`by_column_blocks`]
+/// (fixed, so results do not depend on the number of threads).
+pub(crate) const RESULT_BLOCK: usize = 512;
+
 /// A `nrows x ncols` matrix written block by block in parallel: the columns are cut into
-/// blocks of `block` (the last one shorter; `block` is at least 1) and `fill(b, cols)`
-/// writes block `b`, columns `b block ..`, as one rayon task (on the calling thread when
+/// blocks of `block` (the last one shorter; `block` is at least 1) and `fill(first, cols)`
+/// writes the block of columns `first ..`, as one rayon task (on the calling thread when
 /// there is only one block). Each block is zero when
 /// `fill` sees it: the task zeroes it right before, so a product written with
 /// [`Accum::Replace`](faer::Accum::Replace) touches the memory once, in cache, instead of
@@ -109,7 +113,7 @@ pub fn by_column_blocks(
             }
             MatMut::from_raw_parts_mut(first, nrows, len, 1, stride as isize)
         };
-        fill(b, cols);
+        fill(start, cols);
     };
     let blocks = ncols.div_ceil(block);
     if blocks <= 1 {
@@ -198,13 +202,12 @@ mod tests {
         let value = |i: usize, j: usize| (i * 31 + j) as f64 - 7.5;
         for (r, c) in [(0, 0), (0, 5), (4, 0), (7, 3), (1000, 700), (3, 4500)] {
             for block in [0, 1, 64, 512, 10_000] {
-                let m = by_column_blocks(r, c, block, |b, mut cols| {
+                let m = by_column_blocks(r, c, block, |first, mut cols| {
                     assert!(
                         cols.as_ref()
                             .col_iter()
                             .all(|col| col.iter().all(|&v| v == 0.0))
                     );
-                    let first = b * block.max(1);
                     for j in 0..cols.ncols() {
                         // Every other row written: the rest must stay zero.
                         for i in (0..cols.nrows()).step_by(2) {

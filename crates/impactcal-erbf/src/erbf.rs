@@ -38,7 +38,7 @@ use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
-use faer::{Accum, Mat, MatRef, Par};
+use faer::{Accum, Mat, MatMut, MatRef, Par};
 use impactcal_core::{ParamGuard, ParameterSpace};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -332,11 +332,7 @@ impl Erbf {
                             Par::Seq,
                         );
                     });
-                for (c, &mean) in self.mean.iter().enumerate() {
-                    if mean != 0.0 {
-                        out.col_mut(c).iter_mut().for_each(|v| *v += mean);
-                    }
-                }
+                add_means(out.as_mut(), &self.mean);
                 out
             }
             None => {
@@ -357,23 +353,23 @@ impl Erbf {
                 // written once while in cache, and the result does not depend on the
                 // number of threads.
                 let f = self.responses();
-                buffer::by_column_blocks(q, self.n_outputs(), PRODUCT_COLUMNS, |b, mut cols| {
-                    let (first, len) = (b * PRODUCT_COLUMNS, cols.ncols());
-                    matmul(
-                        cols.as_mut(),
-                        Accum::Replace,
-                        v.transpose(),
-                        f.subcols(first, len),
-                        1.0,
-                        Par::Seq,
-                    );
-                    for (j, col) in cols.col_iter_mut().enumerate() {
-                        let mean = self.mean[first + j];
-                        if mean != 0.0 {
-                            col.iter_mut().for_each(|v| *v += mean);
-                        }
-                    }
-                })
+                buffer::by_column_blocks(
+                    q,
+                    self.n_outputs(),
+                    buffer::RESULT_BLOCK,
+                    |first, mut cols| {
+                        let len = cols.ncols();
+                        matmul(
+                            cols.as_mut(),
+                            Accum::Replace,
+                            v.transpose(),
+                            f.subcols(first, len),
+                            1.0,
+                            Par::Seq,
+                        );
+                        add_means(cols, &self.mean[first..first + len]);
+                    },
+                )
             }
         };
         Ok(out)
@@ -557,9 +553,14 @@ fn direct_is_cheaper(n: usize, m: usize, t: usize, gamma: f64) -> bool {
 /// Queries per chunk of batch prediction (fixed, so results do not depend on threads).
 const CHUNK: usize = 64;
 
-/// Output columns per task of the product `V^T F` of a batch prediction (fixed, so results
-/// do not depend on threads).
-const PRODUCT_COLUMNS: usize = 512;
+/// Adds `means[j]` to column `j` of `out` (the columns whose mean is zero are left alone).
+fn add_means(out: MatMut<'_, f64>, means: &[f64]) {
+    for (col, &mean) in out.col_iter_mut().zip(means) {
+        if mean != 0.0 {
+            col.iter_mut().for_each(|v| *v += mean);
+        }
+    }
+}
 
 fn par() -> Par {
     faer::get_global_parallelism()

@@ -303,7 +303,7 @@ impl RbfInterpolant {
             });
         }
         let coef = OnceLock::new();
-        if values.ncols() <= n {
+        if coefficients_first(values.ncols(), n) {
             let _ = coef.set(lu_solve(&lu, values.as_ref(), n));
         }
         Ok(RbfInterpolant {
@@ -507,7 +507,7 @@ impl RbfInterpolant {
         check_queries(points, self.dim())?;
         let q = points.nrows();
         let t = self.n_outputs();
-        if t > self.system.nrows() {
+        if !coefficients_first(t, self.system.nrows()) {
             // Long histories: the left operands of every block of queries (`N x Q` in all,
             // less than the result), then the result written once, block of output
             // columns by block, while in cache.
@@ -526,9 +526,9 @@ impl RbfInterpolant {
             return Ok(buffer::by_column_blocks(
                 q,
                 t,
-                PRODUCT_COLUMNS,
-                |b, mut cols| {
-                    let (first, width) = (b * PRODUCT_COLUMNS, cols.ncols());
+                buffer::RESULT_BLOCK,
+                |first, mut cols| {
+                    let width = cols.ncols();
                     for (start, lhs) in &parts {
                         matmul(
                             cols.as_mut().subrows_mut(*start, lhs.ncols()),
@@ -582,7 +582,7 @@ impl RbfInterpolant {
     /// `basis_t^T S^{-1} [F; 0] = L^T R`: `(basis_t, [c; a])` when the coefficients are
     /// kept, else `(V, F)` with `V` the first `N` rows of `S^{-T} basis_t`.
     fn apply_operands(&self, basis_t: Mat<f64>) -> (Mat<f64>, MatRef<'_, f64>) {
-        if self.n_outputs() <= self.system.nrows() {
+        if coefficients_first(self.n_outputs(), self.system.nrows()) {
             return (basis_t, self.coef().as_ref());
         }
         let n_pts = self.n_samples();
@@ -749,8 +749,12 @@ impl RbfInterpolant {
 /// Query rows per block of batch prediction (bounds the basis matrix to `n x 4096`).
 const BLOCK: usize = 4096;
 
-/// Output columns per task when a long-history prediction writes its result.
-const PRODUCT_COLUMNS: usize = 512;
+/// Whether the coefficients `[c; a]` (`n x t`) are solved at fit time and predictions
+/// multiply them (`t <= n`); for longer outputs the product is taken the other way round
+/// ([`RbfInterpolant::predict_batch`]).
+fn coefficients_first(t: usize, n: usize) -> bool {
+    t <= n
+}
 
 /// Solves `S X = [F; 0]` for the `n x n` system `S` factorised as `P S = L U`, where `F`
 /// (`N x T`) fills the first `N` rows of the right-hand side: the permutation is applied

@@ -41,9 +41,6 @@ pub const GRAM_RATIO: usize = 2;
 /// unit of work of the Gram matrix and of the time functions.
 const BLOCK: usize = 1024;
 
-/// Output samples per task when histories are rebuilt.
-const REBUILD_COLUMNS: usize = 512;
-
 /// Most groups of blocks the Gram matrix is summed over (one partial `N x N` matrix each).
 const GRAM_GROUPS: usize = 8;
 
@@ -435,17 +432,22 @@ impl ShapeBasis {
             .as_ref()
             .map_or(self.functions.as_ref(), |b| b.as_ref());
         // Written once, in blocks of output samples, one task each.
-        buffer::by_column_blocks(q, self.samples(), REBUILD_COLUMNS, |b, mut cols| {
-            let width = cols.ncols();
-            matmul(
-                cols.as_mut(),
-                Accum::Replace,
-                ext.as_ref(),
-                basis.subrows(b * REBUILD_COLUMNS, width).transpose(),
-                1.0,
-                Par::Seq,
-            );
-        })
+        buffer::by_column_blocks(
+            q,
+            self.samples(),
+            buffer::RESULT_BLOCK,
+            |first, mut cols| {
+                let width = cols.ncols();
+                matmul(
+                    cols.as_mut(),
+                    Accum::Replace,
+                    ext.as_ref(),
+                    basis.subrows(first, width).transpose(),
+                    1.0,
+                    Par::Seq,
+                );
+            },
+        )
     }
 
     /// The part of the training outputs that `k` shapes miss, `F - 1 f_bar^T - A_k G_k^T`
