@@ -3,7 +3,8 @@
 Prints one JSON line per (strategy, function, seed), in the format of our
 `benches/harness/cors_dixon_szego.rs`: evaluations until the relative error drops below 1% (null
 if not within the budget) and the mean time per adaptive iteration spent outside the
-objective (the optimiser's overhead). Run through cors_pysot.sh.
+objective (the optimiser's overhead). Run through cors_pysot.sh; `--seeds S --first-seed F`
+runs seeds F..F+S-1.
 
 Noisy objectives: `--write-noise FILE` writes the shared noise table (the range of each
 function over its box, and per seed the standard normal draws added to evaluation 1, 2, ...);
@@ -189,6 +190,7 @@ def main():
     args = sys.argv[1:]
     opts = dict(zip(args[::2], args[1::2]))
     seeds = int(opts.get("--seeds", 30))
+    first = int(opts.get("--first-seed", 0))
     budget = int(opts.get("--budget", 300))
     names = opts.get("--functions", ",".join(FUNCTIONS)).split(",")
     strategies = opts.get("--strategies", "dycors,srbf").split(",")
@@ -198,7 +200,7 @@ def main():
     table = read_noise(opts["--noise-file"]) if "--noise" in opts else None
     for s in strategies:
         for name in names:
-            for seed in range(seeds):
+            for seed in range(first, first + seeds):
                 if table is None:
                     row = run(s, name, seed, budget)
                 else:

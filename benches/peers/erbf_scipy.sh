@@ -11,6 +11,11 @@
 # nodes x 3 velocity channels x 801 samples; the last 8 held out), generated once by the
 # `airframe_ensemble` example into benches/peers/out/airframe (minutes; kept for later runs).
 #
+# Each table ends with floors timed in numpy on the same data: the Gram matrix and the whole
+# method of snapshots (what a shape basis must compute before any surrogate), and the
+# 1000 x N x T product every full-history surrogate ends with; their ratios to scipy's times
+# are the best a surrogate as fast as numpy's BLAS could reach.
+#
 # Usage: benches/peers/erbf_scipy.sh [reps]   (from the repository root)
 # Our side is benches/harness/erbf_peer.rs, built as the `erbf_peer` example target.
 set -euo pipefail
@@ -90,6 +95,28 @@ print(f"agreement with scipy (max |ours - scipy| / max |scipy|, first {CHECK} ou
 def held_out(pred, truth):
     return np.linalg.norm(pred - truth) / np.linalg.norm(truth - truth.mean(axis=0))
 
+def snapshots(f, k):
+    """numpy's method of snapshots: mean, centred Gram, eigh, time functions of k shapes."""
+    mean = f.mean(axis=0)
+    c = f - mean
+    lam, u = np.linalg.eigh(c @ c.T)
+    top = u[:, ::-1][:, :k] / np.sqrt(lam[::-1][:k])
+    return mean, c.T @ top
+
+def floors(prefix, f, fit_c, pred_c, fit_g, pred_g):
+    """What any surrogate of these histories must do, timed in numpy on the same data."""
+    k = int(ours[f"{prefix}shapes_cubic_count"])
+    gram, _ = timed(lambda: f @ f.T)
+    snap, _ = timed(lambda: snapshots(f, k))
+    w = np.random.default_rng(0).standard_normal((Q, f.shape[0]))
+    product, _ = timed(lambda: w @ f)
+    print(f"  floors in numpy, same data: Gram matrix F F^T {gram * 1e3:.2f} ms, method of snapshots "
+          f"({k} shapes: mean, centring, Gram, eigh, time functions) {snap * 1e3:.2f} ms, "
+          f"{Q} x N x T product {product * 1e3:.2f} ms")
+    print(f"  best ratio a shape basis decomposed at numpy's speed could reach: scipy cubic / "
+          f"snapshots {(fit_c + pred_c) / snap:.2f} (scipy cubic / Gram alone "
+          f"{(fit_c + pred_c) / gram:.2f}); scipy Gaussian / product {(fit_g + pred_g) / product:.2f}")
+
 def shapes_table(title, prefix, fit_c, pred_c, err_c, fit_g, pred_g, erbf_full):
     print(title)
     print(f"{'case':<44} {'ours [s]':>10} {'scipy [s]':>10} {'scipy/ours':>10}")
@@ -122,6 +149,7 @@ fh = np.fromfile(f"{work}/held_values.bin", dtype="<f8").reshape(-1, T)
 shapes_table("impact-like family (same data as above), fit + 1000 predictions of whole histories:",
              "", fit_c, pred_c, held_out(ci(xh), fh), fit_g, pred_g,
              ours["erbf_fit"] + ours["erbf_predict_1000"])
+floors("", f, fit_c, pred_c, fit_g, pred_g)
 
 n, m, t = (int(v) for v in open(f"{airframe}/airframe_shape.txt").read().split())
 ax = np.fromfile(f"{airframe}/airframe_points.bin", dtype="<f8").reshape(n, m)
@@ -137,6 +165,7 @@ shapes_table(f"airframe ensemble ({nf} runs fit, {n - nf} held out, {m} paramete
              "fit + 1000 predictions:", "airframe_", a_fit_c, a_pred_c,
              held_out(aci(ax[nf:]), af[nf:]), a_fit_g, a_pred_g,
              ours["airframe_erbf_fit"] + ours["airframe_erbf_predict_1000"])
+floors("airframe_", f, a_fit_c, a_pred_c, a_fit_g, a_pred_g)
 print(f"  full cubic (ours): fit {ours['airframe_cubic_fit'] * 1e3:.2f} ms, 1000 predictions "
       f"{ours['airframe_cubic_predict_1000'] * 1e3:.2f} ms; scipy cubic {a_fit_c * 1e3:.2f} + "
       f"{a_pred_c * 1e3:.2f} ms")
