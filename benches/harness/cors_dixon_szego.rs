@@ -178,7 +178,13 @@ fn main() {
             if let Some(c) = get("--candidate-floor") {
                 options.candidate_decay = Some(CandidateDecay {
                     min_per_dim: c.parse().unwrap(),
-                    horizon: get("--candidate-horizon").map_or(300, |h| h.parse().unwrap()),
+                    ..options.candidate_decay.unwrap_or_default()
+                });
+            }
+            if let Some(h) = get("--candidate-horizon") {
+                options.candidate_decay = Some(CandidateDecay {
+                    horizon: h.parse().unwrap(),
+                    ..options.candidate_decay.unwrap_or_default()
                 });
             }
             if args.iter().any(|a| a == "--no-candidate-decay") {

