@@ -178,13 +178,7 @@ fn main() {
             if let Some(c) = get("--candidate-floor") {
                 options.candidate_decay = Some(CandidateDecay {
                     min_per_dim: c.parse().unwrap(),
-                    ..options.candidate_decay.unwrap_or_default()
-                });
-            }
-            if let Some(h) = get("--candidate-horizon") {
-                options.candidate_decay = Some(CandidateDecay {
-                    horizon: h.parse().unwrap(),
-                    ..options.candidate_decay.unwrap_or_default()
+                    horizon: get("--candidate-horizon").map_or(300, |h| h.parse().unwrap()),
                 });
             }
             if args.iter().any(|a| a == "--no-candidate-decay") {

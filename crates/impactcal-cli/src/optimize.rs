@@ -152,16 +152,13 @@ struct SuggestArgs {
     /// Move every coordinate of the candidates around the best point.
     #[arg(long)]
     no_perturbation: bool,
-    /// The number of quasi-random candidates falls from 300 d to this many per dimension
-    /// over `--candidate-horizon` evaluations after the initial set (default 100).
-    #[arg(long, conflicts_with = "no_candidate_decay")]
-    candidate_floor: Option<usize>,
-    /// The horizon over which the candidate count falls (default 300).
-    #[arg(long, conflicts_with = "no_candidate_decay")]
-    candidate_horizon: Option<usize>,
-    /// Keep 300 d quasi-random candidates at every step.
+    /// Let the number of quasi-random candidates fall from 300 d to this many per dimension
+    /// over `--candidate-horizon` evaluations after the initial set (off by default).
     #[arg(long)]
-    no_candidate_decay: bool,
+    candidate_floor: Option<usize>,
+    /// The horizon of `--candidate-floor` (default 300).
+    #[arg(long, requires = "candidate_floor", default_value_t = 300)]
+    candidate_horizon: usize,
     /// SRBF's weight cycle (comma-separated weights in [0, 1], e.g. 0.3,0.5,0.8,0.95) in
     /// place of the distance constraint (off by default).
     #[arg(long, value_delimiter = ',')]
@@ -347,15 +344,10 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
                 .map(|horizon| Perturbation { horizon })
                 .or(options.perturbation)
         },
-        candidate_decay: if args.no_candidate_decay {
-            None
-        } else {
-            let base = options.candidate_decay.unwrap_or_default();
-            Some(CandidateDecay {
-                min_per_dim: args.candidate_floor.unwrap_or(base.min_per_dim),
-                horizon: args.candidate_horizon.unwrap_or(base.horizon),
-            })
-        },
+        candidate_decay: args.candidate_floor.map(|min_per_dim| CandidateDecay {
+            min_per_dim,
+            horizon: args.candidate_horizon,
+        }),
         merit_weights: args.merit_weights,
         adaptive_region: args.adaptive_region.map(|on| AdaptiveRegion {
             shrink_after: args.adaptive_shrink_after,

@@ -91,7 +91,7 @@ fn shell_loop_reproduces_the_library_loop() {
 #[test]
 fn search_options_reproduce_the_library_loop() {
     let f = test_functions::by_name("branin").unwrap();
-    let cases: [(&[&str], CorsOptions); 14] = [
+    let cases: [(&[&str], CorsOptions); 12] = [
         (
             &["--local-half-width", "0.15"],
             CorsOptions {
@@ -158,23 +158,6 @@ fn search_options_reproduce_the_library_loop() {
                     min_per_dim: 50,
                     horizon: 20,
                 }),
-                ..CorsOptions::with_seed(3)
-            },
-        ),
-        (
-            &["--candidate-floor", "50"],
-            CorsOptions {
-                candidate_decay: Some(CandidateDecay {
-                    min_per_dim: 50,
-                    horizon: 300,
-                }),
-                ..CorsOptions::with_seed(3)
-            },
-        ),
-        (
-            &["--no-candidate-decay"],
-            CorsOptions {
-                candidate_decay: None,
                 ..CorsOptions::with_seed(3)
             },
         ),
@@ -384,11 +367,6 @@ fn bad_search_options_are_input_errors() {
         (
             &["--candidate-floor", "0"][..],
             "candidate_decay.min_per_dim",
-        ),
-        (&["--candidate-horizon", "1"][..], "candidate_decay.horizon"),
-        (
-            &["--candidate-floor", "50", "--no-candidate-decay"][..],
-            "cannot be used",
         ),
         (&["--merit-weights", "0.5,2"][..], "merit_weights"),
         (

