@@ -25,7 +25,7 @@ VENV=benches/peers/.venv
 if [ ! -x "$VENV/bin/python" ]; then
     python3 -m venv "$VENV"
 fi
-"$VENV/bin/pip" install --quiet numpy scipy
+"$VENV/bin/pip" install --quiet numpy==2.4.6 scipy==1.17.1
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-target}"

@@ -13,7 +13,7 @@ if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
   "$venv/bin/pip" install -q --upgrade pip
 fi
-"$venv/bin/pip" install -q numpy
+"$venv/bin/pip" install -q numpy==2.4.6
 mkdir -p "$out"
 echo "== impactcal (faer) side"
 (cd "$root" && cargo run -q --release --example svd_timing -- "$out" "$repeats") | tee "$out/ours.jsonl"
