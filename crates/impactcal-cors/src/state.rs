@@ -311,15 +311,7 @@ impl CorsState {
 
     /// The best successful evaluation (lowest value; the earliest on ties).
     pub fn best(&self) -> Option<&Evaluation> {
-        let mut best: Option<&Evaluation> = None;
-        for e in &self.evaluations {
-            if let Some(v) = e.value
-                && best.and_then(|b| b.value).is_none_or(|b| v < b)
-            {
-                best = Some(e);
-            }
-        }
-        best
+        best_of(&self.evaluations)
     }
 
     /// Number of restarts so far.
@@ -452,4 +444,17 @@ impl CorsState {
             })
         }
     }
+}
+
+/// The best successful evaluation of `evaluations` (lowest value; the earliest on ties).
+pub(crate) fn best_of(evaluations: &[Evaluation]) -> Option<&Evaluation> {
+    let mut best: Option<&Evaluation> = None;
+    for e in evaluations {
+        if let Some(v) = e.value
+            && best.and_then(|b| b.value).is_none_or(|b| v < b)
+        {
+            best = Some(e);
+        }
+    }
+    best
 }

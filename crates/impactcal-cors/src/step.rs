@@ -13,7 +13,7 @@ use crate::options::{AdaptiveRegion, Converged, InitialDesign};
 use crate::region::{LocalWidth, SUCCESS_IMPROVEMENT, adaptive_width};
 use crate::stall::StallRule;
 use crate::state::{
-    CorsState, DUPLICATE_TOL, FillReason, MATCH_TOL, Mode, Origin, Plan, Suggestion,
+    CorsState, DUPLICATE_TOL, FillReason, MATCH_TOL, Mode, Origin, Plan, Suggestion, best_of,
 };
 use crate::subproblem::{Blockers, Region, StepSettings, cors_step, maximin};
 use crate::surrogate::RbfSurrogate;
@@ -107,27 +107,37 @@ fn keeps_outside(state: &CorsState) -> bool {
 fn run_best(state: &CorsState, plan: &Plan, upto: usize) -> Result<Vec<f64>> {
     let end = upto.min(state.evaluations.len());
     let start = plan.run_start.min(end);
-    let mut best: Option<(f64, &[f64])> = None;
-    for e in &state.evaluations[start..end] {
-        if let Some(v) = e.value
-            && best.is_none_or(|(b, _)| v < b)
-        {
-            best = Some((v, &e.x));
-        }
-    }
-    match best {
-        Some((_, x)) => Ok(state.space.to_unit(x)?),
+    match best_of(&state.evaluations[start..end]) {
+        Some(e) => Ok(state.space.to_unit(&e.x)?),
         None => Ok(vec![0.5; state.space.dim()]),
     }
 }
 
-/// Whether a success `u` (unit box) of an earlier run is kept in the current run's
-/// surrogate: outside every excluded box ([`Converged::RestartOutside`]).
-fn kept_from_earlier(state: &CorsState, plan: &Plan, u: &[f64]) -> bool {
+/// The successes of earlier runs (unit box, with their values) that the current run's
+/// surrogate and distance constraints keep: those outside every excluded box, under
+/// [`Converged::RestartOutside`]; none otherwise.
+///
+/// # Errors
+/// Mapping errors of the parameter space (not expected).
+fn kept_from_earlier(state: &CorsState, plan: &Plan) -> Result<Vec<(Vec<f64>, f64)>> {
+    if !keeps_outside(state) {
+        return Ok(Vec::new());
+    }
     let half = state.options.local_region.unwrap_or(0.3);
-    plan.excluded
-        .iter()
-        .all(|c| c.iter().zip(u).any(|(a, b)| (a - b).abs() > half))
+    let start = plan.run_start.min(state.evaluations.len());
+    let mut kept = Vec::new();
+    for e in &state.evaluations[..start] {
+        let Some(v) = e.value else { continue };
+        let u = state.space.to_unit(&e.x)?;
+        if plan
+            .excluded
+            .iter()
+            .all(|c| c.iter().zip(&u).any(|(a, b)| (a - b).abs() > half))
+        {
+            kept.push((u, v));
+        }
+    }
+    Ok(kept)
 }
 
 /// Whether the local region of the run, seeing the first `upto` evaluations, has converged
@@ -204,12 +214,13 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
         });
     }
     let width = local_width(state, &plan);
-    let fitted = fit_surrogate(state, &plan, width.rank)?;
+    let earlier = kept_from_earlier(state, &plan)?;
+    let fitted = fit_surrogate(state, &plan, &earlier, width.rank)?;
     let root_d = (d as f64).sqrt();
     while out.len() < q {
         let index = evaluated + state.pending.len() + out.len();
         let mut rng = stream(state.options.seed, index);
-        let blockers = blockers(state, &plan, &out)?;
+        let blockers = blockers(state, &plan, &earlier, &out)?;
         // Evaluations after the run's initial set before this one.
         let m = index.saturating_sub(plan.cycle_origin);
         let per_dim = match &state.options.candidate_decay {
@@ -350,8 +361,9 @@ fn basin_centre<'a>(pts: &'a [Vec<f64>], vals: &[f64], half: f64, rank: usize) -
 /// The fitted surrogate, the best successful point and the centre of the local cycles.
 type Fitted = (RbfSurrogate, Vec<f64>, Vec<f64>);
 
-/// The surrogate fitted to the successes of the run starting at `run_start` (near-duplicates
-/// merged, lower value kept, values transformed), the best successful point in the unit
+/// The surrogate fitted to `earlier` (the earlier runs' successes it keeps,
+/// [`kept_from_earlier`]) and the successes of the current run (near-duplicates merged,
+/// lower value kept, values transformed), the best successful point in the unit
 /// box and the centre of the local cycles (the best point, or with `escape_rank > 0` the
 /// first point of another basin, [`basin_centre`]); or why none can be fitted.
 ///
@@ -360,26 +372,16 @@ type Fitted = (RbfSurrogate, Vec<f64>, Vec<f64>);
 fn fit_surrogate(
     state: &CorsState,
     plan: &Plan,
+    earlier: &[(Vec<f64>, f64)],
     escape_rank: usize,
 ) -> Result<std::result::Result<Fitted, FillReason>> {
     let d = state.space.dim();
     let tol = DUPLICATE_TOL * (d as f64).sqrt();
-    let mut pts: Vec<Vec<f64>> = Vec::new();
-    let mut vals: Vec<f64> = Vec::new();
+    // Successes of earlier runs kept in this run's surrogate first ([`kept_from_earlier`]).
+    let kept = earlier.len();
+    let mut pts: Vec<Vec<f64>> = earlier.iter().map(|(u, _)| u.clone()).collect();
+    let mut vals: Vec<f64> = earlier.iter().map(|&(_, v)| v).collect();
     let start = plan.run_start.min(state.evaluations.len());
-    // Successes of earlier runs kept in this run's surrogate (RestartOutside only).
-    let mut kept = 0;
-    if keeps_outside(state) {
-        for e in &state.evaluations[..start] {
-            let Some(v) = e.value else { continue };
-            let u = state.space.to_unit(&e.x)?;
-            if kept_from_earlier(state, plan, &u) {
-                pts.push(u);
-                vals.push(v);
-                kept += 1;
-            }
-        }
-    }
     for e in &state.evaluations[start..] {
         let Some(v) = e.value else { continue };
         let u = state.space.to_unit(&e.x)?;
@@ -421,20 +423,23 @@ fn fit_surrogate(
     )
 }
 
-/// The points to keep away from: successes of the current run, pending points and the
-/// points already proposed, and failures of every run.
-fn blockers(state: &CorsState, plan: &Plan, proposed: &[Suggestion]) -> Result<Blockers> {
+/// The points to keep away from: the earlier runs' successes the surrogate keeps
+/// (`earlier`, first, as in its centres), successes of the current run, pending points and
+/// the points already proposed, and failures of every run.
+fn blockers(
+    state: &CorsState,
+    plan: &Plan,
+    earlier: &[(Vec<f64>, f64)],
+    proposed: &[Suggestion],
+) -> Result<Blockers> {
     let mut b = Blockers::new(state.space.dim());
+    for (u, _) in earlier {
+        b.ok.extend_from_slice(u);
+    }
     for (k, e) in state.evaluations.iter().enumerate() {
         if e.is_success() {
             if k >= plan.run_start {
                 b.ok.extend(state.space.to_unit(&e.x)?);
-            } else if keeps_outside(state) {
-                // The earlier successes kept in the surrogate, first, as in its centres.
-                let u = state.space.to_unit(&e.x)?;
-                if kept_from_earlier(state, plan, &u) {
-                    b.ok.extend(u);
-                }
             }
         } else {
             b.failed.extend(state.space.to_unit(&e.x)?);
