@@ -77,6 +77,26 @@ pub fn by_column_blocks(
     block: usize,
     fill: impl Fn(usize, MatMut<'_, f64>) + Sync,
 ) -> Mat<f64> {
+    by_column_blocks_with(
+        nrows,
+        ncols,
+        block,
+        || (),
+        |(), first, cols| fill(first, cols),
+    )
+}
+
+/// As [`by_column_blocks`], with a scratch value for the blocks: `init` makes one per rayon
+/// task that runs several blocks (as [`rayon::iter::ParallelIterator::for_each_init`]), and
+/// `fill(scratch, first, cols)` may use it as it likes. The result must not depend on what
+/// an earlier block left in the scratch, or it would depend on the number of threads.
+pub fn by_column_blocks_with<S>(
+    nrows: usize,
+    ncols: usize,
+    block: usize,
+    init: impl Fn() -> S + Sync + Send,
+    fill: impl Fn(&mut S, usize, MatMut<'_, f64>) + Sync,
+) -> Mat<f64> {
     /// The matrix's storage, shared by the tasks; each writes only its own columns.
     struct Storage(*mut f64);
     // SAFETY: the tasks write disjoint column ranges of one allocation that outlives them.
@@ -98,7 +118,7 @@ pub fn by_column_blocks(
         advise_huge_pages(m.as_ptr_mut().cast::<u8>(), bytes);
     }
     let storage = Storage(m.as_ptr_mut());
-    let write = |b: usize| {
+    let write = |scratch: &mut S, b: usize| {
         let start = b * block;
         let len = block.min(ncols - start);
         // SAFETY: `with_capacity` allocated `stride >= nrows` rows for each of the `ncols`
@@ -113,14 +133,14 @@ pub fn by_column_blocks(
             }
             MatMut::from_raw_parts_mut(first, nrows, len, 1, stride as isize)
         };
-        fill(start, cols);
+        fill(scratch, start, cols);
     };
     let blocks = ncols.div_ceil(block);
     if blocks <= 1 {
         // One block (a single prediction, say): no task for the pool.
-        (0..blocks).for_each(write);
+        (0..blocks).for_each(|b| write(&mut init(), b));
     } else {
-        (0..blocks).into_par_iter().for_each(write);
+        (0..blocks).into_par_iter().for_each_init(init, write);
     }
     // SAFETY: every column `0 .. ncols` was zeroed by its block's `write` above (the loop
     // has returned), and `nrows x ncols` is within the capacity reserved.

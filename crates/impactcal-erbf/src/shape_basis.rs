@@ -49,9 +49,10 @@ const GRAM_GROUPS: usize = 8;
 pub struct ShapeBasis {
     /// Mean history `f_bar` (length `T`).
     mean: Vec<f64>,
-    /// `[G | f_bar]` (`T x (k + 1)`): the time functions kept (orthonormal columns) and the
-    /// mean history last, so that a rebuild is one product.
-    functions: Mat<f64>,
+    /// `[G | f_bar]^T` (`(k + 1) x T`): the time functions kept (orthonormal rows) and the
+    /// mean history last, so that a rebuild is one product and a block of samples is a
+    /// block of columns.
+    rows: Mat<f64>,
     /// Singular values of the deviations, all of them up to the numerical rank.
     sigma: Vec<f64>,
     /// `||F - 1 f_bar^T||_F^2`.
@@ -63,10 +64,14 @@ pub struct ShapeBasis {
 /// (which [`ShapeSpectrum::basis`] computes for the shapes kept only).
 ///
 /// For long histories (`T >= GRAM_RATIO N`) it is the method of snapshots: with the
-/// deviations `C = F - 1 f_bar^T` (`N x T`, formed block by block, never stored), the Gram
+/// deviations `C = F - 1 f_bar^T` (`N x T`, never stored), the Gram
 /// matrix `K = C C^T = U diag(sigma^2) U^T` (`N x N`, `O(N^2 T)`) gives the singular values
 /// and the left singular vectors `U`, hence the coordinates `A = U diag(sigma)`; the time
 /// functions of the `k` shapes kept are `G_k = C^T U_k diag(sigma_k)^{-1}` (`O(N k T)`).
+/// The mean and `K` come from one pass over the runs: the deviations from the first run,
+/// `D = F - 1 f_1^T`, formed block by block, give `D D^T`, and since `C = P D` with the
+/// centring projector `P = I - 1 1^T / N`, `K = P (D D^T) P`. `D` is of the size of `C`
+/// (`|d_k| <= |c_k| + |c_1|`), so the rounding of `K` stays of the order `eps sigma_1^2`.
 /// Whatever the accuracy of `U`, the rebuilt training runs
 /// `1 f_bar^T + A_k G_k^T = 1 f_bar^T + U_k U_k^T C` are the exact orthogonal projection of
 /// the runs onto the `k` coordinates. Squaring `C` costs precision for weak shapes only:
@@ -105,11 +110,24 @@ impl ShapeSpectrum {
             }
             .into());
         }
-        let mean = column_means(values)?;
         if t < GRAM_RATIO * n {
-            return Self::by_svd(values, mean);
+            return Self::by_svd(values, column_means(values)?);
         }
-        let (gram, total) = centred_gram(values, &mean);
+        let first: Vec<f64> = values.row(0).iter().copied().collect();
+        let (gram, sums) = deviation_gram(values, &first);
+        let scale = 1.0 / n as f64;
+        let mean: Vec<f64> = sums.iter().map(|s| s * scale).collect();
+        let (mean, gram) = if mean.iter().all(|m| m.is_finite()) && gram_is_finite(&gram) {
+            (mean, gram)
+        } else {
+            // A bad entry (named here), or finite entries whose sums overflow: the
+            // deviations from the mean, which is then found from scaled entries.
+            let mean = column_means(values)?;
+            let (gram, _) = deviation_gram(values, &mean);
+            (mean, gram)
+        };
+        let gram = centre_gram(gram);
+        let total = (0..n).map(|i| gram[(i, i)]).sum();
         let eigen = gram
             .self_adjoint_eigen(Side::Lower)
             .map_err(|_| ErbfError::Shapes(impactcal_shapes::ShapesError::NoConvergence))?;
@@ -185,50 +203,49 @@ impl ShapeSpectrum {
             ));
         }
         let k = k.clamp(1, self.sigma.len().max(1));
-        let mut functions = Mat::<f64>::zeros(t, k + 1);
-        match &self.functions {
-            Some(g) => functions
-                .as_mut()
-                .subcols_mut(0, k)
-                .copy_from(g.subcols(0, k)),
-            None => {
-                // G_k = C^T U_k diag(sigma_k)^{-1}, block of samples by block.
-                let mut scaled = self.left.subcols(0, k).to_owned();
-                for (j, s) in self.sigma[..k].iter().enumerate() {
-                    scaled.col_mut(j).iter_mut().for_each(|v| *v /= s);
-                }
-                // One block of samples per task, each its own rows of G_k: the result does
-                // not depend on the number of threads.
-                let mean = &self.mean;
-                functions
-                    .as_mut()
-                    .subcols_mut(0, k)
-                    .par_row_chunks_mut(BLOCK)
-                    .enumerate()
-                    .for_each_init(
-                        || Mat::<f64>::zeros(n, BLOCK.min(t)),
-                        |buffer, (b, rows)| {
-                            let c = centre_block(values, mean, b * BLOCK, buffer);
-                            matmul(
-                                rows,
-                                Accum::Replace,
-                                c.transpose(),
-                                scaled.as_ref(),
-                                1.0,
-                                Par::Seq,
-                            );
-                        },
-                    );
+        let mean = &self.mean;
+        let rows = match &self.functions {
+            Some(g) => {
+                let mut rows = Mat::<f64>::zeros(k + 1, t);
+                rows.as_mut()
+                    .subrows_mut(0, k)
+                    .copy_from(g.subcols(0, k).transpose());
+                rows.row_mut(k)
+                    .iter_mut()
+                    .zip(mean)
+                    .for_each(|(g, m)| *g = *m);
+                rows
             }
-        }
-        functions
-            .col_mut(k)
-            .iter_mut()
-            .zip(&self.mean)
-            .for_each(|(g, m)| *g = *m);
+            None => {
+                // G_k^T = diag(sigma_k)^{-1} U_k^T C, one block of samples per task, each
+                // its own columns: the result does not depend on the number of threads.
+                let scaled = Mat::from_fn(k, n, |j, i| self.left[(i, j)] / self.sigma[j]);
+                buffer::by_column_blocks_with(
+                    k + 1,
+                    t,
+                    BLOCK,
+                    || Mat::<f64>::zeros(n, BLOCK.min(t)),
+                    |scratch, first, mut cols| {
+                        let c = centre_block(values, mean, first, scratch);
+                        matmul(
+                            cols.as_mut().subrows_mut(0, k),
+                            Accum::Replace,
+                            scaled.as_ref(),
+                            c,
+                            1.0,
+                            Par::Seq,
+                        );
+                        cols.row_mut(k)
+                            .iter_mut()
+                            .zip(&mean[first..])
+                            .for_each(|(g, m)| *g = *m);
+                    },
+                )
+            }
+        };
         Ok(ShapeBasis {
             mean: self.mean.clone(),
-            functions,
+            rows,
             sigma: self.sigma.clone(),
             total: self.total,
         })
@@ -244,9 +261,7 @@ impl ShapeSpectrum {
 fn column_means(values: MatRef<'_, f64>) -> Result<Vec<f64>> {
     let (n, t) = values.shape();
     let scale = 1.0 / n as f64;
-    let mean: Vec<f64> = (0..t)
-        .map(|c| values.col(c).iter().sum::<f64>() * scale)
-        .collect();
+    let mean: Vec<f64> = (0..t).map(|c| column_sum(values, c) * scale).collect();
     if mean.iter().all(|m| m.is_finite()) {
         return Ok(mean);
     }
@@ -257,63 +272,120 @@ fn column_means(values: MatRef<'_, f64>) -> Result<Vec<f64>> {
         .collect())
 }
 
-/// The lower triangle of the Gram matrix `K = C C^T` of the deviations
-/// `C = F - 1 f_bar^T` (`N x N`; the upper triangle is zero) and `||C||_F^2`.
+/// The sum of column `c` of `values` in four interleaved partial sums (entry `i` into sum
+/// `i mod 4`, then `(s_0 + s_1) + (s_2 + s_3)`): the same bits for any layout, and
+/// four independent chains of additions instead of one, which the processor overlaps.
+fn column_sum(values: MatRef<'_, f64>, c: usize) -> f64 {
+    let mut acc = [0.0f64; 4];
+    match values.col(c).try_as_col_major() {
+        Some(col) => {
+            let xs = col.as_slice();
+            let mut chunks = xs.chunks_exact(4);
+            for ch in &mut chunks {
+                for (a, x) in acc.iter_mut().zip(ch) {
+                    *a += x;
+                }
+            }
+            for (a, x) in acc.iter_mut().zip(chunks.remainder()) {
+                *a += x;
+            }
+        }
+        None => {
+            for (i, x) in values.col(c).iter().enumerate() {
+                acc[i % 4] += x;
+            }
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3])
+}
+
+/// The lower triangle of the Gram matrix `D D^T` of the deviations
+/// `D = F - 1 r^T` from a reference history `r` (`N x N`; the upper triangle is zero), and
+/// the column sums of `F` (length `T`, by [`column_sum`]), in one pass over `F`.
 ///
 /// The samples are split into at most [`GRAM_GROUPS`] contiguous groups of whole blocks of
 /// [`BLOCK`] samples, independent of the number of threads; each group accumulates its
 /// blocks' products in its own matrix (in parallel across groups, sequentially inside), and
 /// the groups are summed in order, so the result does not depend on the number of threads.
-fn centred_gram(values: MatRef<'_, f64>, mean: &[f64]) -> (Mat<f64>, f64) {
+fn deviation_gram(values: MatRef<'_, f64>, reference: &[f64]) -> (Mat<f64>, Vec<f64>) {
     let (n, t) = values.shape();
     let blocks = t.div_ceil(BLOCK);
     let groups = blocks.clamp(1, GRAM_GROUPS);
     let per_group = blocks.div_ceil(groups);
-    let parts: Vec<(Mat<f64>, f64)> = (0..groups)
+    let parts: Vec<(Mat<f64>, Vec<f64>)> = (0..groups)
         .into_par_iter()
         .map(|g| {
             let mut gram = Mat::<f64>::zeros(n, n);
-            let mut total = 0.0;
+            let mut sums = Vec::new();
             let mut buffer = Mat::<f64>::zeros(n, BLOCK.min(t));
             for b in g * per_group..((g + 1) * per_group).min(blocks) {
-                let c = centre_block(values, mean, b * BLOCK, &mut buffer);
-                total += c.squared_norm_l2();
+                let start = b * BLOCK;
+                let len = BLOCK.min(t - start);
+                sums.extend((start..start + len).map(|c| column_sum(values, c)));
+                let d = centre_block(values, reference, start, &mut buffer);
                 // Only the lower triangle: the eigensolver reads no more.
                 triangular::matmul(
                     gram.as_mut(),
                     BlockStructure::TriangularLower,
                     Accum::Add,
-                    c,
+                    d,
                     BlockStructure::Rectangular,
-                    c.transpose(),
+                    d.transpose(),
                     BlockStructure::Rectangular,
                     1.0,
                     Par::Seq,
                 );
             }
-            (gram, total)
+            (gram, sums)
         })
         .collect();
-    let mut parts = parts.into_iter();
-    let (mut gram, mut total) = parts.next().unwrap_or_else(|| (Mat::zeros(n, n), 0.0));
+    let mut gram = Mat::<f64>::zeros(n, n);
+    let mut sums = Vec::with_capacity(t);
     for (g, s) in parts {
         gram += &g;
-        total += s;
+        sums.extend(s);
     }
-    (gram, total)
+    (gram, sums)
 }
 
-/// The deviations `C_b = F_b - 1 f_bar_b^T` of the block of at most [`BLOCK`] samples
-/// starting at `start`, formed in `buffer` (`N x BLOCK`).
+/// Whether the lower triangle of `gram` is finite.
+fn gram_is_finite(gram: &Mat<f64>) -> bool {
+    (0..gram.ncols()).all(|j| gram.col(j).iter().skip(j).all(|v| v.is_finite()))
+}
+
+/// The lower triangle of `P G P`, `P = I - 1 1^T / N`, from the lower triangle of a
+/// symmetric `G` (`N x N`): `(P G P)_ij = G_ij - g_i - g_j + g`, with `g_i` the row means
+/// of `G` and `g` their mean. For the Gram matrix of the deviations from any one history it
+/// is the Gram matrix of the deviations from the mean history.
+fn centre_gram(lower: Mat<f64>) -> Mat<f64> {
+    let n = lower.nrows();
+    let full = |i: usize, j: usize| if i >= j { lower[(i, j)] } else { lower[(j, i)] };
+    let scale = 1.0 / n as f64;
+    let row_means: Vec<f64> = (0..n)
+        .map(|i| (0..n).map(|j| full(i, j)).sum::<f64>() * scale)
+        .collect();
+    let grand = row_means.iter().sum::<f64>() * scale;
+    Mat::from_fn(n, n, |i, j| {
+        if i >= j {
+            lower[(i, j)] - row_means[i] - row_means[j] + grand
+        } else {
+            0.0
+        }
+    })
+}
+
+/// The deviations `F_b - 1 r_b^T` from a reference history `r` (the mean history, or the
+/// first run) of the block of at most [`BLOCK`] samples starting at `start`, formed in
+/// `buffer` (`N x BLOCK`).
 fn centre_block<'a>(
     values: MatRef<'_, f64>,
-    mean: &[f64],
+    reference: &[f64],
     start: usize,
     buffer: &'a mut Mat<f64>,
 ) -> MatRef<'a, f64> {
     let len = BLOCK.min(values.ncols() - start);
     for j in 0..len {
-        let m = mean[start + j];
+        let m = reference[start + j];
         buffer
             .col_mut(j)
             .iter_mut()
@@ -357,7 +429,7 @@ impl ShapeBasis {
 
     /// Number of shapes kept `k`.
     pub fn len(&self) -> usize {
-        self.functions.ncols() - 1
+        self.rows.nrows() - 1
     }
 
     /// Whether no shape is kept (never true for a basis from [`new`](Self::new)).
@@ -381,9 +453,10 @@ impl ShapeBasis {
         &self.mean
     }
 
-    /// The time functions kept, `T x k`, orthonormal columns.
+    /// The time functions kept, `T x k`, orthonormal columns (a view with row stride
+    /// `k + 1`).
     pub fn functions(&self) -> MatRef<'_, f64> {
-        self.functions.as_ref().subcols(0, self.len())
+        self.rows.as_ref().subrows(0, self.len()).transpose()
     }
 
     /// Relative truncation error of `k` shapes on the training data,
@@ -404,9 +477,8 @@ impl ShapeBasis {
         let k = k.clamp(1, self.len().max(1));
         let len = self.len();
         if k < len {
-            let f = &self.functions;
-            self.functions =
-                Mat::from_fn(f.nrows(), k + 1, |i, j| f[(i, if j < k { j } else { len })]);
+            let r = &self.rows;
+            self.rows = Mat::from_fn(k + 1, r.ncols(), |i, j| r[(if i < k { i } else { len }, j)]);
         }
     }
 
@@ -424,13 +496,11 @@ impl ShapeBasis {
         ext.col_mut(k).iter_mut().for_each(|v| *v = 1.0);
         let len = self.len();
         let fewer = (k < len).then(|| {
-            Mat::from_fn(self.samples(), k + 1, |i, j| {
-                self.functions[(i, if j < k { j } else { len })]
+            Mat::from_fn(k + 1, self.samples(), |i, j| {
+                self.rows[(if i < k { i } else { len }, j)]
             })
         });
-        let basis = fewer
-            .as_ref()
-            .map_or(self.functions.as_ref(), |b| b.as_ref());
+        let basis = fewer.as_ref().map_or(self.rows.as_ref(), |b| b.as_ref());
         // Written once, in blocks of output samples, one task each.
         buffer::by_column_blocks(
             q,
@@ -442,7 +512,7 @@ impl ShapeBasis {
                     cols.as_mut(),
                     Accum::Replace,
                     ext.as_ref(),
-                    basis.subrows(first, width).transpose(),
+                    basis.subcols(first, width),
                     1.0,
                     Par::Seq,
                 );
@@ -606,7 +676,7 @@ mod tests {
                 (
                     s.singular_values().to_vec(),
                     s.left.clone(),
-                    b.functions,
+                    b.rows,
                     rebuilt,
                 )
             })
@@ -621,13 +691,66 @@ mod tests {
         }
     }
 
-    /// Finite outputs whose column sums overflow still give finite means.
+    /// Finite outputs whose column sums overflow still give finite means, on both routes
+    /// (the Gram route falls back to the deviations from the mean).
     #[test]
     fn means_of_huge_finite_outputs_are_finite() {
         let f = Mat::from_fn(4, 3, |i, j| if j == 1 { 1e308 } else { (i + j) as f64 });
         let mean = column_means(f.as_ref()).unwrap();
         assert_relative_eq!(mean[1], 1e308, max_relative = 1e-15);
         assert_relative_eq!(mean[2], 3.5);
+        let mut g = graded_ensemble(6, 40);
+        g.col_mut(7).iter_mut().for_each(|v| *v = 1e308);
+        let s = ShapeSpectrum::new(g.as_ref()).unwrap();
+        assert_relative_eq!(s.mean[7], 1e308, max_relative = 1e-15);
+        let plain = ShapeSpectrum::new(graded_ensemble(6, 40).as_ref()).unwrap();
+        // Column 7 is now constant: the spectrum loses its share of the deviations only.
+        assert!(s.singular_values()[0] <= plain.singular_values()[0] * (1.0 + 1e-12));
+        assert!(
+            s.singular_values()
+                .iter()
+                .all(|v| v.is_finite() && *v > 0.0)
+        );
+    }
+
+    /// The one-pass Gram matrix is centred exactly: a mean history of `1e8` (deviations of
+    /// order 1) leaves the spectrum as it is to the precision the input carries
+    /// (`eps 1e8 ~ 2e-8` per entry). A Gram matrix of the raw runs centred afterwards would
+    /// carry errors of `eps 1e16 ~ 2` on eigenvalues of order 1.
+    #[test]
+    fn a_large_mean_history_costs_no_precision() {
+        let f = graded_ensemble(20, 3 * BLOCK + 5);
+        let mut shifted = f.clone();
+        shifted
+            .col_iter_mut()
+            .for_each(|c| c.iter_mut().for_each(|v| *v += 1e8));
+        let (a, b) = (
+            ShapeSpectrum::new(f.as_ref()).unwrap(),
+            ShapeSpectrum::new(shifted.as_ref()).unwrap(),
+        );
+        let s1 = a.singular_values()[0];
+        for (x, y) in a.singular_values().iter().zip(b.singular_values()).take(6) {
+            assert!((x - y).abs() <= 1e-6 * s1, "{x} vs {y}");
+        }
+        assert_relative_eq!(a.total, b.total, max_relative = 1e-6);
+    }
+
+    /// Column sums do not depend on the layout of the matrix (contiguous or strided
+    /// columns): the same four partial sums in the same order.
+    #[test]
+    fn column_sums_are_the_same_bits_for_any_layout() {
+        let f = graded_ensemble(13, 30);
+        let t = f.transpose().to_owned();
+        let strided = t.transpose();
+        assert!(strided.col(0).try_as_col_major().is_none());
+        for c in 0..30 {
+            assert_eq!(
+                column_sum(f.as_ref(), c).to_bits(),
+                column_sum(strided, c).to_bits()
+            );
+            let naive: f64 = f.col(c).iter().sum();
+            assert_relative_eq!(column_sum(f.as_ref(), c), naive, max_relative = 1e-13);
+        }
     }
 
     #[test]
