@@ -5,6 +5,7 @@
 //! [--functions branin,hartmann3] [--transform identity|log|shifted-log|median-cap]
 //! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]
 //! [--restart-patience N | --restart | --no-restart] [--global-only] [--local-first] [--escape N | --no-escape]
+//! [--second-region H | --no-second-region]
 //! [--perturb-horizon H | --no-perturb] [--candidate-floor N [--candidate-horizon H] |
 //! --no-candidate-decay] [--merit-weights 0.3,0.5,0.8,0.95]
 //! [--adaptive-region restore|escape|restart|restart-outside [--grow-after 3] [--shrink-after N] [--halvings 6] [--sigma-only] |
@@ -160,6 +161,12 @@ fn main() {
             }
             if args.iter().any(|a| a == "--no-escape") {
                 options.local_escape = None;
+            }
+            if let Some(h) = get("--second-region") {
+                options.second_region = Some(h.parse().unwrap());
+            }
+            if args.iter().any(|a| a == "--no-second-region") {
+                options.second_region = None;
             }
             if args.iter().any(|a| a == "--local-first") {
                 options.local_first = true;

@@ -144,6 +144,13 @@ struct SuggestArgs {
     /// Keep the local cycles around the best point (no basin escape).
     #[arg(long)]
     no_local_escape: bool,
+    /// Every second local cycle searches around the best point outside the box of this
+    /// half-width around the first local centre (default 0.5).
+    #[arg(long, conflicts_with_all = ["global_only", "no_second_region"])]
+    second_region: Option<f64>,
+    /// Keep every local cycle around the first centre (no second region).
+    #[arg(long)]
+    no_second_region: bool,
     /// DYCORS-style coordinate perturbation in the local cycles: each coordinate of a
     /// candidate around the best point moves with a probability that falls over this many
     /// evaluations after the initial set (default 300).
@@ -336,6 +343,11 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
             None
         } else {
             args.local_escape.or(options.local_escape)
+        },
+        second_region: if args.no_second_region {
+            None
+        } else {
+            args.second_region.or(options.second_region)
         },
         perturbation: if args.no_perturbation {
             None

@@ -91,7 +91,7 @@ fn shell_loop_reproduces_the_library_loop() {
 #[test]
 fn search_options_reproduce_the_library_loop() {
     let f = test_functions::by_name("branin").unwrap();
-    let cases: [(&[&str], CorsOptions); 12] = [
+    let cases: [(&[&str], CorsOptions); 14] = [
         (
             &["--local-half-width", "0.15"],
             CorsOptions {
@@ -134,6 +134,23 @@ fn search_options_reproduce_the_library_loop() {
             &["--no-local-escape"],
             CorsOptions {
                 local_escape: None,
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            // With the local cycle first, local cycle 1 is pattern cycle 2 (steps 12..17
+            // after the design of 6 points): the second region's first.
+            &["--second-region", "0.4", "--local-first"],
+            CorsOptions {
+                second_region: Some(0.4),
+                local_first: true,
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--no-second-region"],
+            CorsOptions {
+                second_region: None,
                 ..CorsOptions::with_seed(3)
             },
         ),
@@ -364,6 +381,7 @@ fn bad_search_options_are_input_errors() {
         (&["--restart-patience", "0"][..], "patience"),
         (&["--perturb-horizon", "1"][..], "perturbation.horizon"),
         (&["--local-escape", "0"][..], "local_escape"),
+        (&["--second-region", "0"][..], "second_region"),
         (
             &["--candidate-floor", "0"][..],
             "candidate_decay.min_per_dim",

@@ -334,6 +334,16 @@ pub struct CorsOptions {
     /// the best point. Unlike a restart, the surrogate keeps every point of the run.
     /// `None`: always around the best point. Default 60.
     pub local_escape: Option<usize>,
+    /// A second local region: every second local cycle (local cycles 1, 3, 5..., counted
+    /// from 0 among the local cycles: cycles 3, 7, 11... of the pattern) searches around
+    /// the best success lying outside the box of this half-width around the first
+    /// region's centre (the best point, or the escape's basin), instead of around that
+    /// centre; the first region's centre when every success lies inside. Two regions in two basins are
+    /// refined side by side, so a run that started in the basin of a local minimum (the
+    /// best design point there) still resolves the best other basin, as the several trust
+    /// regions of TuRBO (Eriksson et al. 2019) do. `None`: every local cycle searches around
+    /// the first centre. Default 0.5. No effect without `local_region`.
+    pub second_region: Option<f64>,
     /// DYCORS-style perturbation of the candidates around the best point in the local
     /// cycles (`None`: every coordinate of every such candidate moves). Default: a horizon
     /// of 300 evaluations.
@@ -378,6 +388,7 @@ impl Default for CorsOptions {
             local_region: Some(0.3),
             local_first: false,
             local_escape: Some(60),
+            second_region: Some(0.5),
             perturbation: Some(Perturbation { horizon: 300 }),
             adaptive_region: None,
             candidate_decay: None,
@@ -477,6 +488,15 @@ impl ParamGuard for CorsOptions {
         }
         if self.local_escape == Some(0) {
             return bad("local_escape", "0".into(), "must be positive");
+        }
+        if let Some(h) = self.second_region
+            && !(h.is_finite() && h > 0.0)
+        {
+            return bad(
+                "second_region",
+                h.to_string(),
+                "must be finite and positive",
+            );
         }
         if let Some(p) = &self.perturbation
             && p.horizon < 2

@@ -229,12 +229,19 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
         };
         let n_cand = per_dim * d;
         let s = match &fitted {
-            Ok((surrogate, best, centre)) => {
+            Ok((surrogate, best, centre, second)) => {
                 let k = state.options.pattern.len();
                 let beta = state.options.pattern[m % k];
                 let cycle = m / k;
                 let phase = usize::from(state.options.local_first);
                 let local = state.options.local_region.is_some() && (cycle + phase) % 2 == 1;
+                // Local cycles 1, 3, 5... (counted from 0 among the local ones) in the
+                // second region.
+                let centre = if (cycle + phase) / 2 % 2 == 1 {
+                    second
+                } else {
+                    centre
+                };
                 let (region, best, sigma_scale) = match state.options.local_region {
                     Some(initial) if local => (
                         Region::around(centre, width.boxed),
@@ -358,14 +365,31 @@ fn basin_centre<'a>(pts: &'a [Vec<f64>], vals: &[f64], half: f64, rank: usize) -
     &pts[basins[rank % basins.len()]]
 }
 
-/// The fitted surrogate, the best successful point and the centre of the local cycles.
-type Fitted = (RbfSurrogate, Vec<f64>, Vec<f64>);
+/// The centre of the second local region
+/// ([`CorsOptions::second_region`](crate::CorsOptions::second_region)): the best of `pts`
+/// (lowest value, ties to the earlier) outside the box of half-width `half` around
+/// `centre`; `centre` itself when every point lies inside.
+fn second_centre<'a>(pts: &'a [Vec<f64>], vals: &[f64], centre: &'a [f64], half: f64) -> &'a [f64] {
+    let outside = |p: &[f64]| p.iter().zip(centre).any(|(a, b)| (a - b).abs() > half);
+    let mut best: Option<usize> = None;
+    for (k, p) in pts.iter().enumerate() {
+        if outside(p) && best.is_none_or(|b| vals[k] < vals[b]) {
+            best = Some(k);
+        }
+    }
+    best.map_or(centre, |k| &pts[k])
+}
+
+/// The fitted surrogate, the best successful point, the centre of the local cycles and the
+/// centre of the second region ([`second_centre`]).
+type Fitted = (RbfSurrogate, Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// The surrogate fitted to `earlier` (the earlier runs' successes it keeps,
 /// [`kept_from_earlier`]) and the successes of the current run (near-duplicates merged,
 /// lower value kept, values transformed), the best successful point in the unit
-/// box and the centre of the local cycles (the best point, or with `escape_rank > 0` the
-/// first point of another basin, [`basin_centre`]); or why none can be fitted.
+/// box, the centre of the local cycles (the best point, or with `escape_rank > 0` the
+/// first point of another basin, [`basin_centre`]) and that of the second region
+/// ([`second_centre`]); or why none can be fitted.
 ///
 /// # Errors
 /// Mapping errors of the parameter space (not expected).
@@ -409,13 +433,19 @@ fn fit_surrogate(
         }
         _ => best_x.clone(),
     };
+    let second = match state.options.second_region {
+        Some(half) if state.options.local_region.is_some() => {
+            second_centre(&pts[kept..], &vals[kept..], &centre, half).to_vec()
+        }
+        _ => centre.clone(),
+    };
     state.options.transform.apply(&mut vals);
     if vals.iter().any(|v| !v.is_finite()) {
         return Ok(Err(FillReason::TransformNotFinite));
     }
     Ok(
         match state.fit_cache.fit(&pts, &vals, state.options.kernel) {
-            Ok(s) => Ok((s, best_x, centre)),
+            Ok(s) => Ok((s, best_x, centre, second)),
             Err(e) => Err(FillReason::SurrogateFailed {
                 message: e.to_string(),
             }),
@@ -454,6 +484,25 @@ fn blockers(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The second region's centre is the best point outside the box around the first
+    /// centre, whatever the order of the points; the first centre when there is none.
+    #[test]
+    fn second_centre_is_the_best_point_outside_the_box() {
+        let pts = vec![
+            vec![0.10, 0.10],
+            vec![0.50, 0.45], // inside the box of half-width 0.5 around the centre
+            vec![0.90, 0.20], // outside (first coordinate), value 4
+            vec![0.20, 0.95], // outside (second coordinate), value 3
+        ];
+        let vals = [1.0, 0.5, 4.0, 3.0];
+        let centre = [0.3, 0.3];
+        assert_eq!(second_centre(&pts, &vals, &centre, 0.5), &pts[3][..]);
+        assert_eq!(second_centre(&pts, &vals, &centre, 0.7), &centre[..]);
+        // Ties go to the earlier point.
+        let tied = [1.0, 0.5, 3.0, 3.0];
+        assert_eq!(second_centre(&pts, &tied, &centre, 0.5), &pts[2][..]);
+    }
 
     /// Basins: sorted by value, a point opens a basin when it lies outside the box of
     /// half-width `half` around every earlier basin's best point.

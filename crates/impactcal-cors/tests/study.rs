@@ -128,15 +128,20 @@ fn restarts_start_a_new_design_and_keep_the_history() {
         }),
         ..CorsOptions::with_seed(4)
     };
+    // Long enough for steps of the new run after its design.
+    let n = 90;
     let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
-    whole.minimize(|x| f.eval(x), 70).unwrap();
-    assert_eq!(whole.evaluations().len(), 70);
+    whole.minimize(|x| f.eval(x), n).unwrap();
+    assert_eq!(whole.evaluations().len(), n);
     assert!(whole.restarts() >= 1);
     let start = whole.run_start();
-    assert!(start >= 16);
+    assert!(
+        start >= 16 && start + 12 < n,
+        "the last run starts at {start}"
+    );
     // The new run opens with its own design of 2 (d + 1) points.
     assert!(
-        whole.evaluations()[start..(start + 10).min(70)]
+        whole.evaluations()[start..(start + 10).min(n)]
             .iter()
             .all(|e| e.origin == Origin::Design)
     );
@@ -154,13 +159,13 @@ fn restarts_start_a_new_design_and_keep_the_history() {
     let mut first = Cors::new(f.space().unwrap(), options.clone()).unwrap();
     first.minimize(|x| f.eval(x), start + 3).unwrap();
     let mut resumed = Cors::from_json(&first.to_json().unwrap(), "state").unwrap();
-    resumed.minimize(|x| f.eval(x), 70 - start - 3).unwrap();
+    resumed.minimize(|x| f.eval(x), n - start - 3).unwrap();
     assert_eq!(resumed.evaluations(), whole.evaluations());
     assert_replays(
         &f,
         &options,
         &whole,
-        &[start - 1, start, start + 4, start + 12, 69],
+        &[start - 1, start, start + 4, start + 12, n - 1],
     );
 }
 
@@ -755,4 +760,36 @@ fn options_are_validated() {
         Cors::from_json(&text, "x.json"),
         Err(CorsError::State { .. })
     ));
+}
+
+/// The second region acts from the second local cycle: with a pattern of two steps per
+/// cycle, local cycle 1 is pattern cycle 3 (steps 6 and 7 after the design), so the first
+/// 6 steps equal those of a single region and later ones differ; a study resumed from JSON
+/// or rebuilt from its rows gives the same points bit for bit.
+#[test]
+fn the_second_region_acts_and_replays_exactly() {
+    let f = test_functions::by_name("hartmann6").unwrap();
+    let with = CorsOptions {
+        pattern: vec![0.5, 0.0],
+        ..CorsOptions::with_seed(12)
+    };
+    let without = CorsOptions {
+        second_region: None,
+        ..with.clone()
+    };
+    let run = |options: &CorsOptions| {
+        let mut s = Cors::new(f.space().unwrap(), options.clone()).unwrap();
+        s.minimize(|x| f.eval(x), 40).unwrap();
+        s
+    };
+    let (a, b) = (run(&with), run(&without));
+    let design = 14;
+    assert_eq!(a.evaluations()[..design + 6], b.evaluations()[..design + 6]);
+    assert_ne!(a.evaluations()[design + 6..], b.evaluations()[design + 6..]);
+    let mut first = Cors::new(f.space().unwrap(), with.clone()).unwrap();
+    first.minimize(|x| f.eval(x), 21).unwrap();
+    let mut resumed = Cors::from_json(&first.to_json().unwrap(), "state").unwrap();
+    resumed.minimize(|x| f.eval(x), 19).unwrap();
+    assert_eq!(resumed.evaluations(), a.evaluations());
+    assert_replays(&f, &with, &a, &[design + 6, design + 7, 39]);
 }
