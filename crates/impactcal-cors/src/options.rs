@@ -338,11 +338,11 @@ pub struct CorsOptions {
     /// from 0 among the local cycles: cycles 3, 7, 11... of the pattern) searches around
     /// the best success lying outside the box of this half-width around the first
     /// region's centre (the best point, or the escape's basin), instead of around that
-    /// centre; the first region's centre when every success lies inside. Two regions in two basins are
-    /// refined side by side, so a run that started in the basin of a local minimum (the
-    /// best design point there) still resolves the best other basin, as the several trust
-    /// regions of TuRBO (Eriksson et al. 2019) do. `None`: every local cycle searches around
-    /// the first centre. Default 0.5. No effect without `local_region`.
+    /// centre; the first region's centre when every success lies inside. Two regions in
+    /// two basins are refined side by side, so a run that started in the basin of a local
+    /// minimum (the best design point there) still resolves the best other basin, as the
+    /// several trust regions of TuRBO (Eriksson et al. 2019) do. `None`: every local cycle
+    /// searches around the first centre. Default 0.5. No effect without `local_region`.
     pub second_region: Option<f64>,
     /// DYCORS-style perturbation of the candidates around the best point in the local
     /// cycles (`None`: every coordinate of every such candidate moves). Default: a horizon

@@ -129,11 +129,7 @@ fn kept_from_earlier(state: &CorsState, plan: &Plan) -> Result<Vec<(Vec<f64>, f6
     for e in &state.evaluations[..start] {
         let Some(v) = e.value else { continue };
         let u = state.space.to_unit(&e.x)?;
-        if plan
-            .excluded
-            .iter()
-            .all(|c| c.iter().zip(&u).any(|(a, b)| (a - b).abs() > half))
-        {
+        if plan.excluded.iter().all(|c| outside_box(&u, c, half)) {
             kept.push((u, v));
         }
     }
@@ -229,7 +225,12 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
         };
         let n_cand = per_dim * d;
         let s = match &fitted {
-            Ok((surrogate, best, centre, second)) => {
+            Ok(Fitted {
+                surrogate,
+                best,
+                centre,
+                second,
+            }) => {
                 let k = state.options.pattern.len();
                 let beta = state.options.pattern[m % k];
                 let cycle = m / k;
@@ -352,13 +353,7 @@ fn basin_centre<'a>(pts: &'a [Vec<f64>], vals: &[f64], half: f64, rank: usize) -
     order.sort_by(|&a, &b| vals[a].total_cmp(&vals[b]).then(a.cmp(&b)));
     let mut basins: Vec<usize> = Vec::new();
     for k in order {
-        let apart = |j: &usize| {
-            pts[k]
-                .iter()
-                .zip(&pts[*j])
-                .any(|(a, b)| (a - b).abs() > half)
-        };
-        if basins.iter().all(apart) {
+        if basins.iter().all(|&j| outside_box(&pts[k], &pts[j], half)) {
             basins.push(k);
         }
     }
@@ -370,19 +365,31 @@ fn basin_centre<'a>(pts: &'a [Vec<f64>], vals: &[f64], half: f64, rank: usize) -
 /// (lowest value, ties to the earlier) outside the box of half-width `half` around
 /// `centre`; `centre` itself when every point lies inside.
 fn second_centre<'a>(pts: &'a [Vec<f64>], vals: &[f64], centre: &'a [f64], half: f64) -> &'a [f64] {
-    let outside = |p: &[f64]| p.iter().zip(centre).any(|(a, b)| (a - b).abs() > half);
     let mut best: Option<usize> = None;
     for (k, p) in pts.iter().enumerate() {
-        if outside(p) && best.is_none_or(|b| vals[k] < vals[b]) {
+        if outside_box(p, centre, half) && best.is_none_or(|b| vals[k] < vals[b]) {
             best = Some(k);
         }
     }
     best.map_or(centre, |k| &pts[k])
 }
 
-/// The fitted surrogate, the best successful point, the centre of the local cycles and the
-/// centre of the second region ([`second_centre`]).
-type Fitted = (RbfSurrogate, Vec<f64>, Vec<f64>, Vec<f64>);
+/// Whether `p` lies outside the box of half-width `half` around `centre` (farther than
+/// `half` in some coordinate).
+fn outside_box(p: &[f64], centre: &[f64], half: f64) -> bool {
+    p.iter().zip(centre).any(|(a, b)| (a - b).abs() > half)
+}
+
+/// The surrogate of a step and the points it searches around (unit box).
+struct Fitted {
+    surrogate: RbfSurrogate,
+    /// The best successful point of the run.
+    best: Vec<f64>,
+    /// The centre of the local cycles (the best point, or the escape's basin).
+    centre: Vec<f64>,
+    /// The centre of the second region ([`second_centre`]; `centre` without one).
+    second: Vec<f64>,
+}
 
 /// The surrogate fitted to `earlier` (the earlier runs' successes it keeps,
 /// [`kept_from_earlier`]) and the successes of the current run (near-duplicates merged,
@@ -445,7 +452,12 @@ fn fit_surrogate(
     }
     Ok(
         match state.fit_cache.fit(&pts, &vals, state.options.kernel) {
-            Ok(s) => Ok((s, best_x, centre, second)),
+            Ok(surrogate) => Ok(Fitted {
+                surrogate,
+                best: best_x,
+                centre,
+                second,
+            }),
             Err(e) => Err(FillReason::SurrogateFailed {
                 message: e.to_string(),
             }),
