@@ -142,7 +142,7 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
     let model = ResponseSurrogate::fit_with(
         &space,
         params.points.as_ref(),
-        outputs.to_matrix().as_ref(),
+        outputs.to_matrix(),
         outputs.header().to_vec(),
         &options,
     )

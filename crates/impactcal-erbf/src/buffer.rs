@@ -39,6 +39,55 @@ pub fn zeros(nrows: usize, ncols: usize) -> Mat<f64> {
     m
 }
 
+/// Training outputs handed to a fit that keeps them: borrowed, and copied by the fit, or
+/// owned, and moved into the model without a copy (an `N x T` ensemble of long histories
+/// is megabytes, whose fresh pages cost more than the arithmetic of a shape-basis fit).
+///
+/// Built by `From` from a [`MatRef`], a `&Mat` or a [`Mat`].
+#[derive(Debug)]
+pub enum TrainingValues<'a> {
+    /// Outputs the caller keeps; the fit stores a [`copy`].
+    Borrowed(MatRef<'a, f64>),
+    /// Outputs the caller gives away; the fit stores them as they are.
+    Owned(Mat<f64>),
+}
+
+impl TrainingValues<'_> {
+    /// A view of the outputs.
+    pub fn view(&self) -> MatRef<'_, f64> {
+        match self {
+            TrainingValues::Borrowed(m) => *m,
+            TrainingValues::Owned(m) => m.as_ref(),
+        }
+    }
+
+    /// The outputs as an owned matrix: moved when owned, a [`copy`] when borrowed.
+    pub fn into_owned(self) -> Mat<f64> {
+        match self {
+            TrainingValues::Borrowed(m) => copy(m),
+            TrainingValues::Owned(m) => m,
+        }
+    }
+}
+
+impl<'a> From<MatRef<'a, f64>> for TrainingValues<'a> {
+    fn from(m: MatRef<'a, f64>) -> Self {
+        TrainingValues::Borrowed(m)
+    }
+}
+
+impl<'a> From<&'a Mat<f64>> for TrainingValues<'a> {
+    fn from(m: &'a Mat<f64>) -> Self {
+        TrainingValues::Borrowed(m.as_ref())
+    }
+}
+
+impl From<Mat<f64>> for TrainingValues<'_> {
+    fn from(m: Mat<f64>) -> Self {
+        TrainingValues::Owned(m)
+    }
+}
+
 /// A copy of `a`: in a buffer allocated as by [`zeros`] from the threshold above, written
 /// once by [`MatRef::to_owned`] below it.
 pub fn copy(a: MatRef<'_, f64>) -> Mat<f64> {

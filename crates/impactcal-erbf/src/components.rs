@@ -13,6 +13,7 @@ use impactcal_core::error::invalid_option;
 use impactcal_core::{ParameterSpace, error::dimension_mismatch};
 use serde::{Deserialize, Serialize};
 
+use crate::buffer::TrainingValues;
 use crate::data::StoredMat;
 use crate::erbf::Erbf;
 use crate::error::{ErbfError, Result};
@@ -149,19 +150,24 @@ impl Components {
     /// [`choose_count`] from the leave-one-out errors of the coordinates; then one
     /// surrogate per group of columns that share their options.
     ///
+    /// The model keeps the training outputs `values` (`N x T`): moved in when owned
+    /// ([`TrainingValues`]), copied when borrowed.
+    ///
     /// # Errors
     /// As [`Erbf::fit`] and [`RbfInterpolant::fit`];
     /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a shape
     /// count of 0 or above the numerical rank of the deviations from the mean history;
     /// [`ErbfError::Shapes`] when the decomposition fails.
-    pub fn fit(
+    pub fn fit<'a>(
         space: &ParameterSpace,
         points: MatRef<'_, f64>,
-        values: MatRef<'_, f64>,
+        values: impl Into<TrainingValues<'a>>,
         base: ComponentOptions,
         basis: OutputBasis,
         tuning: Tuning,
     ) -> Result<Self> {
+        let training = values.into();
+        let values = training.view();
         // In the shape basis the spectrum checks the values in its first pass.
         match basis {
             OutputBasis::Full => crate::data::check_training(points, values, Some(space.dim()))?,
@@ -242,7 +248,7 @@ impl Components {
             space: space.clone(),
             points: points.to_owned(),
             unit,
-            values: crate::buffer::copy(values),
+            values: training.into_owned(),
             basis: shape_basis,
             coords,
             groups: Vec::new(),

@@ -85,6 +85,7 @@ pub mod trend;
 pub mod tuning;
 
 pub use bordered::{BorderedRbf, RbfCoefficients};
+pub use buffer::TrainingValues;
 pub use components::{Components, OutputBasis, Tuning};
 pub use erbf::Erbf;
 pub use error::{ErbfError, Result};

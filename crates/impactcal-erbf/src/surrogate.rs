@@ -10,6 +10,7 @@ use faer::{Mat, MatRef};
 use impactcal_core::ParameterSpace;
 use serde::{Deserialize, Serialize};
 
+use crate::buffer::TrainingValues;
 use crate::components::{Components, OutputBasis, Tuning};
 use crate::erbf::Erbf;
 use crate::error::Result;
@@ -201,19 +202,24 @@ impl ResponseSurrogate {
     /// tuning, else a [`Components`] model (impact-shape coordinates and/or options chosen
     /// by leave-one-out).
     ///
+    /// `values` (`N x T`) may be borrowed (a `MatRef` or `&Mat`) or given away (a `Mat`,
+    /// see [`TrainingValues`]): a component model moves owned outputs in rather than
+    /// copying them; [`fit`](Self::fit)'s kernels copy them either way.
+    ///
     /// # Errors
     /// As [`fit`](Self::fit) and [`Components::fit`].
-    pub fn fit_with(
+    pub fn fit_with<'a>(
         space: &ParameterSpace,
         points: MatRef<'_, f64>,
-        values: MatRef<'_, f64>,
+        values: impl Into<TrainingValues<'a>>,
         output_names: Vec<String>,
         options: &FitOptions,
     ) -> Result<Self> {
+        let values = values.into();
         if options.basis == OutputBasis::Full && options.tuning == Tuning::Off {
-            return Self::fit(space, options.kind, points, values, output_names);
+            return Self::fit(space, options.kind, points, values.view(), output_names);
         }
-        crate::components::check_names(&output_names, values.ncols())?;
+        crate::components::check_names(&output_names, values.view().ncols())?;
         let model = Components::fit(
             space,
             points,

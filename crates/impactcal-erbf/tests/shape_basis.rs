@@ -226,3 +226,40 @@ fn shape_counts_out_of_range_are_invalid_options() {
         );
     }
 }
+
+/// Outputs given to the fit (moved in) and outputs lent to it (copied) make the same model,
+/// bit for bit, with and without tuning; an owned matrix's storage becomes the model's.
+#[test]
+fn owned_and_borrowed_outputs_fit_the_same_model() {
+    let space = space();
+    let x = design(20, 11, &space);
+    let f = histories(&x, &space);
+    let q = design(9, 12, &space);
+    for tuning in [Tuning::Off, Tuning::Parameters] {
+        let options = FitOptions {
+            kind: SurrogateKind::Cubic,
+            basis: OutputBasis::Shapes { count: None },
+            tuning,
+        };
+        let borrowed =
+            ResponseSurrogate::fit_with(&space, x.as_ref(), f.as_ref(), names(), &options).unwrap();
+        let by_ref =
+            ResponseSurrogate::fit_with(&space, x.as_ref(), &f, names(), &options).unwrap();
+        let given = f.clone();
+        let storage = given.as_ptr();
+        let owned =
+            ResponseSurrogate::fit_with(&space, x.as_ref(), given, names(), &options).unwrap();
+        assert_eq!(owned.values().as_ptr(), storage, "moved, not copied");
+        assert_ne!(borrowed.values().as_ptr(), f.as_ptr(), "copied");
+        let p = borrowed.predict_batch(q.as_ref()).unwrap();
+        for other in [&by_ref, &owned] {
+            assert_eq!(other.values(), f.as_ref());
+            let o = other.predict_batch(q.as_ref()).unwrap();
+            assert!(
+                (0..p.nrows())
+                    .all(|i| (0..p.ncols()).all(|j| p[(i, j)].to_bits() == o[(i, j)].to_bits())),
+                "{tuning:?}: the predictions differ"
+            );
+        }
+    }
+}
