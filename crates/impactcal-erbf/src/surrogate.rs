@@ -204,7 +204,8 @@ impl ResponseSurrogate {
     ///
     /// `values` (`N x T`) may be borrowed (a `MatRef` or `&Mat`) or given away (a `Mat`,
     /// see [`TrainingValues`]): a component model moves owned outputs in rather than
-    /// copying them; [`fit`](Self::fit)'s kernels copy them either way.
+    /// copying them; [`fit`](Self::fit)'s kernels copy them either way. Outputs given away
+    /// are dropped with the error when the fit fails: lend them to keep them.
     ///
     /// # Errors
     /// As [`fit`](Self::fit) and [`Components::fit`].
