@@ -317,13 +317,15 @@ pub struct CorsOptions {
     /// The restart rule (`None`, the default: a single run, as in the 2005 method).
     pub restart: Option<Restart>,
     /// Half-width (in the unit box) of the box around the run's best point that every
-    /// second cycle of the pattern searches: cycles 0, 2, 4... search the whole box,
-    /// cycles 1, 3, 5... the box `[x_best - h, x_best + h]` cut to the unit box, with
-    /// `Delta` the maximin distance within it. `None`: every cycle searches the whole box
+    /// second cycle of the pattern searches: cycles 1, 3, 5... search the box
+    /// `[x_best - h, x_best + h]` cut to the unit box, with `Delta` the maximin distance
+    /// within it, cycles 0, 2, 4... the whole box (cycles 2, 6, 10... the second region's
+    /// box instead, with [`second_region`](Self::second_region)). `None`: every cycle searches the whole box
     /// (the 2005 method). Default 0.3.
     pub local_region: Option<f64>,
-    /// Whether the first cycle after a run's initial set is a local one (then cycles 0, 2,
-    /// 4... search the box around the best point and 1, 3, 5... the whole box). Default
+    /// Whether the first cycle after a run's initial set is a local one: the pattern of
+    /// regions is shifted by one cycle (cycles 0, 2, 4... search the box around the best
+    /// point; 1, 3, 5... the whole box, or 1, 5, 9... the second region's box). Default
     /// `false`. No effect without `local_region`.
     pub local_first: bool,
     /// Local-basin escape: once the run has gone this many evaluations after its initial
@@ -334,11 +336,11 @@ pub struct CorsOptions {
     /// the best point. Unlike a restart, the surrogate keeps every point of the run.
     /// `None`: always around the best point. Default 60.
     pub local_escape: Option<usize>,
-    /// A second local region: every second local cycle (local cycles 1, 3, 5..., counted
-    /// from 0 among the local cycles: cycles 3, 7, 11... of the pattern) searches around
-    /// the best success lying outside the box of this half-width around the first
-    /// region's centre (the best point, or the escape's basin), instead of around that
-    /// centre; the first region's centre when every success lies inside. Two regions in
+    /// A second local region: every second whole-box cycle (cycles 2, 6, 10... of the
+    /// pattern, so that cycles run whole, first, second, first) searches instead the box of
+    /// half-width `local_region` around the best success lying outside the box of this
+    /// half-width around the first region's centre (the best point, or the escape's
+    /// basin); around the first region's centre when every success lies inside. Two regions in
     /// two basins are refined side by side, so a run that started in the basin of a local
     /// minimum (the best design point there) still resolves the best other basin, as the
     /// several trust regions of TuRBO (Eriksson et al. 2019) do. `None`: every local cycle

@@ -9,7 +9,7 @@
 use crate::design::affine_rank_of_rows;
 use crate::error::Result;
 use crate::geometry::{distance, stream};
-use crate::options::{AdaptiveRegion, Converged, InitialDesign};
+use crate::options::{AdaptiveRegion, Converged, CorsOptions, InitialDesign};
 use crate::region::{LocalWidth, SUCCESS_IMPROVEMENT, adaptive_width};
 use crate::stall::StallRule;
 use crate::state::{
@@ -233,12 +233,9 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
             }) => {
                 let k = state.options.pattern.len();
                 let beta = state.options.pattern[m % k];
-                let cycle = m / k;
-                let phase = usize::from(state.options.local_first);
-                let local = state.options.local_region.is_some() && (cycle + phase) % 2 == 1;
-                // Local cycles 1, 3, 5... (counted from 0 among the local ones) in the
-                // second region.
-                let centre = if (cycle + phase) / 2 % 2 == 1 {
+                let searched = cycle_search(m / k, &state.options);
+                let local = searched != CycleSearch::Whole;
+                let centre = if searched == CycleSearch::Second {
                     second
                 } else {
                     centre
@@ -300,6 +297,34 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
         plan,
         suggestions: out,
     })
+}
+
+/// Where a cycle of the `beta` pattern searches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum CycleSearch {
+    /// The whole unit box, with `Delta` the maximin distance in it.
+    Whole,
+    /// The local box around the first centre (the best point, or the escape's basin).
+    First,
+    /// The local box around the second region's centre.
+    Second,
+}
+
+/// Where cycle `cycle` (counted from the run's initial set) searches. Without
+/// `local_region`, always the whole box. With it, cycles alternate between the whole box
+/// (even) and the first local region (odd); with `second_region` as well, every second
+/// whole-box cycle gives way to the second region, so that the pattern of four is whole,
+/// first, second, first. `local_first` shifts the pattern by one cycle.
+fn cycle_search(cycle: usize, options: &CorsOptions) -> CycleSearch {
+    if options.local_region.is_none() {
+        return CycleSearch::Whole;
+    }
+    let c = cycle + usize::from(options.local_first);
+    match (c % 4, options.second_region.is_some()) {
+        (1 | 3, _) => CycleSearch::First,
+        (2, true) => CycleSearch::Second,
+        _ => CycleSearch::Whole,
+    }
 }
 
 /// The local region of the next step: its half-width (`local_region`, or under
@@ -496,6 +521,43 @@ fn blockers(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The cycles search whole, first, second, first with both regions; whole and first
+    /// alternate without the second; the whole box only without local cycles; and the
+    /// local-first option shifts the pattern by one.
+    #[test]
+    fn the_cycles_follow_the_pattern_of_the_regions() {
+        use CycleSearch::{First, Second, Whole};
+        let pattern = |options: &CorsOptions| -> Vec<CycleSearch> {
+            (0..8).map(|c| cycle_search(c, options)).collect()
+        };
+        let both = CorsOptions::default();
+        assert_eq!(
+            pattern(&both),
+            [Whole, First, Second, First, Whole, First, Second, First]
+        );
+        let one = CorsOptions {
+            second_region: None,
+            ..CorsOptions::default()
+        };
+        assert_eq!(
+            pattern(&one),
+            [Whole, First, Whole, First, Whole, First, Whole, First]
+        );
+        let shifted = CorsOptions {
+            local_first: true,
+            ..CorsOptions::default()
+        };
+        assert_eq!(
+            pattern(&shifted),
+            [First, Second, First, Whole, First, Second, First, Whole]
+        );
+        let global = CorsOptions {
+            local_region: None,
+            ..CorsOptions::default()
+        };
+        assert!(pattern(&global).iter().all(|&c| c == Whole));
+    }
 
     /// The second region's centre is the best point outside the box around the first
     /// centre, whatever the order of the points; the first centre when there is none.
