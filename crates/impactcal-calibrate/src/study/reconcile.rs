@@ -65,7 +65,7 @@ pub fn reconcile(
         transform: Transform::Log,
         // A reconciliation's short budget refines the one basin near the test: with the
         // second region, 40 runs of the study test's model had a higher prediction error
-        // in 46 of 64 seeds (lower in 17; docs/cors.md).
+        // in 40 of 64 seeds (lower in 24; docs/cors.md).
         second_region: None,
         ..CorsOptions::with_seed(seed)
     };
