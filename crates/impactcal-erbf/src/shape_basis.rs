@@ -219,7 +219,8 @@ impl ShapeSpectrum {
             None => {
                 // G_k^T = diag(sigma_k)^{-1} U_k^T C, one block of samples per task, each
                 // its own columns: the result does not depend on the number of threads.
-                let scaled = Mat::from_fn(k, n, |j, i| self.left[(i, j)] / self.sigma[j]);
+                let mut scaled = Mat::from_fn(k, n, |j, i| self.left[(i, j)] / self.sigma[j]);
+                buffer::zero_padding(&mut scaled);
                 buffer::by_column_blocks_with(
                     k + 1,
                     t,
@@ -318,6 +319,8 @@ fn deviation_gram(values: MatRef<'_, f64>, reference: &[f64]) -> (Mat<f64>, Vec<
             let mut gram = Mat::<f64>::zeros(n, n);
             let mut sums = Vec::new();
             let mut buffer = Mat::<f64>::zeros(n, BLOCK.min(t));
+            // The deviations are the left operand of the product below.
+            buffer::zero_padding(&mut buffer);
             for b in g * per_group..((g + 1) * per_group).min(blocks) {
                 let start = b * BLOCK;
                 let len = BLOCK.min(t - start);
@@ -494,6 +497,7 @@ impl ShapeBasis {
             .subcols_mut(0, k)
             .copy_from(coords.subcols(0, k));
         ext.col_mut(k).iter_mut().for_each(|v| *v = 1.0);
+        buffer::zero_padding(&mut ext);
         let len = self.len();
         let fewer = (k < len).then(|| {
             Mat::from_fn(k + 1, self.samples(), |i, j| {
