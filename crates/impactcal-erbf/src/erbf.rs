@@ -44,7 +44,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::basis::{basis_gradient, basis_matrix_t, fill_basis, row_major};
-use crate::buffer;
+use crate::buffer::{self, TrainingValues};
 use crate::data::{
     StoredMat, check_queries, check_training, collect_rows, reject_duplicates, without_row,
 };
@@ -85,11 +85,14 @@ pub struct Erbf {
 impl Erbf {
     /// Fits the model to samples `points` (`N x m`, raw parameter values, one sample per
     /// row, columns in the order of `space`) and responses `values` (`N x T`, one row per
-    /// sample). Takes [`ErbfOptions`] (checked here) or [`ValidErbfOptions`].
+    /// sample). Takes [`ErbfOptions`] (checked here) or [`ValidErbfOptions`]. The model
+    /// keeps the responses: lent (`MatRef`, `&Mat`) they are copied, given (`Mat`) they
+    /// are moved in ([`TrainingValues`]; a failed fit drops them with its error).
     ///
     /// Cost: `O(N^2 m)` to build `A`, `O(M N^2)` to factorise, `O(m N^2)` for the
-    /// prediction tables, and a copy of `values`; `O(N^2 T)` more only when `T` is small
-    /// enough that the coefficients `c` are stored.
+    /// prediction tables, a copy of `values` when lent, and a centred copy when outputs
+    /// are centred; `O(N^2 T)` more only when `T` is small enough that the coefficients
+    /// `c` are stored.
     ///
     /// # Errors
     /// Under [`ErbfError::Core`]:
@@ -104,13 +107,15 @@ impl Erbf {
     /// And [`ErbfError::DuplicateSamples`] for two samples closer than the tolerance in
     /// scaled inputs, naming both; [`ErbfError::Singular`] when `min |R_ii| / max |R_ii|`
     /// falls below `N eps` without smoothing (with smoothing the problem stays well posed).
-    pub fn fit(
+    pub fn fit<'a>(
         space: &ParameterSpace,
         points: MatRef<'_, f64>,
-        values: MatRef<'_, f64>,
+        values: impl Into<TrainingValues<'a>>,
         options: impl ParamGuard<Checked = ValidErbfOptions>,
     ) -> Result<Self> {
         let options = options.check()?;
+        let training = values.into();
+        let values = training.view();
         check_training(points, values, Some(space.dim()))?;
         let unit = space.to_unit_matrix(points)?;
         reject_duplicates(unit.as_ref(), options.duplicate_tolerance)?;
@@ -149,7 +154,7 @@ impl Erbf {
             options,
             points: points.to_owned(),
             unit,
-            values: buffer::copy(values),
+            values: training.into_owned(),
             mean,
             projection,
             r: factor.r,

@@ -34,7 +34,7 @@ use impactcal_core::{CoreError, ParamGuard};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::buffer;
+use crate::buffer::{self, TrainingValues};
 use crate::data::{
     StoredMat, check_queries, check_training, collect_rows, find_duplicate, mat_from_rows,
     stack_rows, without_row,
@@ -176,7 +176,9 @@ pub struct RbfInterpolant {
 
 impl RbfInterpolant {
     /// Fits the interpolant to `points` (`N x d`, one sample per row) and `values`
-    /// (`N x T`, one output per column).
+    /// (`N x T`, one output per column). The interpolant keeps the values: lent
+    /// (`MatRef`, `&Mat`) they are copied, given (`Mat`) they are moved in
+    /// ([`TrainingValues`]; a failed fit drops them with its error).
     ///
     /// Cost: `O(N^2 d)` to assemble, `O(n^3)` to factorise (`n = N + ` tail terms), and
     /// `O(n^2 T)` to solve for the coefficients when `T <= n`; for longer outputs the
@@ -199,13 +201,14 @@ impl RbfInterpolant {
     ///   largest (for example points on a hyperplane with a linear tail).
     ///
     /// The [`CoreError`]s come wrapped as [`ErbfError::Core`].
-    pub fn fit(
+    pub fn fit<'a>(
         points: MatRef<'_, f64>,
-        values: MatRef<'_, f64>,
+        values: impl Into<TrainingValues<'a>>,
         options: impl ParamGuard<Checked = ValidRbfOptions>,
     ) -> Result<Self> {
         let options = options.check()?;
-        check_training(points, values, None)?;
+        let values = values.into();
+        check_training(points, values.view(), None)?;
         let d = points.ncols();
         let q = options.degree.terms(d);
         if points.nrows() < q {
@@ -230,7 +233,12 @@ impl RbfInterpolant {
             });
         }
         let kernel_block = radial_matrix(&options, points);
-        Self::assemble(options, points.to_owned(), values.to_owned(), kernel_block)
+        Self::assemble(
+            options,
+            points.to_owned(),
+            values.into_owned(),
+            kernel_block,
+        )
     }
 
     /// Fits one output from rows: `points[k]` is sample `k` (all of length `d`) and

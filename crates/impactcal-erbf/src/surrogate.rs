@@ -156,23 +156,25 @@ pub struct ResponseSurrogate {
 
 impl ResponseSurrogate {
     /// Fits a surrogate of `kind` to raw samples `points` (`N x m`, columns in the order of
-    /// `space`) and responses `values` (`N x T`) with one name per output column.
+    /// `space`) and responses `values` (`N x T`) with one name per output column; lent
+    /// responses are copied into the model, given ones moved in ([`TrainingValues`]).
     ///
     /// # Errors
     /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when
     /// the names do not match the columns; otherwise as [`Erbf::fit`] or
     /// [`RbfInterpolant::fit`].
-    pub fn fit(
+    pub fn fit<'a>(
         space: &ParameterSpace,
         kind: SurrogateKind,
         points: MatRef<'_, f64>,
-        values: MatRef<'_, f64>,
+        values: impl Into<TrainingValues<'a>>,
         output_names: Vec<String>,
     ) -> Result<Self> {
-        if output_names.len() != values.ncols() {
+        let values = values.into();
+        if output_names.len() != values.view().ncols() {
             return Err(dimension_mismatch(
                 "output names (one per output column)",
-                values.ncols(),
+                values.view().ncols(),
                 output_names.len(),
             ));
         }
@@ -203,8 +205,8 @@ impl ResponseSurrogate {
     /// by leave-one-out).
     ///
     /// `values` (`N x T`) may be borrowed (a `MatRef` or `&Mat`) or given away (a `Mat`,
-    /// see [`TrainingValues`]): a component model moves owned outputs in rather than
-    /// copying them; [`fit`](Self::fit)'s kernels copy them either way. Outputs given away
+    /// see [`TrainingValues`]): the model moves owned outputs in rather than copying them
+    /// (ERBF still keeps a centred copy when it centres the outputs). Outputs given away
     /// are dropped with the error when the fit fails: lend them to keep them.
     ///
     /// # Errors
@@ -218,7 +220,7 @@ impl ResponseSurrogate {
     ) -> Result<Self> {
         let values = values.into();
         if options.basis == OutputBasis::Full && options.tuning == Tuning::Off {
-            return Self::fit(space, options.kind, points, values.view(), output_names);
+            return Self::fit(space, options.kind, points, values, output_names);
         }
         crate::components::check_names(&output_names, values.view().ncols())?;
         let model = Components::fit(

@@ -235,10 +235,25 @@ fn owned_and_borrowed_outputs_fit_the_same_model() {
     let x = design(20, 11, &space);
     let f = histories(&x, &space);
     let q = design(9, 12, &space);
-    for tuning in [Tuning::Off, Tuning::Parameters] {
+    let cases = [
+        (
+            SurrogateKind::Cubic,
+            OutputBasis::Shapes { count: None },
+            Tuning::Off,
+        ),
+        (
+            SurrogateKind::Cubic,
+            OutputBasis::Shapes { count: None },
+            Tuning::Parameters,
+        ),
+        // The full-output kernels keep the outputs too.
+        (SurrogateKind::Cubic, OutputBasis::Full, Tuning::Off),
+        (SurrogateKind::Erbf, OutputBasis::Full, Tuning::Off),
+    ];
+    for (kind, basis, tuning) in cases {
         let options = FitOptions {
-            kind: SurrogateKind::Cubic,
-            basis: OutputBasis::Shapes { count: None },
+            kind,
+            basis,
             tuning,
         };
         let borrowed =
@@ -258,7 +273,7 @@ fn owned_and_borrowed_outputs_fit_the_same_model() {
             assert!(
                 (0..p.nrows())
                     .all(|i| (0..p.ncols()).all(|j| p[(i, j)].to_bits() == o[(i, j)].to_bits())),
-                "{tuning:?}: the predictions differ"
+                "{kind:?} {basis:?} {tuning:?}: the predictions differ"
             );
         }
     }
