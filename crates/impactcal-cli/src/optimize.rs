@@ -144,11 +144,11 @@ struct SuggestArgs {
     /// Keep the local cycles around the best point (no basin escape).
     #[arg(long)]
     no_local_escape: bool,
-    /// Every second local cycle searches around the best point outside the box of this
-    /// half-width around the first local centre (default 0.5).
+    /// Every second whole-box cycle searches instead around the best point outside the box
+    /// of this half-width around the first local centre (default 0.5).
     #[arg(long, conflicts_with_all = ["global_only", "no_second_region"])]
     second_region: Option<f64>,
-    /// Keep every local cycle around the first centre (no second region).
+    /// No second region: the cycles alternate between the whole box and the first centre's.
     #[arg(long)]
     no_second_region: bool,
     /// DYCORS-style coordinate perturbation in the local cycles: each coordinate of a

@@ -138,8 +138,8 @@ fn search_options_reproduce_the_library_loop() {
             },
         ),
         (
-            // With the local cycle first, local cycle 1 is pattern cycle 2 (steps 12..17
-            // after the design of 6 points): the second region's first.
+            // With the local cycle first, pattern cycle 1 (steps 6..11 after the design of
+            // 6 points) is the second region's first.
             &["--second-region", "0.4", "--local-first"],
             CorsOptions {
                 second_region: Some(0.4),

@@ -320,8 +320,8 @@ pub struct CorsOptions {
     /// second cycle of the pattern searches: cycles 1, 3, 5... search the box
     /// `[x_best - h, x_best + h]` cut to the unit box, with `Delta` the maximin distance
     /// within it, cycles 0, 2, 4... the whole box (cycles 2, 6, 10... the second region's
-    /// box instead, with [`second_region`](Self::second_region)). `None`: every cycle searches the whole box
-    /// (the 2005 method). Default 0.3.
+    /// box instead, with [`second_region`](Self::second_region)). `None`: every cycle
+    /// searches the whole box (the 2005 method). Default 0.3.
     pub local_region: Option<f64>,
     /// Whether the first cycle after a run's initial set is a local one: the pattern of
     /// regions is shifted by one cycle (cycles 0, 2, 4... search the box around the best
@@ -340,11 +340,12 @@ pub struct CorsOptions {
     /// pattern, so that cycles run whole, first, second, first) searches instead the box of
     /// half-width `local_region` around the best success lying outside the box of this
     /// half-width around the first region's centre (the best point, or the escape's
-    /// basin); around the first region's centre when every success lies inside. Two regions in
-    /// two basins are refined side by side, so a run that started in the basin of a local
-    /// minimum (the best design point there) still resolves the best other basin, as the
-    /// several trust regions of TuRBO (Eriksson et al. 2019) do. `None`: every local cycle
-    /// searches around the first centre. Default 0.5. No effect without `local_region`.
+    /// basin); around the first region's centre when every success lies inside. Two
+    /// regions in two basins are refined side by side, so a run that started in the basin
+    /// of a local minimum (the best design point there) still resolves the best other
+    /// basin, as the several trust regions of TuRBO (Eriksson et al. 2019) do. `None`: the
+    /// cycles alternate between the whole box and the first region. Default 0.5. No effect
+    /// without `local_region`.
     pub second_region: Option<f64>,
     /// DYCORS-style perturbation of the candidates around the best point in the local
     /// cycles (`None`: every coordinate of every such candidate moves). Default: a horizon

@@ -318,14 +318,14 @@ fn deviation_gram(values: MatRef<'_, f64>, reference: &[f64]) -> (Mat<f64>, Vec<
         .map(|g| {
             let mut gram = Mat::<f64>::zeros(n, n);
             let mut sums = Vec::new();
-            let mut buffer = Mat::<f64>::zeros(n, BLOCK.min(t));
+            let mut deviations = Mat::<f64>::zeros(n, BLOCK.min(t));
             // The deviations are the left operand of the product below.
-            buffer::zero_padding(&mut buffer);
+            buffer::zero_padding(&mut deviations);
             for b in g * per_group..((g + 1) * per_group).min(blocks) {
                 let start = b * BLOCK;
                 let len = BLOCK.min(t - start);
                 sums.extend((start..start + len).map(|c| column_sum(values, c)));
-                let d = centre_block(values, reference, start, &mut buffer);
+                let d = centre_block(values, reference, start, &mut deviations);
                 // Only the lower triangle: the eigensolver reads no more.
                 triangular::matmul(
                     gram.as_mut(),

@@ -19,7 +19,6 @@ use crate::options::ValidErbfOptions;
 use crate::radial::RadialFunction;
 use crate::rbf::{RbfInterpolant, RbfOptions};
 use crate::tuning::ComponentOptions;
-use impactcal_core::error::dimension_mismatch;
 
 /// The kinds of surrogate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -171,13 +170,7 @@ impl ResponseSurrogate {
         output_names: Vec<String>,
     ) -> Result<Self> {
         let values = values.into();
-        if output_names.len() != values.view().ncols() {
-            return Err(dimension_mismatch(
-                "output names (one per output column)",
-                values.view().ncols(),
-                output_names.len(),
-            ));
-        }
+        crate::components::check_names(&output_names, values.view().ncols())?;
         let model = match kind.rbf_options() {
             None => SurrogateModel::Erbf(Erbf::fit(
                 space,
