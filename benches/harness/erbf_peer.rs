@@ -189,8 +189,10 @@ fn shape_cases(
 }
 
 /// The steps of a shape-basis cubic fit, timed one by one (medians): the spectrum of the
-/// deviations (mean, Gram matrix, eigenproblem), the time functions of the kept shapes, the
-/// coordinate surrogate with its leave-one-out errors, and the coordinate prediction.
+/// deviations (mean, Gram matrix and eigenproblem; or, for a large ensemble of low rank,
+/// sketch, projection and time functions of every shape), the time functions of the kept
+/// shapes (a copy when the spectrum made them), the coordinate surrogate with its
+/// leave-one-out errors, and the coordinate prediction.
 fn shape_phases(
     prefix: &str,
     reps: usize,

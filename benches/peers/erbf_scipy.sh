@@ -16,9 +16,10 @@
 # `airframe_ensemble` example into benches/peers/out/airframe (minutes; kept for later runs).
 #
 # Each table ends with floors timed in numpy on the same data: the Gram matrix and the whole
-# method of snapshots (what a shape basis must compute before any surrogate), and the
+# method of snapshots (what a shape basis of full-rank runs computes before any surrogate;
+# a large ensemble of low rank takes a sketch and one projection pass instead), and the
 # 1000 x N x T product every full-history surrogate ends with; their ratios to scipy's times
-# are the best a surrogate as fast as numpy's BLAS could reach.
+# are the best a surrogate as fast as numpy's BLAS could reach that way.
 #
 # Usage: benches/peers/erbf_scipy.sh [reps]   (from the repository root)
 # Our side is benches/harness/erbf_peer.rs, built as the `erbf_peer` example target.
@@ -119,7 +120,7 @@ def floors(prefix, f, fit_c, pred_c, fit_g, pred_g):
     print(f"  floors in numpy, same data: Gram matrix F F^T {gram * 1e3:.2f} ms, method of snapshots "
           f"({k} shapes: mean, centring, Gram, eigh, time functions) {snap * 1e3:.2f} ms, "
           f"{Q} x N x T product {product * 1e3:.2f} ms")
-    print(f"  best ratio a shape basis decomposed at numpy's speed could reach: scipy cubic / "
+    print(f"  best ratio the method of snapshots at numpy's speed could reach: scipy cubic / "
           f"snapshots {(fit_c + pred_c) / snap:.2f} (scipy cubic / Gram alone "
           f"{(fit_c + pred_c) / gram:.2f}); scipy Gaussian / product {(fit_g + pred_g) / product:.2f}")
 

@@ -351,8 +351,8 @@ impl BorderedRbf {
                 a[(q + i, q + k)] = self.radial.value(distance(p, r));
             }
         }
-        let lu = a.partial_piv_lu();
-        let (lower, upper) = (lu.L(), lu.U());
+        let lu = crate::lu::Lu::new(a);
+        let (lower, upper) = (lu.lower(), lu.upper());
         let pivots: Vec<f64> = (0..m).map(|i| upper[(i, i)].abs()).collect();
         let max_pivot = pivots.iter().copied().fold(0.0, f64::max);
         let min_pivot = pivots.iter().copied().fold(f64::INFINITY, f64::min);
@@ -366,7 +366,7 @@ impl BorderedRbf {
             u_cols.extend((0..=i).map(|k| upper[(k, i)]));
         }
         Some(Factors {
-            perm: lu.P().arrays().0.to_vec(),
+            perm: lu.forward().to_vec(),
             l_rows,
             u_cols,
             size: m,

@@ -235,8 +235,8 @@ impl Components {
             }
             _ => targets.ncols(),
         };
-        let shape_basis = match &spectrum {
-            Some(s) => Some(s.basis(values, count)?),
+        let shape_basis = match spectrum {
+            Some(s) => Some(s.into_basis(values, count)?),
             None => None,
         };
         let coords = if shape_basis.is_some() {
@@ -538,8 +538,8 @@ impl<'de> Deserialize<'de> for Components {
                             "{k} shapes kept, but the data have {r}"
                         )));
                     }
-                    let b = s.basis(values.as_ref(), k)?;
-                    (Some(b), s.coordinates().subcols(0, k).to_owned())
+                    let coords = s.coordinates().subcols(0, k).to_owned();
+                    (Some(s.into_basis(values.as_ref(), k)?), coords)
                 }
             };
             let mut out = Components {

@@ -71,6 +71,7 @@ mod data;
 pub mod erbf;
 pub mod error;
 pub mod loo;
+mod lu;
 pub mod metrics;
 pub mod nrbf;
 pub mod options;

@@ -22,7 +22,6 @@
 //! interpolant, and keeps the pivots balanced.
 
 use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::{DenseSolveCore, PartialPivLu};
 use std::sync::OnceLock;
 
 use faer::linalg::triangular_solve::{
@@ -41,6 +40,7 @@ use crate::data::{
 };
 use crate::error::{ErbfError, Result};
 use crate::loo::LooMethod;
+use crate::lu::Lu;
 use crate::radial::{PolyDegree, RadialFunction};
 use impactcal_core::error::dimension_mismatch;
 
@@ -167,7 +167,7 @@ pub struct RbfInterpolant {
     scale: f64,
     tail_weight: f64,
     system: Mat<f64>,
-    lu: PartialPivLu<f64>,
+    lu: Lu,
     /// The coefficients `[c; a]` (`n x T`): solved at fit time when `T <= n`, on first
     /// use otherwise (see [`predict_batch`](Self::predict_batch)).
     coef: OnceLock<Mat<f64>>,
@@ -301,8 +301,8 @@ impl RbfInterpolant {
                 system[(n_pts + l, k)] = p;
             }
         }
-        let lu = system.partial_piv_lu();
-        let pivot_ratio = pivot_ratio(lu.U());
+        let lu = Lu::new(system.clone());
+        let pivot_ratio = pivot_ratio(lu.upper());
         let threshold = n as f64 * f64::EPSILON;
         if pivot_ratio.is_nan() || pivot_ratio <= threshold {
             return Err(ErbfError::Singular {
@@ -596,9 +596,9 @@ impl RbfInterpolant {
         let n_pts = self.n_samples();
         let mut z = basis_t;
         // S = P^T L U, so S^T v = b is U^T L^T P v = b.
-        solve_lower_triangular_in_place(self.lu.U().transpose(), z.as_mut(), Par::Seq);
-        solve_unit_upper_triangular_in_place(self.lu.L().transpose(), z.as_mut(), Par::Seq);
-        let (forward, _) = self.lu.P().arrays();
+        solve_lower_triangular_in_place(self.lu.upper().transpose(), z.as_mut(), Par::Seq);
+        solve_unit_upper_triangular_in_place(self.lu.lower().transpose(), z.as_mut(), Par::Seq);
+        let forward = self.lu.forward();
         let mut v = Mat::<f64>::zeros(n_pts, z.ncols());
         for (i, &p) in forward.iter().enumerate() {
             if p < n_pts {
@@ -769,8 +769,8 @@ fn coefficients_first(t: usize, n: usize) -> bool {
 /// while gathering `F` (in parallel over columns), then the two triangular solves run on
 /// all columns at once. Equal, bit for bit, to faer's `solve_in_place`, whose
 /// row permutation of a wide right-hand side is several times slower.
-fn lu_solve(lu: &PartialPivLu<f64>, f: MatRef<'_, f64>, n: usize) -> Mat<f64> {
-    let (forward, _) = lu.P().arrays();
+fn lu_solve(lu: &Lu, f: MatRef<'_, f64>, n: usize) -> Mat<f64> {
+    let forward = lu.forward();
     let n_pts = f.nrows();
     let mut x = Mat::<f64>::zeros(n, f.ncols());
     x.par_col_chunks_mut(64)
@@ -785,9 +785,9 @@ fn lu_solve(lu: &PartialPivLu<f64>, f: MatRef<'_, f64>, n: usize) -> Mat<f64> {
                 }
             }
         });
-    let par = faer::get_global_parallelism();
-    solve_unit_lower_triangular_in_place(lu.L(), x.as_mut(), par);
-    solve_upper_triangular_in_place(lu.U(), x.as_mut(), par);
+    let par = crate::lu::parallelism(n);
+    solve_unit_lower_triangular_in_place(lu.lower(), x.as_mut(), par);
+    solve_upper_triangular_in_place(lu.upper(), x.as_mut(), par);
     x
 }
 
