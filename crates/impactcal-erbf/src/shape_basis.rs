@@ -992,32 +992,42 @@ mod tests {
         );
     }
 
-    /// An `N x T` ensemble around a mean history whose deviations have the singular values
-    /// `10^(-i/2)`, `i = 0..N` (so the weaker half is below what the Gram route resolves).
-    fn graded_ensemble(n: usize, t: usize) -> Mat<f64> {
+    /// `F = 1 m^T + P diag(s) Q^T` (`N x T`): the mean history `m_j = 5 + sin(0.01 j)` and
+    /// deviations of rank `r` with singular values `s_i = 10^(-decay i)` (`P` orthonormal
+    /// and orthogonal to `1`, so that the mean of the runs is exactly `m`; `Q`
+    /// orthonormal; both random from `seed`).
+    fn ensemble(n: usize, t: usize, r: usize, decay: f64, seed: u64) -> Mat<f64> {
         use rand::{Rng, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let mut random = |r: usize, c: usize| Mat::from_fn(r, c, |_, _| rng.random::<f64>() - 0.5);
-        // Orthonormal columns, each orthogonal to the constant vector so that the mean of
-        // the runs is exactly the mean history added below.
-        let mut p = random(n, n - 1);
-        for j in 0..n - 1 {
+        let mut p = random(n, r);
+        for j in 0..r {
             let m = p.col(j).iter().sum::<f64>() / n as f64;
             p.col_mut(j).iter_mut().for_each(|v| *v -= m);
         }
-        let p = p.qr().compute_thin_Q();
-        let q = random(t, n - 1).qr().compute_thin_Q();
-        let mut ps = p.clone();
-        for (j, col) in ps.col_iter_mut().enumerate() {
-            let s = 10f64.powf(-(j as f64) / 2.0);
+        let mut p = p.qr().compute_thin_Q();
+        let q = random(t, r).qr().compute_thin_Q();
+        for (j, col) in p.col_iter_mut().enumerate() {
+            let s = 10f64.powf(-decay * j as f64);
             col.iter_mut().for_each(|v| *v *= s);
         }
-        let mut f = &ps * q.transpose();
+        let mut f = &p * q.transpose();
         for (j, col) in f.col_iter_mut().enumerate() {
             let m = 5.0 + (j as f64 * 0.01).sin();
             col.iter_mut().for_each(|v| *v += m);
         }
         f
+    }
+
+    /// An `N x T` ensemble whose deviations have the singular values `10^(-i/2)`,
+    /// `i = 0..N-1` (so the weaker half is below what the Gram route resolves).
+    fn graded_ensemble(n: usize, t: usize) -> Mat<f64> {
+        ensemble(n, t, n - 1, 0.5, 11)
+    }
+
+    /// An ensemble of exact rank `r` (singular values `10^(-i/4)`).
+    fn low_rank_ensemble(n: usize, t: usize, r: usize, seed: u64) -> Mat<f64> {
+        ensemble(n, t, r, 0.25, seed)
     }
 
     /// The Gram route (method of snapshots) and the full thin SVD agree: singular values to
@@ -1062,30 +1072,33 @@ mod tests {
     #[test]
     fn spectrum_does_not_depend_on_the_thread_count() {
         let f = graded_ensemble(12, 9 * BLOCK + 37);
+        same_on_one_two_and_three_threads(|| {
+            let s = ShapeSpectrum::new(f.as_ref()).unwrap();
+            let b = s.basis(f.as_ref(), 5).unwrap();
+            let rebuilt = b.rebuild(s.coordinates().as_ref());
+            (
+                s.singular_values().to_vec(),
+                s.left.clone(),
+                b.rows,
+                rebuilt,
+            )
+        });
+    }
+
+    /// Runs `work` in pools of 1, 2 and 3 threads and checks that it returns the same.
+    fn same_on_one_two_and_three_threads<R: PartialEq + std::fmt::Debug + Send>(
+        work: impl Fn() -> R + Sync,
+    ) {
         let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
+            rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
-                .unwrap();
-            pool.install(|| {
-                let s = ShapeSpectrum::new(f.as_ref()).unwrap();
-                let b = s.basis(f.as_ref(), 5).unwrap();
-                let rebuilt = b.rebuild(s.coordinates().as_ref());
-                (
-                    s.singular_values().to_vec(),
-                    s.left.clone(),
-                    b.rows,
-                    rebuilt,
-                )
-            })
+                .unwrap()
+                .install(&work)
         };
         let one = run(1);
         for threads in [2, 3] {
-            let other = run(threads);
-            assert_eq!(one.0, other.0);
-            assert_eq!(one.1, other.1);
-            assert_eq!(one.2, other.2);
-            assert_eq!(one.3, other.3);
+            assert_eq!(one, run(threads), "{threads} threads");
         }
     }
 
@@ -1161,32 +1174,6 @@ mod tests {
         assert!(ShapeSpectrum::new(empty.as_ref()).is_err());
     }
 
-    /// `F = 1 m^T + P diag(s) Q^T` (`N x T`): a mean history `m` and deviations of exact
-    /// rank `r` (`P` orthonormal and orthogonal to `1`, `Q` orthonormal,
-    /// `s_i = 10^(-i/4)`).
-    fn low_rank_ensemble(n: usize, t: usize, r: usize, seed: u64) -> Mat<f64> {
-        use rand::{Rng, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let mut random = |r: usize, c: usize| Mat::from_fn(r, c, |_, _| rng.random::<f64>() - 0.5);
-        let mut p = random(n, r);
-        for j in 0..r {
-            let m = p.col(j).iter().sum::<f64>() / n as f64;
-            p.col_mut(j).iter_mut().for_each(|v| *v -= m);
-        }
-        let mut p = p.qr().compute_thin_Q();
-        let q = random(t, r).qr().compute_thin_Q();
-        for (j, col) in p.col_iter_mut().enumerate() {
-            let s = 10f64.powf(-(j as f64) / 4.0);
-            col.iter_mut().for_each(|v| *v *= s);
-        }
-        let mut f = &p * q.transpose();
-        for (j, col) in f.col_iter_mut().enumerate() {
-            let m = 2.0 + (j as f64 * 0.003).cos();
-            col.iter_mut().for_each(|v| *v += m);
-        }
-        f
-    }
-
     /// On a large ensemble of low rank the sketch route gives the decomposition of the
     /// method of snapshots: the same mean (bits), singular values to `1e-12 sigma_1`,
     /// coordinates, time functions and rebuilt runs to `1e-9`, and the training runs back
@@ -1258,25 +1245,11 @@ mod tests {
     #[test]
     fn the_sketch_route_does_not_depend_on_the_thread_count() {
         let f = low_rank_ensemble(SKETCH_MIN_RUNS, 5 * ROTATION_BLOCK + 37, 9, 3);
-        let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| {
-                let s = ShapeSpectrum::new(f.as_ref()).unwrap();
-                assert!(s.functions.is_some());
-                (s.sigma, s.left, s.functions, s.total.to_bits())
-            })
-        };
-        let one = run(1);
-        for threads in [2, 3] {
-            let other = run(threads);
-            assert_eq!(one.0, other.0);
-            assert_eq!(one.1, other.1);
-            assert_eq!(one.2, other.2);
-            assert_eq!(one.3, other.3);
-        }
+        same_on_one_two_and_three_threads(|| {
+            let s = ShapeSpectrum::new(f.as_ref()).unwrap();
+            assert!(s.functions.is_some());
+            (s.sigma, s.left, s.functions, s.total.to_bits())
+        });
     }
 
     /// A mean history far above the deviations: the sketch route still applies and loses
