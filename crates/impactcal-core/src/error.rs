@@ -343,6 +343,12 @@ pub fn check_finite(what: &str, values: &[f64]) -> Result<()> {
 /// [`CoreError::NonFinite`].
 pub fn check_finite_mat(what: &str, m: faer::MatRef<'_, f64>) -> Result<()> {
     for j in 0..m.ncols() {
+        if m.col(j)
+            .try_as_col_major()
+            .is_some_and(|c| all_finite(c.as_slice()))
+        {
+            continue;
+        }
         for i in 0..m.nrows() {
             let value = m[(i, j)];
             if !value.is_finite() {
@@ -355,6 +361,23 @@ pub fn check_finite_mat(what: &str, m: faer::MatRef<'_, f64>) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Whether every entry of `xs` is finite, without a branch per entry: `0 x` is 0 for a
+/// finite `x` and NaN otherwise, summed in eight independent lanes (which the compiler
+/// vectorises), so one NaN lane marks the slice.
+fn all_finite(xs: &[f64]) -> bool {
+    let mut lanes = [0.0f64; 8];
+    let mut chunks = xs.chunks_exact(8);
+    for chunk in &mut chunks {
+        for (lane, x) in lanes.iter_mut().zip(chunk) {
+            *lane += x * 0.0;
+        }
+    }
+    for (lane, x) in lanes.iter_mut().zip(chunks.remainder()) {
+        *lane += x * 0.0;
+    }
+    !lanes.iter().any(|lane| lane.is_nan())
 }
 
 /// A configuration checked once into a form that only valid values can take (the
@@ -488,5 +511,32 @@ mod tests {
             e.to_string(),
             "points: non-finite value NaN at row 1, column 1 (0-based)"
         );
+    }
+
+    /// Every position of a column (the eight lanes and the remainder), contiguous or
+    /// strided, and each kind of non-finite value is found and named; extreme finite
+    /// values (the largest, the smallest subnormal, signed zeros) pass.
+    #[test]
+    fn every_non_finite_entry_is_found_and_named() {
+        let finite = [f64::MAX, -f64::MAX, 4.9e-324, -0.0, 0.0, 1.0];
+        for rows in 1..20 {
+            let m = faer::Mat::from_fn(rows, 3, |i, j| finite[(i + j) % finite.len()]);
+            assert!(check_finite_mat("v", m.as_ref()).is_ok());
+            assert!(check_finite_mat("v", m.transpose().transpose()).is_ok());
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for r in 0..rows {
+                    let mut b = m.clone();
+                    b[(r, 2)] = bad;
+                    let strided = b.transpose().to_owned();
+                    for view in [b.as_ref(), strided.transpose()] {
+                        let e = check_finite_mat("v", view).unwrap_err();
+                        assert!(
+                            e.to_string().contains(&format!("row {r}, column 2 ")),
+                            "{e}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }
