@@ -215,7 +215,19 @@ impl ShapeSpectrum {
     /// [`CoreError::DimensionMismatch`] when
     /// `values` is not `N x T`.
     pub fn basis(&self, values: MatRef<'_, f64>, k: usize) -> Result<ShapeBasis> {
-        self.clone().into_basis(values, k)
+        // Only the rows kept are copied: `into_basis` then moves them.
+        let kept = k.clamp(1, self.sigma.len().max(1));
+        ShapeSpectrum {
+            mean: self.mean.clone(),
+            sigma: self.sigma.clone(),
+            left: self.left.clone(),
+            functions: self
+                .functions
+                .as_ref()
+                .map(|rows| kept_rows(rows.as_ref(), kept)),
+            total: self.total,
+        }
+        .into_basis(values, k)
     }
 
     /// As [`basis`](Self::basis), consuming the spectrum: time functions it holds already

@@ -14,7 +14,7 @@ use super::{ShapeSpectrum, column_sum, fix_signs, kept_rows, leading_roots, symm
 use crate::buffer;
 use crate::error::Result;
 
-/// Columns of the sparse sketch `Y = C Omega` that tests an ensemble for low rank.
+/// Columns of the sparse sketch `Y = P D_S Omega` that tests an ensemble for low rank.
 pub(super) const SKETCH_WIDTH: usize = 64;
 
 /// Samples per block (and task) of the pass that projects the runs onto the sketch's range:
