@@ -17,18 +17,27 @@
 //! `A` the `N x M` matrix whose row `k` is `b(x_k)^T`, and `F` the `N x T` responses.
 //!
 //! The system is under-determined; the fit takes its minimum-norm solution
-//! `c = A^T (A A^T)^{-1} F` without forming `A A^T`: a Householder QR factorisation
-//! `A^T = Q_1 R` (`Q_1` is `M x N` with orthonormal columns, `R` is `N x N` upper
-//! triangular; computed by a two-block TSQR) gives `c = Q_1 Z` with `R^T Z = F`. One
-//! factorisation serves all `T` columns, and the solution is linear in `F`.
+//! `c = A^T (A A^T)^{-1} F` through a triangular factor `A A^T = R^T R` (`R` is `N x N`
+//! upper triangular) and never forms `c` for long histories. The factor comes by one of two
+//! routes (see `factor.rs`):
+//! - usually the Gram route: the kernel matrix `K = A A^T` and its Cholesky factor, when a
+//!   bound on `kappa(K)` shows that the squared conditioning costs at most `2.2e-10` in
+//!   relative accuracy; the `M x N` matrix `P` the model keeps is `A^T` itself, and
+//!   `Q_1 = A^T R^{-1}`;
+//! - otherwise a Householder QR factorisation `A^T = Q_1 R` (`Q_1` is `M x N` with
+//!   orthonormal columns; computed by a two-block TSQR), which keeps `P = Q_1`.
+//!
+//! Either way `c = Q_1 Z` with `R^T Z = F`. One factorisation serves all `T` columns, and
+//! the solution is linear in `F`.
 //!
 //! A prediction is `f(x) = (Q_1^T b(x))^T Z = (R^{-1} Q_1^T b(x))^T F`. For time histories
-//! (`T >> N`) the model keeps `Q_1`, `R` and `F` and never forms `c` (`M x T`) or `Z`: per
-//! query it computes `w = Q_1^T b(x)` from prefix sums of the rows of `Q_1` tabulated at
-//! fit time, which the piecewise-linear N-RBFs allow (about `N^2 + 2 gamma m N^2` operations instead of the `M N` of the
-//! direct product), solves `R v = w` (`N^2 / 2`), and takes `v^T F` (`N T`). The fit costs
-//! one QR of `A^T` and no work proportional to `T` beyond copying `F`. When `T` is so
-//! small that `b(x)^T c` is cheaper, the model stores `c` instead.
+//! (`T >> N`) the model keeps `P`, `R` and `F` and never forms `c` (`M x T`) or `Z`: per
+//! query it computes `P^T b(x)` from prefix sums of the rows of `P` tabulated at fit time,
+//! which the piecewise-linear N-RBFs allow (about `N^2 + 2 gamma m N^2` operations instead
+//! of the `M N` of the direct product), turns it into `w = Q_1^T b(x)` (a solve with `R^T`
+//! on the Gram route, `N^2 / 2`), solves `R v = w` (`N^2 / 2`), and takes `v^T F` (`N T`).
+//! The fit costs one factorisation and no work proportional to `T` beyond copying `F`. When
+//! `T` is so small that `b(x)^T c` is cheaper, the model stores `c` instead.
 //!
 //! With [`ErbfOptions::smoothing`] above zero the model stops interpolating and solves the
 //! ridge problem of `smoothing.rs`: the solves with `R` become filters on its
@@ -49,12 +58,12 @@ use crate::data::{
     StoredMat, check_queries, check_training, collect_rows, reject_duplicates, without_row,
 };
 use crate::error::{ErbfError, Result};
+use crate::factor::{Factor, Rows, orthonormalise, q1_times};
 use crate::loo::LooMethod;
 use crate::options::{ErbfOptions, ValidErbfOptions};
 use crate::projection::Projection;
 use crate::rbf::{condition_number, relative_max_error};
 use crate::smoothing::RSvd;
-use crate::thin_qr::{ThinQr, thin_qr};
 
 /// A fitted ERBF model of `T` outputs over a parameter space of `m` inputs.
 ///
@@ -68,8 +77,11 @@ pub struct Erbf {
     unit: Mat<f64>,
     values: Mat<f64>,
     mean: Vec<f64>,
-    /// `Q_1^T` and the tables that evaluate `Q_1^T b(x)` quickly.
+    /// The tables that evaluate `P^T b(x)` quickly, for the fit's `M x N` factor `P`
+    /// (`Q_1` or `A^T`, see [`Rows`]).
     projection: Projection,
+    /// What `P` is.
+    rows: Rows,
     r: Mat<f64>,
     /// The responses less their column means, kept only when outputs are centred.
     centred: Option<Mat<f64>>,
@@ -89,7 +101,8 @@ impl Erbf {
     /// keeps the responses: lent (`MatRef`, `&Mat`) they are copied, given (`Mat`) they
     /// are moved in ([`TrainingValues`]; a failed fit drops them with its error).
     ///
-    /// Cost: `O(N^2 m)` to build `A`, `O(M N^2)` to factorise, `O(m N^2)` for the
+    /// Cost: `O(N^2 m)` to build `A`, `O(M N^2)` to factorise (`M N^2 / 2` multiply-adds
+    /// on the Gram route, four times that on the QR route), `O(m N^2)` for the
     /// prediction tables, a copy of `values` when lent, and a centred copy when outputs
     /// are centred; `O(N^2 T)` more only when `T` is small enough that the coefficients
     /// `c` are stored.
@@ -146,9 +159,9 @@ impl Erbf {
         let coef = direct_is_cheaper(unit.nrows(), unit.ncols(), t, options.gamma).then(|| {
             let mut z = centred.as_ref().map_or(values, |f| f.as_ref()).to_owned();
             solve_rt(factor.r.as_ref(), smoother.as_deref(), z.as_mut());
-            &factor.q1 * &z
+            q1_times(factor.kind, factor.rows.as_ref(), factor.r.as_ref(), z)
         });
-        let projection = Projection::new(factor.q1, unit.as_ref(), &options);
+        let projection = Projection::new(factor.rows, unit.as_ref(), &options);
         Ok(Erbf {
             space: space.clone(),
             options,
@@ -157,6 +170,7 @@ impl Erbf {
             values: training.into_owned(),
             mean,
             projection,
+            rows: factor.kind,
             r: factor.r,
             centred,
             coef,
@@ -229,12 +243,13 @@ impl Erbf {
             .to_owned()
     }
 
-    /// The coefficients `c = Q_1 Z` (`M x T`) with `R^T Z = F`, formed on demand
+    /// The coefficients `c = Q_1 Z` (`M x T`) with `R^T Z = F` (`Q_1 = A^T R^{-1}` on the
+    /// Gram route), formed on demand
     /// (`O(M N T)` time and `M T` memory; large for long histories).
     pub fn coefficients(&self) -> Mat<f64> {
         match &self.coef {
             Some(c) => c.clone(),
-            None => self.projection.q1() * self.z(),
+            None => q1_times(self.rows, self.projection.rows(), self.r.as_ref(), self.z()),
         }
     }
 
@@ -267,7 +282,7 @@ impl Erbf {
             .map_or(self.values.as_ref(), |f| f.as_ref())
     }
 
-    /// `min |R_ii| / max |R_ii|` of the factorisation `A^T = Q_1 R`: a cheap conditioning
+    /// `min |R_ii| / max |R_ii|` of the factor `A A^T = R^T R`: a cheap conditioning
     /// indicator (near `1e-16` means `A` is close to rank deficient).
     pub fn r_diagonal_ratio(&self) -> f64 {
         self.r_ratio
@@ -301,8 +316,8 @@ impl Erbf {
     /// Predictions at the rows of `points` (`Q x m`, raw): a `Q x T` matrix.
     ///
     /// The queries are processed in fixed chunks of 64, in parallel: for each chunk the
-    /// projected basis `W = Q_1^T B` (`N x 64`) is evaluated from the fit's tables and
-    /// `V = R^{-1} W` solved; one product `V^T F` then gives all `T` outputs. Cost about
+    /// projected basis `W = Q_1^T B` (`N x 64`) is evaluated from the fit's tables (with a
+    /// solve by `R^T` on the Gram route) and `V = R^{-1} W` solved; one product `V^T F` then gives all `T` outputs. Cost about
     /// `Q (N^2 (1 + 2 gamma m) + N T)`; memory `Q N` besides the result. When the model
     /// stores `c` (few outputs) each chunk multiplies `B^T c` directly. The product is taken
     /// in fixed blocks of 512 output columns, one task each, which also adds the mean and
@@ -350,6 +365,7 @@ impl Erbf {
                         let len = cols.ncols();
                         let u = &unit[k * CHUNK * m..(k * CHUNK + len) * m];
                         self.projection.project(u, cols.as_mut());
+                        orthonormalise(self.rows, self.r.as_ref(), cols.as_mut());
                         solve_r(self.r.as_ref(), self.smoother.as_deref(), cols);
                     });
                 // out = V^T F + 1 mean^T in fixed blocks of output columns, one rayon task
@@ -455,7 +471,8 @@ impl Erbf {
                 let b = basis_matrix_t(uk.as_ref(), unit.as_ref(), &self.options);
                 // w = R^{-1} Q_1^T b (filtered with smoothing, the same lambda), so that
                 // f^{(-k)}(x_k) = F_{-k}^T w.
-                let mut w = factor.q1.transpose() * &b;
+                let mut w = factor.rows.transpose() * &b;
+                orthonormalise(factor.kind, factor.r.as_ref(), w.as_mut());
                 let smoother = match self.smoother.as_deref() {
                     Some((_, lambda)) => Some((
                         RSvd::new(factor.r.as_ref()).map_err(|e| undefined(e.to_string()))?,
@@ -514,7 +531,8 @@ impl Erbf {
         match &self.coef {
             Some(c) => matmul(out, Accum::Replace, bt.transpose(), c.as_ref(), 1.0, par()),
             None => {
-                let mut v = self.projection.q1().transpose() * bt;
+                let mut v = self.projection.rows().transpose() * bt;
+                orthonormalise(self.rows, self.r.as_ref(), v.as_mut());
                 solve_r(self.r.as_ref(), self.smoother.as_deref(), v.as_mut());
                 matmul(
                     out,
@@ -569,34 +587,6 @@ fn add_means(out: MatMut<'_, f64>, means: &[f64]) {
 
 fn par() -> Par {
     faer::get_global_parallelism()
-}
-
-/// The thin QR factors of `A^T` for samples `unit` (scaled).
-struct Factor {
-    q1: Mat<f64>,
-    r: Mat<f64>,
-    ratio: f64,
-}
-
-impl Factor {
-    /// Factorises `A^T` for the scaled samples `unit` (see [`crate::thin_qr`]);
-    /// `parallel` lets the two halves of the rows run side by side.
-    fn new(unit: MatRef<'_, f64>, options: &ErbfOptions, parallel: bool) -> Result<Self> {
-        let n = unit.nrows();
-        let ThinQr { q1, r } = thin_qr(basis_matrix_t(unit, unit, options), parallel);
-        let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
-        for i in 0..n {
-            lo = lo.min(r[(i, i)].abs());
-            hi = hi.max(r[(i, i)].abs());
-        }
-        let ratio = if hi > 0.0 { lo / hi } else { 0.0 };
-        let threshold = n as f64 * f64::EPSILON;
-        // With smoothing a (near-)singular kernel matrix is well posed.
-        if ratio.is_nan() || (ratio <= threshold && options.smoothing <= 0.0) {
-            return Err(ErbfError::Singular { ratio, threshold });
-        }
-        Ok(Factor { q1, r, ratio })
-    }
 }
 
 /// The serialised form of an [`Erbf`]: space, options and training data.

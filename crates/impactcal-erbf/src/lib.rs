@@ -70,6 +70,7 @@ pub mod components;
 mod data;
 pub mod erbf;
 pub mod error;
+mod factor;
 pub mod loo;
 mod lu;
 pub mod metrics;

@@ -1,4 +1,5 @@
-//! Fast evaluation of the projected ERBF basis `w(x) = Q_1^T b(x)`.
+//! Fast evaluation of the projected ERBF basis `w(x) = P^T b(x)`, for the fit's `M x N`
+//! factor `P` (`Q_1`, or `A^T` itself on the Gram route of `factor.rs`).
 //!
 //! A prediction needs `w(x)` (length `N`) for every query. Formed directly it costs the
 //! `M = N (3 m + 1)` basis values and an `N x M` product, `O(m N^2)` per query. The
@@ -13,11 +14,11 @@
 //!
 //! with `s = n gamma^(n-1)`, `alpha = (1 - n) gamma^n`, and zero elsewhere. With the centres
 //! of each input sorted once, the linear pieces reduce to prefix (or suffix) sums of rows of
-//! `Q_1`, `sum Q_1[row, :]` and `sum Q_1[row, :] c`, tabulated at fit time; only the centres
+//! `P`, `sum P[row, :]` and `sum P[row, :] c`, tabulated at fit time; only the centres
 //! within `gamma` of `u` are added one by one, as one small product. The cost per query
 //! falls to about `N^2 + m N (2 gamma N + 6)` operations, an eighth of the direct product
 //! at the default `gamma = 0.15`, and no `M x Q` basis matrix is formed. The tables take
-//! `m N (6 N + 6)` values, twice the size of `Q_1`.
+//! `m N (6 N + 6)` values, twice the size of `P`.
 //!
 //! The result equals the direct product up to rounding (a test compares them to `1e-12`).
 
@@ -30,7 +31,7 @@ use crate::buffer;
 use crate::nrbf::even_power;
 use crate::options::ErbfOptions;
 
-/// `Q_1^T` and the tables that give `Q_1^T b(x)`; see the module documentation.
+/// `P` and the tables that give `P^T b(x)`; see the module documentation.
 #[derive(Debug, Clone)]
 pub(crate) struct Projection {
     n: usize,
@@ -46,8 +47,8 @@ pub(crate) struct Projection {
     beta_weight: f64,
     /// The centres, row-major `N x m`.
     centres: Vec<f64>,
-    /// `Q_1` (`M x N`).
-    q1: Mat<f64>,
+    /// `P` (`M x N`).
+    rows: Mat<f64>,
     /// Per input `j`: the centres' coordinates in ascending order (`m x N`).
     sorted: Vec<f64>,
     /// One block of [`Layout::block`] values per input; see [`Layout`].
@@ -55,7 +56,7 @@ pub(crate) struct Projection {
 }
 
 /// Offsets inside the table block of one input (every row has `N` values):
-/// - `rows_l`, `rows_r`: the `phi_L` and `phi_R` rows of `Q_1` of the centres in sorted
+/// - `rows_l`, `rows_r`: the `phi_L` and `phi_R` rows of `P` of the centres in sorted
 ///   order (`N` rows each);
 /// - `prefix(p)`: `[sum_{s<p} R_s, sum_{s<p} R_s c_s]` over sorted positions, `p = 0..=N`;
 /// - `suffix(p)`: `[sum_{s>=p} L_s, sum_{s>=p} L_s c_s]`, `p = 0..=N`;
@@ -87,9 +88,9 @@ impl Layout {
 }
 
 impl Projection {
-    /// Tables for the factor `q1` (`M x N`) of an ERBF fit with scaled centres `unit`
+    /// Tables for the factor `rows` (`P`, `M x N`) of an ERBF fit with scaled centres `unit`
     /// (`N x m`) and options `o`. Cost `O(m N^2)` time and memory.
-    pub(crate) fn new(q1: Mat<f64>, unit: MatRef<'_, f64>, o: &ErbfOptions) -> Self {
+    pub(crate) fn new(rows: Mat<f64>, unit: MatRef<'_, f64>, o: &ErbfOptions) -> Self {
         let (n, m) = unit.shape();
         let order = o.order as i32;
         let layout = Layout { n };
@@ -107,7 +108,7 @@ impl Projection {
                     let c = unit[(i, j)];
                     cs[s] = c;
                     let row = n + 3 * (i * m + j);
-                    let (l, r, b) = (q1.row(row), q1.row(row + 1), q1.row(row + 2));
+                    let (l, r, b) = (rows.row(row), rows.row(row + 1), rows.row(row + 2));
                     let at = layout.rows_l(s);
                     block[at..at + n]
                         .iter_mut()
@@ -153,18 +154,18 @@ impl Projection {
             lr_weight: o.weights.left_right,
             beta_weight: o.weights.beta,
             centres,
-            q1,
+            rows,
             sorted,
             tables,
         }
     }
 
-    /// `Q_1`, `M x N`.
-    pub(crate) fn q1(&self) -> MatRef<'_, f64> {
-        self.q1.as_ref()
+    /// The tabulated rows `P`, `M x N`.
+    pub(crate) fn rows(&self) -> MatRef<'_, f64> {
+        self.rows.as_ref()
     }
 
-    /// Writes `w(u_q) = Q_1^T b(u_q)` into column `q` of `out` (`N x Q`) for the scaled
+    /// Writes `w(u_q) = P^T b(u_q)` into column `q` of `out` (`N x Q`) for the scaled
     /// queries `u` (row-major, `Q x m`). Sequential; callers parallelise over chunks.
     pub(crate) fn project(&self, u: &[f64], mut out: MatMut<'_, f64>) {
         let (n, m) = (self.n, self.m);
@@ -179,7 +180,7 @@ impl Projection {
         matmul(
             out.as_mut(),
             Accum::Replace,
-            self.q1.as_ref().subrows(0, n).transpose(),
+            self.rows.as_ref().subrows(0, n).transpose(),
             psi.as_ref(),
             1.0,
             Par::Seq,
