@@ -15,9 +15,15 @@
 //! with `s = n gamma^(n-1)`, `alpha = (1 - n) gamma^n`, and zero elsewhere. With the centres
 //! of each input sorted once, the linear pieces reduce to prefix (or suffix) sums of rows of
 //! `P`, `sum P[row, :]` and `sum P[row, :] c`, tabulated at fit time; only the centres
-//! within `gamma` of `u` are added one by one, as one small product. The cost per query
-//! falls to about `N^2 + m N (2 gamma N + 6)` operations, an eighth of the direct product
-//! at the default `gamma = 0.15`, and no `M x Q` basis matrix is formed. The tables take
+//! within `gamma` of `u` are added one by one. Those sums are taken for groups of eight
+//! queries of a chunk sorted by the input's coordinate: one product of the table rows over
+//! the union of the group's windows with the values of the polynomial pieces (zero outside
+//! each query's own window). Sorted neighbours share most of their windows, so the product
+//! does about 1.4 times the operations of eight matrix-vector products at about twice
+//! their speed (200 outputs at 1000 queries of the erbf bench, mostly this projection:
+//! 7.7-7.9 ms against 9.5-10.0). The cost per query falls to about
+//! `N^2 + m N (2 gamma N + 6)` operations, an eighth of the direct product at the default
+//! `gamma = 0.15`, and no `M x Q` basis matrix is formed. The tables take
 //! `m N (6 N + 6)` values, twice the size of `P`.
 //!
 //! The result equals the direct product up to rounding (a test compares them to `1e-12`).
@@ -186,20 +192,36 @@ impl Projection {
             Par::Seq,
         );
         // Input by input, so that one input's tables stay in cache for the whole chunk.
-        let mut scratch = vec![0.0; n];
+        let mut windows = vec![Windows::default(); q];
+        let mut order: Vec<usize> = (0..q).collect();
+        let mut scratch = Scratch {
+            values: vec![0.0; n * GROUP],
+            sums: Mat::zeros(n, GROUP),
+        };
         for j in 0..m {
-            for c in 0..q {
-                self.add_input(j, u[c * m + j], out.as_mut().col_mut(c), &mut scratch);
+            for (c, window) in windows.iter_mut().enumerate() {
+                *window = self.add_linear(j, u[c * m + j], out.as_mut().col_mut(c));
+            }
+            order.sort_by(|&a, &b| u[a * m + j].total_cmp(&u[b * m + j]));
+            for group in order.chunks(GROUP) {
+                self.add_polynomial(j, u, group, &windows, out.as_mut(), &mut scratch);
             }
         }
     }
 
-    /// Adds the non-radial and linear contributions of input `j` at coordinate `x` to `w`
-    /// (length `N`); `scratch` holds `N` values.
-    fn add_input(&self, j: usize, x: f64, mut w: ColMut<'_, f64>, scratch: &mut [f64]) {
+    /// The table block of input `j`.
+    fn block(&self, j: usize) -> &[f64] {
+        let size = Layout { n: self.n }.block();
+        &self.tables[j * size..(j + 1) * size]
+    }
+
+    /// Adds the linear pieces of input `j` at coordinate `x` to `w` (length `N`): the
+    /// prefix and suffix sums of the centres beyond `gamma` and the `beta` rows. Returns
+    /// where the polynomial pieces lie among the sorted centres.
+    fn add_linear(&self, j: usize, x: f64, mut w: ColMut<'_, f64>) -> Windows {
         let n = self.n;
         let layout = Layout { n };
-        let block = &self.tables[j * layout.block()..(j + 1) * layout.block()];
+        let block = self.block(j);
         let cs = &self.sorted[j * n..(j + 1) * n];
         // Sorted positions [0, a): c <= x - gamma (phi_R linear); [a, b): phi_R
         // polynomial; [b, d): phi_L polynomial; [d, N): phi_L linear.
@@ -212,41 +234,103 @@ impl Projection {
             (layout.suffix(d), lr * (al - s * x), lr * s),
             (layout.beta(), self.beta_weight * x, -self.beta_weight),
         ];
-        let pairs = linear.map(|(at, v0, v1)| (&block[at..at + 2 * n], [v0, v1]));
         if let Some(w) = w.rb_mut().try_as_col_major_mut() {
             let w = w.as_slice_mut();
-            for (pair, [v0, v1]) in pairs {
-                let (t0, t1) = pair.split_at(n);
+            for (at, v0, v1) in linear {
+                let (t0, t1) = block[at..at + 2 * n].split_at(n);
                 for ((wk, a0), a1) in w.iter_mut().zip(t0).zip(t1) {
                     *wk += v0 * a0 + v1 * a1;
                 }
             }
         }
-        // The polynomial pieces: two products of contiguous blocks of rows with values.
-        for (v, &c) in scratch.iter_mut().zip(&cs[a..b]) {
-            *v = lr * even_power(x - c, self.order);
+        Windows {
+            right: a..b,
+            left: b..d,
         }
-        let rows = &block[layout.rows_r(a)..layout.rows_r(b)];
-        add_rows(w.rb_mut(), rows, &scratch[..b - a]);
-        for (v, &c) in scratch.iter_mut().zip(&cs[b..d]) {
-            *v = lr * even_power(c - x, self.order);
+    }
+
+    /// Adds the polynomial pieces of input `j` for a group of queries (columns of `out`,
+    /// sorted by their coordinate `j`): for each side, one product of the table rows over
+    /// the union of the group's windows with their values (zero outside a query's own
+    /// window), whose columns are then added to the queries' columns.
+    fn add_polynomial(
+        &self,
+        j: usize,
+        u: &[f64],
+        group: &[usize],
+        windows: &[Windows],
+        mut out: MatMut<'_, f64>,
+        scratch: &mut Scratch,
+    ) {
+        let (n, m, g) = (self.n, self.m, group.len());
+        let layout = Layout { n };
+        let block = self.block(j);
+        let cs = &self.sorted[j * n..(j + 1) * n];
+        let mut accum = Accum::Replace;
+        for right in [true, false] {
+            let window = |c: usize| {
+                if right {
+                    windows[c].right.clone()
+                } else {
+                    windows[c].left.clone()
+                }
+            };
+            let first = group.iter().map(|&c| window(c).start).min().unwrap_or(0);
+            let last = group.iter().map(|&c| window(c).end).max().unwrap_or(0);
+            if last <= first {
+                continue;
+            }
+            let len = last - first;
+            let values = &mut scratch.values[..len * g];
+            values.fill(0.0);
+            for (k, &c) in group.iter().enumerate() {
+                let x = u[c * m + j];
+                for s in window(c) {
+                    let t = if right { x - cs[s] } else { cs[s] - x };
+                    values[k * len + s - first] = self.lr_weight * even_power(t, self.order);
+                }
+            }
+            let at = if right {
+                layout.rows_r(first)
+            } else {
+                layout.rows_l(first)
+            };
+            matmul(
+                scratch.sums.as_mut().subcols_mut(0, g),
+                accum,
+                MatRef::from_column_major_slice(&block[at..at + len * n], n, len),
+                MatRef::from_column_major_slice(values, len, g),
+                1.0,
+                Par::Seq,
+            );
+            accum = Accum::Add;
         }
-        let rows = &block[layout.rows_l(b)..layout.rows_l(d)];
-        add_rows(w, rows, &scratch[..d - b]);
+        if accum == Accum::Add {
+            for (k, &c) in group.iter().enumerate() {
+                let mut w = out.rb_mut().col_mut(c);
+                w += scratch.sums.col(k);
+            }
+        }
     }
 }
 
-/// `w += sum_s v_s row_s` for consecutive rows of length `len(w)` in `rows`.
-fn add_rows(w: ColMut<'_, f64>, rows: &[f64], v: &[f64]) {
-    let n = w.nrows();
-    matmul(
-        w.as_mat_mut(),
-        Accum::Add,
-        MatRef::from_column_major_slice(rows, n, v.len()),
-        MatRef::from_column_major_slice(v, v.len(), 1),
-        1.0,
-        Par::Seq,
-    );
+/// Queries whose polynomial pieces are summed by one product (see
+/// [`Projection::add_polynomial`]).
+const GROUP: usize = 8;
+
+/// Where the polynomial pieces of one query and input lie among the sorted centres:
+/// `phi_R` on `right`, `phi_L` on `left`.
+#[derive(Debug, Clone, Default)]
+struct Windows {
+    right: std::ops::Range<usize>,
+    left: std::ops::Range<usize>,
+}
+
+/// Work space of [`Projection::add_polynomial`]: the values of a group (`N x GROUP` at
+/// most) and the group's sums (`N x GROUP`).
+struct Scratch {
+    values: Vec<f64>,
+    sums: Mat<f64>,
 }
 
 /// `out = [base_0 + row, base_1 + c row]` for a pair of rows `base = [base_0, base_1]`.
