@@ -13,8 +13,9 @@
 //! with `phi_L`, `phi_R` the non-radial functions of [`crate::nrbf`]: `M = N (3 m + 1)`
 //! coefficients for `N` interpolation conditions. Writing `b(x)` for the `M` basis values
 //! (radial first, then ordered by sample `i`, input `j` and `{L, R, beta}`, each family
-//! multiplied by its weight of [`FamilyWeights`](crate::FamilyWeights)), the conditions read `A c = F` with
-//! `A` the `N x M` matrix whose row `k` is `b(x_k)^T`, and `F` the `N x T` responses.
+//! multiplied by its weight of [`FamilyWeights`](crate::FamilyWeights)), the conditions
+//! read `A c = F` with `A` the `N x M` matrix whose row `k` is `b(x_k)^T`, and `F` the
+//! `N x T` responses.
 //!
 //! The system is under-determined; the fit takes its minimum-norm solution
 //! `c = A^T (A A^T)^{-1} F` through a triangular factor `A A^T = R^T R` (`R` is `N x N`
@@ -244,8 +245,8 @@ impl Erbf {
     }
 
     /// The coefficients `c = Q_1 Z` (`M x T`) with `R^T Z = F` (`Q_1 = A^T R^{-1}` on the
-    /// Gram route), formed on demand
-    /// (`O(M N T)` time and `M T` memory; large for long histories).
+    /// Gram route), formed on demand (`O(M N T)` time and `M T` memory; large for long
+    /// histories).
     pub fn coefficients(&self) -> Mat<f64> {
         match &self.coef {
             Some(c) => c.clone(),
@@ -317,12 +318,12 @@ impl Erbf {
     ///
     /// The queries are processed in fixed chunks of 64, in parallel: for each chunk the
     /// projected basis `W = Q_1^T B` (`N x 64`) is evaluated from the fit's tables (with a
-    /// solve by `R^T` on the Gram route) and `V = R^{-1} W` solved; one product `V^T F` then gives all `T` outputs. Cost about
-    /// `Q (N^2 (1 + 2 gamma m) + N T)`; memory `Q N` besides the result. When the model
-    /// stores `c` (few outputs) each chunk multiplies `B^T c` directly. The product is taken
-    /// in fixed blocks of 512 output columns, one task each, which also adds the mean and
-    /// writes its block of the result once. The result does not depend on the number of
-    /// threads.
+    /// solve by `R^T` on the Gram route) and `V = R^{-1} W` solved; one product `V^T F`
+    /// then gives all `T` outputs. Cost about `Q (N^2 (1 + 2 gamma m) + N T)`; memory
+    /// `Q N` besides the result. When the model stores `c` (few outputs) each chunk
+    /// multiplies `B^T c` directly. The product is taken in fixed blocks of 512 output
+    /// columns, one task each, which also adds the mean and writes its block of the result
+    /// once. The result does not depend on the number of threads.
     ///
     /// # Errors
     /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) or
