@@ -13,7 +13,8 @@
 //! clones them before each timed call, off the clock.
 //!
 //! `cargo run --release --example erbf_peer -- <dir> [reps] [airframe-dir]` (set
-//! `ERBF_PEER_VERBOSE=1` to print every timed call to stderr).
+//! `ERBF_PEER_VERBOSE=1` to print every timed call to stderr, `ERBF_PEER_DEFAULT_POOL=1` to
+//! keep rayon's default global pool instead of making the main thread one of its workers).
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -252,6 +253,16 @@ fn bounds(prefix: &str, reps: usize, q: usize, f: MatRef<'_, f64>) {
 }
 
 fn main() {
+    if std::env::var_os("ERBF_PEER_DEFAULT_POOL").is_none() {
+        // This thread is one of the pool's workers, as numpy's calling thread is one of
+        // OpenBLAS's: with rayon's default pool, its workers and this thread are three on
+        // two processors, and the scheduler at times leaves both workers on one of them
+        // (docs/performance.md, "The calling thread as a worker").
+        rayon::ThreadPoolBuilder::new()
+            .use_current_thread()
+            .build_global()
+            .unwrap();
+    }
     let dir = std::env::args()
         .nth(1)
         .expect("usage: erbf_peer <dir> [reps] [airframe-dir]");
