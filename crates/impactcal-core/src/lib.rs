@@ -49,6 +49,7 @@ pub mod points;
 pub mod samples;
 pub mod sampling;
 pub mod signal;
+pub mod simd;
 pub mod space;
 pub mod synthetic;
 pub mod table;

@@ -51,6 +51,7 @@ pub(crate) fn fill_basis(
     o: &ErbfOptions,
     mut out: faer::MatMut<'_, f64>,
 ) {
+    impactcal_core::simd::clear_upper_registers();
     let lr = LeftRight::new(o.order as i32, o.gamma);
     let inv2rc2 = 0.5 / (o.rc * o.rc);
     let w = o.weights;

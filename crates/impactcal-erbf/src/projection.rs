@@ -176,6 +176,7 @@ impl Projection {
     pub(crate) fn project(&self, u: &[f64], mut out: MatMut<'_, f64>) {
         let (n, m) = (self.n, self.m);
         let q = out.ncols();
+        impactcal_core::simd::clear_upper_registers();
         // The radial part of all the chunk's queries as one product.
         let psi = Mat::from_fn(n, q, |i, c| {
             let x = &u[c * m..(c + 1) * m];
@@ -191,6 +192,7 @@ impl Projection {
             1.0,
             Par::Seq,
         );
+        impactcal_core::simd::clear_upper_registers();
         // Input by input, so that one input's tables stay in cache for the whole chunk.
         let mut windows = vec![Windows::default(); q];
         let mut order: Vec<usize> = (0..q).collect();
@@ -305,6 +307,7 @@ impl Projection {
             );
             accum = Accum::Add;
         }
+        impactcal_core::simd::clear_upper_registers();
         if accum == Accum::Add {
             for (k, &c) in group.iter().enumerate() {
                 let mut w = out.rb_mut().col_mut(c);

@@ -576,6 +576,7 @@ impl RbfInterpolant {
             .par_col_chunks_mut(1)
             .enumerate()
             .for_each(|(i, mut col)| {
+                impactcal_core::simd::clear_upper_registers();
                 let x: Vec<f64> = points.row(start + i).iter().copied().collect();
                 let mut buf = vec![0.0; n];
                 self.basis_row(&x, &mut buf);
