@@ -6,7 +6,7 @@
 //! [--kernel cubic|thin-plate] [--candidates 300] [--local-candidates 100] [--pattern 0.9,0.75,0.25,0.05,0.03,0]
 //! [--restart-patience N | --restart | --no-restart] [--global-only] [--local-first] [--escape N | --no-escape]
 //! [--second-region H | --no-second-region]
-//! [--perturb-horizon H | --no-perturb] [--candidate-floor N [--candidate-horizon H] |
+//! [--perturb-horizon H | --no-perturb] [--repeat-refinement N | --no-repeat-refinement] [--candidate-floor N [--candidate-horizon H] |
 //! --no-candidate-decay] [--merit-weights 0.3,0.5,0.8,0.95]
 //! [--adaptive-region restore|escape|restart|restart-outside [--grow-after 3] [--shrink-after N] [--halvings 6] [--sigma-only] |
 //! --no-adaptive-region] [--points]`
@@ -187,6 +187,15 @@ fn main() {
                     min_per_dim: c.parse().unwrap(),
                     horizon: get("--candidate-horizon").map_or(300, |h| h.parse().unwrap()),
                 });
+            }
+            if let Some(n) = get("--repeat-refinement") {
+                options.repeat_refinement = Some(impactcal_cors::RepeatRefinement {
+                    max_repeats: n.parse().unwrap(),
+                    ..Default::default()
+                });
+            }
+            if args.iter().any(|a| a == "--no-repeat-refinement") {
+                options.repeat_refinement = None;
             }
             if args.iter().any(|a| a == "--no-candidate-decay") {
                 options.candidate_decay = None;

@@ -12,7 +12,7 @@ use impactcal::core::ParamGuard;
 use impactcal::core::{CoreError, ParameterSpace, Table, TableOptions, read_samples};
 use impactcal::cors::{
     AdaptiveRegion, CandidateDecay, Converged, Cors, CorsOptions, InitialDesign, Perturbation,
-    Restart, SurrogateKernel, Transform,
+    RepeatRefinement, Restart, SurrogateKernel, Transform,
 };
 
 use crate::error::CliError;
@@ -29,7 +29,7 @@ pub struct Args {
 enum OptimizeCommand {
     /// Print the next points to evaluate (CSV with the parameter header): missing design
     /// points first, then CORS points.
-    Suggest(SuggestArgs),
+    Suggest(Box<SuggestArgs>),
     /// Print the answers of a study from its history (JSON): the best sample (lowest
     /// objective seen) and the evaluated point of lowest smoothed-surrogate value, the
     /// better answer under a noisy objective.
@@ -159,6 +159,13 @@ struct SuggestArgs {
     /// Move every coordinate of the candidates around the best point.
     #[arg(long)]
     no_perturbation: bool,
+    /// Take a refinement step (beta <= 0.05) again while it lowers the best value by more
+    /// than 0.1 %, at most this many times in a row (default 6).
+    #[arg(long, conflicts_with = "no_repeat_refinement")]
+    repeat_refinement: Option<usize>,
+    /// Advance the search pattern by one step at every evaluation (no repeated refinement).
+    #[arg(long)]
+    no_repeat_refinement: bool,
     /// Let the number of quasi-random candidates fall from 300 d to this many per dimension
     /// over `--candidate-horizon` evaluations after the initial set (off by default).
     #[arg(long)]
@@ -194,7 +201,7 @@ struct SuggestArgs {
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<(), CliError> {
     match args.command {
-        OptimizeCommand::Suggest(a) => suggest(a),
+        OptimizeCommand::Suggest(a) => suggest(*a),
         OptimizeCommand::Answer(a) => answer(a),
     }
 }
@@ -355,6 +362,16 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
             args.perturb_horizon
                 .map(|horizon| Perturbation { horizon })
                 .or(options.perturbation)
+        },
+        repeat_refinement: if args.no_repeat_refinement {
+            None
+        } else {
+            args.repeat_refinement
+                .map(|max_repeats| RepeatRefinement {
+                    max_repeats,
+                    ..RepeatRefinement::default()
+                })
+                .or(options.repeat_refinement)
         },
         candidate_decay: args.candidate_floor.map(|min_per_dim| CandidateDecay {
             min_per_dim,

@@ -12,7 +12,8 @@ use std::path::Path;
 use impactcal::core::points::to_rows;
 use impactcal::core::{Table, TableOptions, test_functions};
 use impactcal::cors::{
-    AdaptiveRegion, CandidateDecay, Converged, Cors, CorsOptions, Perturbation, Restart,
+    AdaptiveRegion, CandidateDecay, Converged, Cors, CorsOptions, Perturbation, RepeatRefinement,
+    Restart,
 };
 
 /// Runs `impactcal optimize suggest` on the files with extra arguments.
@@ -91,7 +92,7 @@ fn shell_loop_reproduces_the_library_loop() {
 #[test]
 fn search_options_reproduce_the_library_loop() {
     let f = test_functions::by_name("branin").unwrap();
-    let cases: [(&[&str], CorsOptions); 14] = [
+    let cases: [(&[&str], CorsOptions); 16] = [
         (
             &["--local-half-width", "0.15"],
             CorsOptions {
@@ -165,6 +166,23 @@ fn search_options_reproduce_the_library_loop() {
             &["--perturb-horizon", "20"],
             CorsOptions {
                 perturbation: Some(Perturbation { horizon: 20 }),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--no-repeat-refinement"],
+            CorsOptions {
+                repeat_refinement: None,
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--repeat-refinement", "2"],
+            CorsOptions {
+                repeat_refinement: Some(RepeatRefinement {
+                    max_repeats: 2,
+                    ..RepeatRefinement::default()
+                }),
                 ..CorsOptions::with_seed(3)
             },
         ),
@@ -251,7 +269,7 @@ fn search_options_reproduce_the_library_loop() {
         let history = dir.path().join("history.csv");
         let mut extra = vec!["--seed", "3"];
         extra.extend_from_slice(flags);
-        for _ in 0..12 {
+        for _ in 0..24 {
             let x = suggest(&bounds, &history, &extra).pop().unwrap();
             append(&history, &x, f.eval(&x));
         }

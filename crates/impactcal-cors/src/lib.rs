@@ -49,6 +49,7 @@ mod geometry;
 pub mod optimizer;
 pub mod options;
 mod region;
+mod schedule;
 mod stall;
 pub mod state;
 mod step;
@@ -60,6 +61,7 @@ pub use error::{CorsError, Result};
 pub use optimizer::{Cors, Outcome, StopReason};
 pub use options::{
     AdaptiveRegion, CandidateDecay, Converged, CorsOptions, DEFAULT_PATTERN, InitialDesign,
-    Perturbation, Restart, Stopping, SurrogateKernel, Transform, ValidCorsOptions, dycors_decay,
+    Perturbation, RepeatRefinement, Restart, Stopping, SurrogateKernel, Transform,
+    ValidCorsOptions, dycors_decay,
 };
 pub use state::{CorsState, Evaluation, FillReason, Mode, Origin, Suggestion};

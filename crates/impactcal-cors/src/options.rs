@@ -190,6 +190,37 @@ impl CandidateDecay {
     }
 }
 
+/// Refinement steps taken again while they improve: a step of the pattern with
+/// `beta <= max_beta` whose result lowers the run's best value by more than 0.1 % of
+/// `|best|` (DYCORS's success) is followed by another step with the same `beta` in the same
+/// region instead of the pattern's next one, up to `max_repeats` times in a row.
+///
+/// The pattern's `beta` cycle spends a fixed share of the steps on exploration whatever
+/// the refinement achieves; a success at a small `beta` says that the surrogate resolves
+/// the basin it refines, where one more such step is the cheapest improvement on offer.
+/// Exploration resumes at the first refinement step that does not succeed (or after
+/// `max_repeats`), so every exploration step of the pattern still comes, only later, and
+/// the cycle never stalls. The schedule is a function of the run's ordered results: a
+/// point still pending counts as a step that did not succeed, so a study rebuilt from its
+/// history (or resumed) proposes what an uninterrupted one does.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RepeatRefinement {
+    /// The largest `beta` of a refinement step, in `[0, 1]` (default 0.05: the last three
+    /// values of the default pattern).
+    pub max_beta: f64,
+    /// The most repeats in a row; at least 1 (default 6, one pattern's length).
+    pub max_repeats: usize,
+}
+
+impl Default for RepeatRefinement {
+    fn default() -> Self {
+        RepeatRefinement {
+            max_beta: 0.05,
+            max_repeats: 6,
+        }
+    }
+}
+
 /// DYCORS's step-size rule (Regis & Shoemaker 2013; pySOT's `DYCORSStrategy`) applied to
 /// the half-width of the local region ([`CorsOptions::local_region`]).
 ///
@@ -351,6 +382,10 @@ pub struct CorsOptions {
     /// cycles (`None`: every coordinate of every such candidate moves). Default: a horizon
     /// of 300 evaluations.
     pub perturbation: Option<Perturbation>,
+    /// Refinement steps repeated while they improve the run's best value
+    /// ([`RepeatRefinement`]); `None`: the pattern advances by one at every evaluation.
+    /// Default: `beta <= 0.05`, at most 6 repeats in a row.
+    pub repeat_refinement: Option<RepeatRefinement>,
     /// DYCORS's adaptive step applied to the local region's half-width, with what follows
     /// its convergence (`None`: the half-width stays `local_region`). Without
     /// `local_region` there are no local cycles to adapt and only a convergence restart
@@ -393,6 +428,7 @@ impl Default for CorsOptions {
             local_escape: Some(60),
             second_region: Some(0.5),
             perturbation: Some(Perturbation { horizon: 300 }),
+            repeat_refinement: Some(RepeatRefinement::default()),
             adaptive_region: None,
             candidate_decay: None,
             merit_weights: None,
@@ -426,8 +462,9 @@ impl ParamGuard for CorsOptions {
     /// design of fewer than 2 points, no candidates, no polishing start, a distance that is
     /// negative or not finite, a zero patience (stopping or restart) or a negative or
     /// non-finite improvement threshold, a decay horizon below 2, a candidate floor of 0
-    /// or above `candidates_per_dim`, or an adaptive region with a zero count or halvings
-    /// outside `[1, 30]`.
+    /// or above `candidates_per_dim`, a repeated refinement with `max_beta` outside
+    /// `[0, 1]` or no repeat, or an adaptive region with a zero count or halvings outside
+    /// `[1, 30]`.
     fn check_ref(&self) -> impactcal_core::Result<()> {
         let bad = |name: &'static str, value: String, message: &str| {
             Err(CoreError::invalid_option(name, value, message))
@@ -509,6 +546,22 @@ impl ParamGuard for CorsOptions {
                 p.horizon.to_string(),
                 "must be at least 2",
             );
+        }
+        if let Some(r) = &self.repeat_refinement {
+            if !(r.max_beta >= 0.0 && r.max_beta <= 1.0) {
+                return bad(
+                    "repeat_refinement.max_beta",
+                    r.max_beta.to_string(),
+                    "must lie in [0, 1]",
+                );
+            }
+            if r.max_repeats == 0 {
+                return bad(
+                    "repeat_refinement.max_repeats",
+                    "0".into(),
+                    "must be positive",
+                );
+            }
         }
         if let Some(a) = &self.adaptive_region {
             if a.grow_after == 0 {

@@ -11,6 +11,7 @@ use crate::error::Result;
 use crate::geometry::{distance, stream};
 use crate::options::{AdaptiveRegion, Converged, CorsOptions, InitialDesign};
 use crate::region::{LocalWidth, SUCCESS_IMPROVEMENT, adaptive_width};
+use crate::schedule::pattern_position;
 use crate::stall::StallRule;
 use crate::state::{
     CorsState, DUPLICATE_TOL, FillReason, MATCH_TOL, Mode, Origin, Plan, Suggestion, best_of,
@@ -219,6 +220,7 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
         let blockers = blockers(state, &plan, &earlier, &out)?;
         // Evaluations after the run's initial set before this one.
         let m = index.saturating_sub(plan.cycle_origin);
+        let position = run_position(state, &plan, index);
         let per_dim = match &state.options.candidate_decay {
             Some(decay) => decay.per_dim(state.options.candidates_per_dim, m),
             None => state.options.candidates_per_dim,
@@ -232,8 +234,8 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
                 second,
             }) => {
                 let k = state.options.pattern.len();
-                let beta = state.options.pattern[m % k];
-                let searched = cycle_search(m / k, &state.options);
+                let beta = state.options.pattern[position % k];
+                let searched = cycle_search(position / k, &state.options);
                 let local = searched != CycleSearch::Whole;
                 let centre = if searched == CycleSearch::Second {
                     second
@@ -297,6 +299,19 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
         plan,
         suggestions: out,
     })
+}
+
+/// The pattern position of the step at history index `index` ([`pattern_position`] over
+/// the current run).
+fn run_position(state: &CorsState, plan: &Plan, index: usize) -> usize {
+    let end = state.evaluations.len();
+    let start = plan.run_start.min(end);
+    pattern_position(
+        &state.options,
+        &state.evaluations[start..end],
+        plan.cycle_origin.saturating_sub(start),
+        index.saturating_sub(start),
+    )
 }
 
 /// Where a cycle of the `beta` pattern searches.

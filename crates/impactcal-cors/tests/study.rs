@@ -9,7 +9,8 @@ use impactcal_core::{CoreError, Parameter, ParameterSpace};
 use impactcal_cors::design::{affine_rank, symmetric_design};
 use impactcal_cors::{
     AdaptiveRegion, CandidateDecay, Converged, Cors, CorsError, CorsOptions, FillReason,
-    InitialDesign, Mode, Origin, Perturbation, Restart, StopReason, Stopping, Transform,
+    InitialDesign, Mode, Origin, Perturbation, RepeatRefinement, Restart, StopReason, Stopping,
+    Transform,
 };
 
 fn unit_distance(space: &ParameterSpace, a: &[f64], b: &[f64]) -> f64 {
@@ -58,7 +59,11 @@ fn affine_rank_sees_collinear_points() {
 fn cors_points_respect_the_distance_constraint_and_cycle() {
     let f = test_functions::by_name("hartmann3").unwrap();
     let space = f.space().unwrap();
-    let mut study = Cors::new(space.clone(), CorsOptions::with_seed(3)).unwrap();
+    let options = CorsOptions {
+        repeat_refinement: None,
+        ..CorsOptions::with_seed(3)
+    };
+    let mut study = Cors::new(space.clone(), options).unwrap();
     let mut betas = Vec::new();
     for _ in 0..26 {
         let s = study.suggest(1).unwrap().pop().unwrap();
@@ -91,11 +96,51 @@ fn cors_points_respect_the_distance_constraint_and_cycle() {
     assert_eq!(betas, expected);
 }
 
+/// With the default repeated refinement, a step repeats the previous `beta` exactly when
+/// that was a refinement step (`beta <= 0.05`) whose result lowered the best by more than
+/// 0.1 % and the repeats in a row stay within 6; every other step takes the pattern's next
+/// value; and on this run the rule fires at least once.
+#[test]
+fn refinement_steps_repeat_while_they_improve() {
+    let pattern = [0.9, 0.75, 0.25, 0.05, 0.03, 0.0];
+    for seed in 0..4 {
+        let f = test_functions::by_name("hartmann3").unwrap();
+        let mut study = Cors::new(f.space().unwrap(), CorsOptions::with_seed(seed)).unwrap();
+        let (mut best, mut previous) = (f64::INFINITY, None::<(f64, bool)>);
+        let (mut position, mut repeats, mut fired) = (0usize, 0usize, 0usize);
+        for _ in 0..60 {
+            let s = study.suggest(1).unwrap().pop().unwrap();
+            let v = f.eval(&s.x);
+            if s.origin == Origin::Cors {
+                if let Some((beta, improved)) = previous {
+                    if beta <= 0.05 && improved && repeats < 6 {
+                        repeats += 1;
+                        fired += 1;
+                    } else {
+                        position += 1;
+                        repeats = 0;
+                    }
+                }
+                assert_eq!(s.beta, Some(pattern[position % 6]), "seed {seed}");
+                previous = Some((s.beta.unwrap(), v < best - 1e-3 * best.abs()));
+            }
+            best = best.min(v);
+            study.tell(s.id, v).unwrap();
+        }
+        assert!(fired > 0, "seed {seed}: no refinement step repeated");
+    }
+}
+
 #[test]
 fn every_second_cycle_searches_the_box_around_the_best() {
     let f = test_functions::by_name("hartmann3").unwrap();
     let space = f.space().unwrap();
-    let mut study = Cors::new(space.clone(), CorsOptions::with_seed(3)).unwrap();
+    // Cycles of six steps each: the pattern without repeated refinement.
+    let options = CorsOptions {
+        repeat_refinement: None,
+        ..CorsOptions::with_seed(3)
+    };
+    let mut study = Cors::new(space.clone(), options).unwrap();
     let mut outside = [0usize; 3];
     for n in 0..26 {
         let s = study.suggest(1).unwrap().pop().unwrap();
@@ -129,7 +174,7 @@ fn restarts_start_a_new_design_and_keep_the_history() {
         ..CorsOptions::with_seed(4)
     };
     // Long enough for steps of the new run after its design.
-    let n = 110;
+    let n = 105;
     let mut whole = Cors::new(f.space().unwrap(), options.clone()).unwrap();
     whole.minimize(|x| f.eval(x), n).unwrap();
     assert_eq!(whole.evaluations().len(), n);
@@ -361,7 +406,7 @@ fn from_history_matches_the_library_loop() {
 }
 
 /// The search options of the DYCORS and SRBF variants (coordinate perturbation, falling
-/// candidate count, weight cycle) keep a study a function of its history: resuming from
+/// candidate count, weight cycle) and repeated refinement keep a study a function of its history: resuming from
 /// JSON and rebuilding from the rows give the library loop's points bit for bit.
 #[test]
 fn search_variants_resume_and_replay_exactly() {
@@ -378,6 +423,13 @@ fn search_variants_resume_and_replay_exactly() {
         CorsOptions {
             merit_weights: Some(vec![0.3, 0.5, 0.8, 0.95]),
             ..CorsOptions::with_seed(6)
+        },
+        CorsOptions {
+            repeat_refinement: Some(RepeatRefinement {
+                max_beta: 0.25,
+                max_repeats: 2,
+            }),
+            ..CorsOptions::with_seed(12)
         },
         CorsOptions {
             local_escape: Some(3),
@@ -401,7 +453,7 @@ fn search_variants_resume_and_replay_exactly() {
                 shrink_box: false,
                 ..AdaptiveRegion::default()
             }),
-            ..CorsOptions::with_seed(9)
+            ..CorsOptions::with_seed(11)
         },
         CorsOptions {
             adaptive_region: Some(AdaptiveRegion {
@@ -445,7 +497,7 @@ fn search_variants_resume_and_replay_exactly() {
         };
         // The variant changes the search (after the common design of 14 points).
         assert_eq!(whole.evaluations()[..14], default.evaluations()[..14]);
-        assert_ne!(whole.evaluations(), default.evaluations());
+        assert_ne!(whole.evaluations(), default.evaluations(), "{options:?}");
         let mut first = Cors::new(f.space().unwrap(), options.clone()).unwrap();
         first.minimize(|x| f.eval(x), 23).unwrap();
         let mut resumed = Cors::from_json(&first.to_json().unwrap(), "state").unwrap();
@@ -695,6 +747,20 @@ fn options_are_validated() {
             ..CorsOptions::default()
         },
         CorsOptions {
+            repeat_refinement: Some(RepeatRefinement {
+                max_beta: f64::NAN,
+                max_repeats: 6,
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            repeat_refinement: Some(RepeatRefinement {
+                max_beta: 0.05,
+                max_repeats: 0,
+            }),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
             candidate_decay: Some(CandidateDecay {
                 min_per_dim: 0,
                 horizon: 300,
@@ -771,6 +837,7 @@ fn the_second_region_acts_and_replays_exactly() {
     let f = test_functions::by_name("hartmann6").unwrap();
     let with = CorsOptions {
         pattern: vec![0.5, 0.0],
+        repeat_refinement: None,
         ..CorsOptions::with_seed(12)
     };
     let without = CorsOptions {
