@@ -87,17 +87,10 @@ pub(crate) fn adaptive_width(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::Origin;
+    use crate::state::evaluations_with_values;
 
     fn evals(values: &[f64]) -> Vec<Evaluation> {
-        values
-            .iter()
-            .map(|&v| Evaluation {
-                x: vec![0.0],
-                value: Some(v),
-                origin: Origin::Cors,
-            })
-            .collect()
+        evaluations_with_values(&values.iter().map(|&v| Some(v)).collect::<Vec<_>>())
     }
 
     /// Halves after `shrink_after` failures, doubles (capped) after `grow_after`

@@ -53,18 +53,7 @@ pub(crate) fn pattern_position(
 mod tests {
     use super::*;
     use crate::options::RepeatRefinement;
-    use crate::state::Origin;
-
-    fn run(values: &[Option<f64>]) -> Vec<Evaluation> {
-        values
-            .iter()
-            .map(|&value| Evaluation {
-                x: vec![0.0],
-                value,
-                origin: Origin::Cors,
-            })
-            .collect()
-    }
+    use crate::state::evaluations_with_values as run;
 
     fn betas(options: &CorsOptions, values: &[Option<f64>], cycle_start: usize) -> Vec<f64> {
         let r = run(values);

@@ -54,18 +54,7 @@ impl StallRule {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::Origin;
-
-    fn evals(values: &[Option<f64>]) -> Vec<Evaluation> {
-        values
-            .iter()
-            .map(|&value| Evaluation {
-                x: vec![0.0],
-                value,
-                origin: Origin::Existing,
-            })
-            .collect()
-    }
+    use crate::state::evaluations_with_values as evals;
 
     #[test]
     fn counts_since_the_last_substantial_improvement() {

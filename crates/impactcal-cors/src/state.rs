@@ -458,3 +458,17 @@ pub(crate) fn best_of(evaluations: &[Evaluation]) -> Option<&Evaluation> {
     }
     best
 }
+
+/// Evaluations at the origin of a one-dimensional box with the given values (`None`:
+/// failed), for the tests of the rules that walk a run's results.
+#[cfg(test)]
+pub(crate) fn evaluations_with_values(values: &[Option<f64>]) -> Vec<Evaluation> {
+    values
+        .iter()
+        .map(|&value| Evaluation {
+            x: vec![0.0],
+            value,
+            origin: Origin::Cors,
+        })
+        .collect()
+}
