@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
 use impactcal::core::{Samples, Table, TableOptions, read_samples, read_text};
 use impactcal::erbf::{
-    ErbfError, FitOptions, LooMethod, OutputBasis, ResponseSurrogate, SurrogateKind, Tuning,
+    ErbfError, FitOptions, LOO_ROUND_OFF, LooMethod, OutputBasis, ResponseSurrogate, SurrogateKind,
+    Tuning,
 };
 
 use impactcal::erbf::{ComponentOptions, RadialFunction, SurrogateModel};
@@ -216,7 +217,7 @@ fn describe_options(o: &ComponentOptions) -> String {
 const MAX_LISTED: usize = 20;
 
 /// Prints the leave-one-out error, beside the linear trend's, and warns where the model
-/// is worse than the trend.
+/// is worse than the trend (beyond round-off, [`LOO_ROUND_OFF`]).
 fn report_loo(model: &ResponseSurrogate) {
     let cmp = match model.loo_against_trend(LooMethod::Auto) {
         Ok(c) => c,
@@ -226,47 +227,82 @@ fn report_loo(model: &ResponseSurrogate) {
         }
     };
     let s = cmp.summary;
+    let pooled = if s.relative_rms.is_nan() {
+        "undefined (every output is constant over the samples)".to_string()
+    } else {
+        relative(s.relative_rms)
+    };
     eprintln!(
-        "leave-one-out error: rms {:.6e}, max {:.6e}, rms / std(F) {:.4}",
-        s.rms, s.max_abs, s.relative_rms
+        "leave-one-out error: rms {:.6e}, max {:.6e}, rms / std(F) {pooled}",
+        s.rms, s.max_abs
     );
     let names = model.output_names();
     if names.len() <= MAX_LISTED {
         for (c, name) in names.iter().enumerate() {
-            eprintln!(
-                "  {name}: leave-one-out rms / std {:.4}, linear trend {:.4}",
-                cmp.model[c], cmp.trend[c]
-            );
+            if cmp.model[c].is_nan() {
+                eprintln!("  {name}: constant over the samples; the surrogate reproduces it");
+            } else {
+                eprintln!(
+                    "  {name}: leave-one-out rms / std {}, linear trend {}",
+                    relative(cmp.model[c]),
+                    relative(cmp.trend[c])
+                );
+            }
         }
     } else {
         eprintln!(
-            "linear trend leave-one-out rms / std(F) {:.4} (pooled over {} outputs)",
-            cmp.pooled_trend,
+            "linear trend leave-one-out rms / std(F) {} (pooled over {} outputs)",
+            relative(cmp.pooled_trend),
             names.len()
         );
     }
     let worse = cmp.worse_than_trend();
     if names.len() <= MAX_LISTED {
         for c in worse {
-            eprintln!(
-                "warning: {}: the leave-one-out error ({:.4} of std) is {:.2}x that of a \
-                 linear trend ({:.4}): the surrogate fits noise or its width does not suit \
-                 the samples; try --auto, --kind auto, or a linear model",
-                names[c],
-                cmp.model[c],
-                cmp.model[c] / cmp.trend[c],
-                cmp.trend[c]
-            );
+            if cmp.trend[c] < LOO_ROUND_OFF {
+                eprintln!(
+                    "warning: {}: a linear trend reproduces this output to round-off \
+                     ({:.1e} of std) where the surrogate's leave-one-out error is {} of std: \
+                     the output is linear in the parameters; a linear model, or --kind cubic \
+                     or thin-plate (their linear tail reproduces it), fits it exactly",
+                    names[c],
+                    cmp.trend[c],
+                    relative(cmp.model[c])
+                );
+            } else {
+                eprintln!(
+                    "warning: {}: the leave-one-out error ({} of std) is {:.2}x that of a \
+                     linear trend ({}): the surrogate fits noise or its width does not suit \
+                     the samples; try --auto, --kind auto, or a linear model",
+                    names[c],
+                    relative(cmp.model[c]),
+                    cmp.model[c] / cmp.trend[c],
+                    relative(cmp.trend[c])
+                );
+            }
         }
-    } else if !worse.is_empty() || cmp.pooled_model > cmp.pooled_trend {
+    } else if !worse.is_empty() || cmp.pooled_worse_than_trend() {
         eprintln!(
             "warning: the leave-one-out error is worse than a linear trend's on {} of {} \
-             outputs (pooled {:.4} against {:.4} of std); try --auto or --kind auto",
+             outputs (pooled {} against {} of std); try --auto or --kind auto",
             worse.len(),
             names.len(),
-            cmp.pooled_model,
-            cmp.pooled_trend
+            relative(cmp.pooled_model),
+            relative(cmp.pooled_trend)
         );
+    }
+}
+
+/// A relative error for the summaries: four decimals, small values in exponent form so that
+/// round-off does not print as `0.0000`, `undefined` for `NaN` (too few samples for the
+/// linear trend).
+fn relative(x: f64) -> String {
+    if x.is_nan() {
+        "undefined".into()
+    } else if x > 0.0 && x < 1e-3 {
+        format!("{x:.2e}")
+    } else {
+        format!("{x:.4}")
     }
 }
 

@@ -331,3 +331,42 @@ fn fit_warns_when_worse_than_a_linear_trend() {
     let (model, trend) = (nums[nums.len() - 2], nums[nums.len() - 1]);
     assert!(model <= 1.05 * trend, "{line}");
 }
+
+/// Outputs a linear trend reproduces exactly (a plane) or that never change (a constant, as
+/// a history's first instants often are): no `NaN` and no round-off ratio in the summary; a
+/// kernel whose linear tail reproduces the plane draws no warning, one without a tail is
+/// told the output is linear.
+#[test]
+fn linear_and_constant_outputs_are_summarised_without_nan_or_false_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("bounds.csv"),
+        "name,lower,upper,nominal\na,0,1,0.5\nb,0,1,0.5\n",
+    )
+    .unwrap();
+    let n = 20;
+    let mut p = String::from("a,b\n");
+    let mut y = String::from("plane,constant\n");
+    for i in 0..n {
+        let a = (i as f64 + 0.5) / n as f64;
+        let b = (((7 * i + 3) % n) as f64 + 0.5) / n as f64;
+        p.push_str(&format!("{a},{b}\n"));
+        y.push_str(&format!("{},4.5\n", 2.0 * a - b));
+    }
+    std::fs::write(dir.path().join("P.csv"), p).unwrap();
+    std::fs::write(dir.path().join("Y.csv"), y).unwrap();
+    for kind in ["cubic", "thin-plate", "auto"] {
+        let (code, _, err) = fit_in(dir.path(), &["--kind", kind]);
+        assert_eq!(code, 0, "{kind}: {err}");
+        assert!(!err.contains("NaN") && !err.contains("warning"), "{kind}: {err}");
+        assert!(err.contains("constant: constant over the samples"), "{err}");
+    }
+    let (code, _, err) = fit_in(dir.path(), &["--kind", "gaussian"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("NaN"), "{err}");
+    assert!(
+        err.contains("warning: plane: a linear trend reproduces this output to round-off"),
+        "{err}"
+    );
+    assert!(!err.contains("warning: constant"), "{err}");
+}

@@ -329,7 +329,11 @@ impl Histories {
                 return Err(err(
                     table.lines[k],
                     1,
-                    format!("non-uniform time step {step} (mean step {mean_dt})"),
+                    format!(
+                        "non-uniform time step {step} (mean step {mean_dt}); resample the record onto \
+                         a uniform step first (`impactcal convert --csv`, or \
+                         `signal::resample_uniform`)"
+                    ),
                 ));
             }
         }

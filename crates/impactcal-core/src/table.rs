@@ -186,6 +186,18 @@ impl Table {
             }
         };
         let header_row = record_line(&header_record);
+        if let Some(separator) = foreign_separator(&header_record) {
+            return Err(csv_error(
+                header_row,
+                1,
+                format!(
+                    "the header is one field containing `{separator}`: the file is separated by \
+                     {}, and impactcal reads comma-separated files (export with `,` between \
+                     fields and `.` as the decimal mark)",
+                    separator_name(separator)
+                ),
+            ));
+        }
         let mut header: Vec<String> = Vec::with_capacity(header_record.len());
         for (j, name) in header_record.iter().enumerate() {
             if name.is_empty() {
@@ -331,6 +343,25 @@ pub(crate) fn write_row(out: &mut impl Write, row: &[f64]) -> std::io::Result<()
     out.write_all(line.as_bytes())
 }
 
+/// The separator of a file exported with another delimiter than the comma (a spreadsheet's
+/// semicolon, a tab or a `|`): the header is then one field that contains it.
+fn foreign_separator(header: &csv::StringRecord) -> Option<char> {
+    if header.len() != 1 {
+        return None;
+    }
+    [';', '\t', '|']
+        .into_iter()
+        .find(|&c| header[0].contains(c))
+}
+
+fn separator_name(separator: char) -> &'static str {
+    match separator {
+        ';' => "semicolons",
+        '\t' => "tabs",
+        _ => "`|`",
+    }
+}
+
 fn csv_read_error(source_name: &str, e: &csv::Error) -> CoreError {
     match e.position() {
         Some(p) => CoreError::Csv {
@@ -409,6 +440,24 @@ mod tests {
             parse("a,b\n").unwrap_err(),
             CoreError::File { .. }
         ));
+    }
+
+    #[test]
+    fn files_with_another_separator_are_named() {
+        for (text, name) in [
+            ("time;a.x;b.x\n0;1,5;2\n", "semicolons"),
+            ("\n\ntime\ta.x\n0\t1\n", "tabs"),
+            ("a|b\n1|2\n", "`|`"),
+        ] {
+            let err = parse(text).unwrap_err();
+            let message = err.to_string();
+            assert!(message.contains(name), "{message}");
+            assert!(message.contains("comma-separated"), "{message}");
+            let header_line = text.lines().position(|l| !l.is_empty()).unwrap() + 1;
+            assert_eq!(position(err), (header_line, 1));
+        }
+        // One column whose name has none of them is an ordinary single-column table.
+        assert_eq!(parse("a\n1\n").unwrap().header(), &["a"]);
     }
 
     #[test]

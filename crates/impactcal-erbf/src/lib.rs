@@ -97,6 +97,8 @@ pub use options::{ErbfOptions, FamilyWeights, ValidErbfOptions};
 pub use radial::{PolyDegree, RadialFunction};
 pub use rbf::{RbfInterpolant, RbfOptions, ValidRbfOptions};
 pub use shape_basis::{ShapeBasis, ShapeSpectrum};
-pub use surrogate::{FitOptions, LooComparison, ResponseSurrogate, SurrogateKind, SurrogateModel};
+pub use surrogate::{
+    FitOptions, LOO_ROUND_OFF, LooComparison, ResponseSurrogate, SurrogateKind, SurrogateModel,
+};
 pub use trend::linear_trend_loo;
 pub use tuning::ComponentOptions;

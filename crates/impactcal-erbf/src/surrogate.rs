@@ -112,15 +112,32 @@ pub struct LooComparison {
     pub summary: ErrorSummary,
 }
 
+/// Leave-one-out errors (as `rms / std`) below this are round-off: an output that both the
+/// surrogate and the linear trend reproduce to this level is not one where the surrogate
+/// does worse (an output linear in the parameters gives `1e-15` against `1e-14`).
+pub const LOO_ROUND_OFF: f64 = 1e-8;
+
 impl LooComparison {
     /// The outputs whose leave-one-out error exceeds the linear trend's: where the
     /// surrogate, by its own cross-validation, does worse than a straight line (fitting
-    /// noise, or a shape parameter unsuited to the sample spacing).
+    /// noise, or a shape parameter unsuited to the sample spacing). An output counts when
+    /// its error exceeds both the trend's and [`LOO_ROUND_OFF`]; an undefined error on
+    /// either side (`NaN`: a constant output, or too few samples for the trend) never does.
     pub fn worse_than_trend(&self) -> Vec<usize> {
         (0..self.model.len())
-            .filter(|&c| self.model[c] > self.trend[c])
+            .filter(|&c| exceeds_trend(self.model[c], self.trend[c]))
             .collect()
     }
+
+    /// Whether the pooled error exceeds the pooled trend's, by the rule of
+    /// [`LooComparison::worse_than_trend`].
+    pub fn pooled_worse_than_trend(&self) -> bool {
+        exceeds_trend(self.pooled_model, self.pooled_trend)
+    }
+}
+
+fn exceeds_trend(model: f64, trend: f64) -> bool {
+    !trend.is_nan() && model > trend.max(LOO_ROUND_OFF)
 }
 
 /// The fitted model inside a [`ResponseSurrogate`].
@@ -387,5 +404,37 @@ impl ResponseSurrogate {
             SurrogateModel::Rbf { interpolant, .. } => interpolant.values(),
             SurrogateModel::Components(c) => c.values(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn comparison(model: Vec<f64>, trend: Vec<f64>) -> LooComparison {
+        LooComparison {
+            pooled_model: model[0],
+            pooled_trend: trend[0],
+            model,
+            trend,
+            summary: ErrorSummary {
+                rms: 0.0,
+                max_abs: 0.0,
+                relative_rms: 0.0,
+            },
+        }
+    }
+
+    #[test]
+    fn worse_than_trend_ignores_round_off_and_undefined_errors() {
+        let c = comparison(
+            vec![0.30, 0.05, 1.5e-14, 0.20, f64::NAN, 0.10],
+            vec![0.20, 0.10, 1.0e-15, f64::NAN, f64::NAN, 3.0e-16],
+        );
+        // Worse: a real margin (0), and a linear output the trend reproduces exactly (5).
+        assert_eq!(c.worse_than_trend(), vec![0, 5]);
+        assert!(c.pooled_worse_than_trend());
+        assert!(!comparison(vec![2e-9], vec![1e-12]).pooled_worse_than_trend());
+        assert!(!comparison(vec![0.5], vec![f64::NAN]).pooled_worse_than_trend());
     }
 }
