@@ -51,7 +51,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ..CompareOptions::default()
     };
     let comparison = compare(&test, &model, &pairs, &options)?;
+    if let Some((t0, t1)) = window {
+        let [u0, u1] = comparison.window;
+        if u0 - t0 > comparison.dt || t1 - u1 > comparison.dt {
+            eprintln!(
+                "note: the test has samples over [{}, {}] of the window [{t0}, {t1}]; the \
+                 metrics cover that range",
+                significant(u0),
+                significant(u1)
+            );
+        }
+    }
     write_json(&comparison, args.out.as_deref())
+}
+
+/// `x` rounded to seven significant digits, for messages (sample times carry the
+/// round-off of `start + k dt`).
+fn significant(x: f64) -> f64 {
+    format!("{x:.6e}").parse().unwrap_or(x)
 }
 
 /// Parses `T0,T1`.

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
 use faer::Mat;
 use impactcal::core::ParamGuard;
-use impactcal::core::{CoreError, ParameterSpace, Table, TableOptions, read_samples};
+use impactcal::core::{CoreError, ParameterSpace, Samples, Table, TableOptions};
 use impactcal::cors::{
     AdaptiveRegion, CandidateDecay, Converged, Cors, CorsOptions, InitialDesign, Perturbation,
     RepeatRefinement, Restart, SurrogateKernel, Transform,
@@ -299,9 +299,36 @@ fn read_history(
         allow_missing: true,
         allow_no_rows: true,
     };
-    let mut samples = read_samples(path, space, &["objective"], options)?;
+    let table = Table::read(path, options)?;
+    let mut samples = table.samples(space, &["objective"])?;
+    check_inside(space, &table, &samples)?;
     let values = samples.also.pop().unwrap_or_default();
     Ok((samples.points, values))
+}
+
+/// The first history value outside its bounds, as a positioned error (line and column of
+/// the file); the optimiser would otherwise name only the point's index. The slack is the
+/// optimiser's own (`1e-12` of the width), so that what passes here passes there.
+fn check_inside(space: &ParameterSpace, table: &Table, samples: &Samples) -> Result<(), CliError> {
+    for (i, &line) in samples.lines.iter().enumerate() {
+        for (j, p) in space.parameters().iter().enumerate() {
+            let v = samples.points[(i, j)];
+            let slack = 1e-12 * p.width();
+            if v < p.lower - slack || v > p.upper + slack {
+                return Err(CoreError::Csv {
+                    file: table.source().to_string(),
+                    row: line,
+                    column: table.column_index(&p.name).map_or(0, |c| c + 1),
+                    message: format!(
+                        "parameter `{}` = {v} lies outside its bounds [{}, {}]",
+                        p.name, p.lower, p.upper
+                    ),
+                }
+                .into());
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Whether the directory that would hold `path` exists (the current directory for a bare

@@ -384,7 +384,7 @@ fn bad_history_is_an_input_error() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("history row 1") && err.contains("outside"),
+        err.contains("row 2, column 1: parameter `x1` = 100 lies outside"),
         "{err}"
     );
 }

@@ -358,7 +358,10 @@ fn linear_and_constant_outputs_are_summarised_without_nan_or_false_warnings() {
     for kind in ["cubic", "thin-plate", "auto"] {
         let (code, _, err) = fit_in(dir.path(), &["--kind", kind]);
         assert_eq!(code, 0, "{kind}: {err}");
-        assert!(!err.contains("NaN") && !err.contains("warning"), "{kind}: {err}");
+        assert!(
+            !err.contains("NaN") && !err.contains("warning"),
+            "{kind}: {err}"
+        );
         assert!(err.contains("constant: constant over the samples"), "{err}");
     }
     let (code, _, err) = fit_in(dir.path(), &["--kind", "gaussian"]);

@@ -234,20 +234,26 @@ fn bad_input_is_one_line_and_exit_2() {
         &["metrics", "--test", s(&test), "--analysis", s(&short)],
         "restrict the comparison window",
     );
-    // ... which the window then allows.
-    assert!(
-        impactcal(&[
+    // ... which the window then allows, without a note; a window reaching past the test's
+    // end is cut to it, and the note says so.
+    for (window, note) in [("0,0.025", false), ("0.01,5", true)] {
+        let out = impactcal(&[
             "metrics",
             "--test",
             s(&test),
             "--analysis",
-            s(&short),
+            s(if note { &test } else { &short }),
             "--window",
-            "0,0.025"
-        ])
-        .status
-        .success()
-    );
+            window,
+        ]);
+        assert!(out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            err.contains("note: the test has samples over [0.01, 0.0399"),
+            note,
+            "{window}: {err}"
+        );
+    }
     let back = dir.path().join("back.csv");
     std::fs::write(&back, "time,a\n0,1\n0.001,2\n0.0005,3\n").unwrap();
     bad_input(
