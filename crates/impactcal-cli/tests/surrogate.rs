@@ -296,24 +296,11 @@ fn shape_basis_fit_reproduces_the_training_runs_within_its_truncation() {
 #[test]
 fn fit_warns_when_worse_than_a_linear_trend() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("bounds.csv"),
-        "name,lower,upper,nominal\na,0,1,0.5\nb,0,1,0.5\n",
-    )
-    .unwrap();
-    let n = 60;
-    let mut p = String::from("a,b\n");
-    let mut y = String::from("y\n");
-    for i in 0..n {
-        let a = (i as f64 + 0.5) / n as f64;
-        let b = (((17 * i + 5) % n) as f64 + 0.5) / n as f64;
+    write_unit_square_case(dir.path(), 60, (17, 5), "y", |i, a, b| {
         // Deterministic "noise" of amplitude 0.5 on a plane of range 3.
         let noise = 0.5 * ((i * 7919 % 101) as f64 / 50.0 - 1.0);
-        p.push_str(&format!("{a},{b}\n"));
-        y.push_str(&format!("{}\n", 1.0 + 2.0 * a + b + noise));
-    }
-    std::fs::write(dir.path().join("P.csv"), p).unwrap();
-    std::fs::write(dir.path().join("Y.csv"), y).unwrap();
+        format!("{}", 1.0 + 2.0 * a + b + noise)
+    });
     let fit = |extra: &[&str]| fit_in(dir.path(), extra);
     let (code, _, err) = fit(&["--kind", "cubic"]);
     assert_eq!(code, 0, "{err}");
@@ -339,22 +326,9 @@ fn fit_warns_when_worse_than_a_linear_trend() {
 #[test]
 fn linear_and_constant_outputs_are_summarised_without_nan_or_false_warnings() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("bounds.csv"),
-        "name,lower,upper,nominal\na,0,1,0.5\nb,0,1,0.5\n",
-    )
-    .unwrap();
-    let n = 20;
-    let mut p = String::from("a,b\n");
-    let mut y = String::from("plane,constant\n");
-    for i in 0..n {
-        let a = (i as f64 + 0.5) / n as f64;
-        let b = (((7 * i + 3) % n) as f64 + 0.5) / n as f64;
-        p.push_str(&format!("{a},{b}\n"));
-        y.push_str(&format!("{},4.5\n", 2.0 * a - b));
-    }
-    std::fs::write(dir.path().join("P.csv"), p).unwrap();
-    std::fs::write(dir.path().join("Y.csv"), y).unwrap();
+    write_unit_square_case(dir.path(), 20, (7, 3), "plane,constant", |_, a, b| {
+        format!("{},4.5", 2.0 * a - b)
+    });
     for kind in ["cubic", "thin-plate", "auto"] {
         let (code, _, err) = fit_in(dir.path(), &["--kind", kind]);
         assert_eq!(code, 0, "{kind}: {err}");
@@ -372,4 +346,31 @@ fn linear_and_constant_outputs_are_summarised_without_nan_or_false_warnings() {
         "{err}"
     );
     assert!(!err.contains("warning: constant"), "{err}");
+}
+
+/// Writes `bounds.csv` (a, b on [0, 1]), `P.csv` with `n` points of a stratified design
+/// (a in order, b permuted by `i -> (step i + shift) mod n`) and `Y.csv` with `header` and
+/// the row `row(i, a, b)` of each point.
+fn write_unit_square_case(
+    dir: &Path,
+    n: usize,
+    (step, shift): (usize, usize),
+    header: &str,
+    row: impl Fn(usize, f64, f64) -> String,
+) {
+    std::fs::write(
+        dir.join("bounds.csv"),
+        "name,lower,upper,nominal\na,0,1,0.5\nb,0,1,0.5\n",
+    )
+    .unwrap();
+    let mut p = String::from("a,b\n");
+    let mut y = format!("{header}\n");
+    for i in 0..n {
+        let a = (i as f64 + 0.5) / n as f64;
+        let b = (((step * i + shift) % n) as f64 + 0.5) / n as f64;
+        p.push_str(&format!("{a},{b}\n"));
+        y.push_str(&format!("{}\n", row(i, a, b)));
+    }
+    std::fs::write(dir.join("P.csv"), p).unwrap();
+    std::fs::write(dir.join("Y.csv"), y).unwrap();
 }
