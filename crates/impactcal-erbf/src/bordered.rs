@@ -46,6 +46,7 @@ use impactcal_core::error::{check_finite, dimension_mismatch};
 
 use crate::error::{ErbfError, Result};
 use crate::radial::RadialFunction;
+use crate::rbf::distance;
 
 /// A bordered pivot at most this fraction of the largest pivot triggers a full
 /// factorisation with partial pivoting.
@@ -348,7 +349,7 @@ impl BorderedRbf {
                 a[(q + i, l)] = *t;
             }
             for (k, r) in pts.iter().enumerate() {
-                a[(q + i, q + k)] = self.radial.value(distance(p, r));
+                a[(q + i, q + k)] = self.radial.value(distance(*p, *r));
             }
         }
         let lu = crate::lu::Lu::new(a);
@@ -373,14 +374,6 @@ impl BorderedRbf {
             max_pivot,
         })
     }
-}
-
-fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y) * (x - y))
-        .sum::<f64>()
-        .sqrt()
 }
 
 impl RbfCoefficients {

@@ -222,7 +222,7 @@ impl RbfInterpolant {
             ));
         }
         let (lower, upper) = bounding_box(points);
-        let diameter = diameter(&lower, &upper);
+        let diameter = distance(&lower, &upper);
         let tol = options.duplicate_tolerance * diameter;
         if let Some((first, second, distance)) = find_duplicate(points, tol) {
             return Err(ErbfError::DuplicateSamples {
@@ -351,12 +351,12 @@ impl RbfInterpolant {
         let all_points = stack_rows(self.points.as_ref(), points);
         let all_values = stack_rows(self.values.as_ref(), values);
         let (lower, upper) = bounding_box(all_points.as_ref());
-        let tol = self.options.duplicate_tolerance * diameter(&lower, &upper);
+        let tol = self.options.duplicate_tolerance * distance(&lower, &upper);
         let n_old = self.points.nrows();
         let n_all = all_points.nrows();
         for j in n_old..n_all {
             for i in 0..j {
-                let dist = distance(all_points.row(i), all_points.row(j));
+                let dist = distance(all_points.row(i).iter(), all_points.row(j).iter());
                 if dist <= tol {
                     return Err(ErbfError::DuplicateSamples {
                         first: i,
@@ -374,7 +374,7 @@ impl RbfInterpolant {
             if i < n_old && j < n_old {
                 old[(i, j)]
             } else {
-                let r = distance(all_points.row(i), all_points.row(j));
+                let r = distance(all_points.row(i).iter(), all_points.row(j).iter());
                 radial.value(r) + if i == j { smoothing } else { 0.0 }
             }
         });
@@ -741,7 +741,7 @@ impl RbfInterpolant {
     fn basis_row(&self, x: &[f64], out: &mut [f64]) {
         let n_pts = self.n_samples();
         for (i, o) in out.iter_mut().enumerate().take(n_pts) {
-            let r = distance_slice(x, self.points.row(i));
+            let r = distance(x, self.points.row(i).iter());
             *o = self.options.radial.value(r);
         }
         tail_row(
@@ -832,7 +832,7 @@ fn radial_matrix(options: &RbfOptions, points: MatRef<'_, f64>) -> Mat<f64> {
         .enumerate()
         .for_each(|(j, mut col)| {
             for i in 0..n {
-                let r = distance(points.row(i), points.row(j));
+                let r = distance(points.row(i).iter(), points.row(j).iter());
                 col[(i, 0)] =
                     options.radial.value(r) + if i == j { options.smoothing } else { 0.0 };
             }
@@ -866,14 +866,6 @@ pub(crate) fn bounding_box(points: MatRef<'_, f64>) -> (Vec<f64>, Vec<f64>) {
     (lo, hi)
 }
 
-fn diameter(lo: &[f64], hi: &[f64]) -> f64 {
-    lo.iter()
-        .zip(hi)
-        .map(|(l, h)| (h - l) * (h - l))
-        .sum::<f64>()
-        .sqrt()
-}
-
 pub(crate) fn outside_box(lo: &[f64], hi: &[f64], x: &[f64]) -> bool {
     x.len() != lo.len()
         || x.iter().zip(lo.iter().zip(hi)).any(|(&v, (&l, &h))| {
@@ -882,17 +874,14 @@ pub(crate) fn outside_box(lo: &[f64], hi: &[f64], x: &[f64]) -> bool {
         })
 }
 
-fn distance(a: faer::RowRef<'_, f64>, b: faer::RowRef<'_, f64>) -> f64 {
-    a.iter()
-        .zip(b.iter())
-        .map(|(x, y)| (x - y) * (x - y))
-        .sum::<f64>()
-        .sqrt()
-}
-
-fn distance_slice(a: &[f64], b: faer::RowRef<'_, f64>) -> f64 {
-    a.iter()
-        .zip(b.iter())
+/// Euclidean distance `||a - b||_2` of two points given as coordinate sequences of one
+/// length (slices, or faer rows through `.iter()`).
+pub(crate) fn distance<'a>(
+    a: impl IntoIterator<Item = &'a f64>,
+    b: impl IntoIterator<Item = &'a f64>,
+) -> f64 {
+    a.into_iter()
+        .zip(b)
         .map(|(x, y)| (x - y) * (x - y))
         .sum::<f64>()
         .sqrt()
