@@ -68,8 +68,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let started = std::time::Instant::now();
     let (noise, group): (SimulationNoise, Grouping) = match &args.source.deck {
         Some(path) => {
-            let model =
-                DeckModel::from_deck(args.source.deck(path)?, None).map_err(CliError::input)?;
+            let model = DeckModel::from_deck(args.source.deck(path)?, None)
+                .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
             let point = model.space().nominal();
             let noise = measure(&pool, &model, &point, &options)?;
             (noise, Box::new(|l: &str| axis(l).to_string()))

@@ -177,7 +177,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             sim.run()
         }
     });
-    let result = result?;
+    let result = result.map_err(|e| CliError::from(e).context(&name))?;
     let wall = started.elapsed().as_secs_f64();
     let q = match args.quantity {
         QuantityArg::Velocity => Quantity::Velocity,

@@ -621,7 +621,8 @@ fn deck_model(
     deck.warnings
         .iter()
         .for_each(|w| eprintln!("impactcal: warning: {w}"));
-    let model = DeckModel::new(deck.model).map_err(CliError::input)?;
+    let model = DeckModel::new(deck.model)
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
     let fields_of = |name: &str| {
         config
             .parameters

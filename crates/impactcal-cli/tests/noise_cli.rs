@@ -110,7 +110,18 @@ fn bad_input_exits_with_code_two_and_one_line() {
         .unwrap()
         .replace("*DATABASE_HISTORY_NODE\n        21        42\n", "");
     std::fs::write(&no_history, text).unwrap();
+    // A deck the solver refuses is named with what is wrong, before any run and before
+    // its zero modulus could make empty bounds.
+    let soft = dir.path().join("soft.k");
+    let text = std::fs::read_to_string(deck)
+        .unwrap()
+        .replace("2.1e+11", "0.0    ");
+    std::fs::write(&soft, text).unwrap();
     for (args, needle) in [
+        (
+            vec!["--deck", soft.to_str().unwrap()],
+            "soft.k: material 1, Young's modulus: must be finite and positive",
+        ),
         (vec!["--deck", deck, "--runs", "1"], "at least 2 runs"),
         (vec!["--deck", deck, "--eps", "0"], "eps"),
         (vec!["--deck", deck, "--fraction", "0"], "--fraction"),

@@ -74,6 +74,37 @@ fn a_bad_deck_is_an_input_error_naming_the_line() {
     );
 }
 
+/// Errors found when the deck becomes a model (a node an element needs, a value out of
+/// range) name the deck too, not only the ids.
+#[test]
+fn a_model_error_names_the_deck() {
+    let dir = tempfile::tempdir().unwrap();
+    let deck = std::fs::read_to_string(example_file("decks", "strip_drop.k")).unwrap();
+    let node_21 = deck
+        .lines()
+        .find(|l| l.split_whitespace().next() == Some("21") && l.contains("0.500000"))
+        .unwrap();
+    for (name, text, message) in [
+        (
+            "missing.k",
+            deck.replace(&format!("{node_21}\n"), ""),
+            "node 21: referenced by shell",
+        ),
+        (
+            "soft.k",
+            deck.replace("2.1e+11", "0.0    "),
+            "material 1, Young's modulus",
+        ),
+    ] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = impactcal(&["simulate", "--deck", path.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{name}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(&format!("{name}: {message}")), "{err}");
+    }
+}
+
 #[test]
 fn every_unsupported_keyword_is_named_on_one_line() {
     let dir = tempfile::tempdir().unwrap();

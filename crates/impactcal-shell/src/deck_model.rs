@@ -344,9 +344,11 @@ impl DeckModel {
     /// concentrated mass as a parameter; the output is the velocity of the history nodes.
     ///
     /// # Errors
-    /// [`ShellError::Value`] when the model has no history nodes (nothing to output) or a
-    /// value cannot bound a parameter (not finite and positive).
+    /// As [`ShellModel::check`] for a model the solver would refuse; [`ShellError::Value`]
+    /// when the model has no history nodes (nothing to output) or a value cannot bound a
+    /// parameter (not finite and positive).
     pub fn new(model: ShellModel) -> Result<Self> {
+        model.check()?;
         check_outputs(&model)?;
         let quantities = quantities(&model)?;
         let (params, targets) = quantities
@@ -373,7 +375,8 @@ impl DeckModel {
     /// history nodes.
     ///
     /// # Errors
-    /// [`ShellError::Value`] when the model has no history nodes, a bound names a parameter
+    /// As [`ShellModel::check`] for a model the solver would refuse; [`ShellError::Value`]
+    /// when the model has no history nodes, a bound names a parameter
     /// the deck does not define (or the deck defines none), or a deck value of 0 would be
     /// bounded without bounds given.
     pub fn from_deck(deck: Deck, bounds: Option<&ParameterSpace>) -> Result<Self> {
@@ -387,6 +390,7 @@ impl DeckModel {
             }
             return DeckModel::new(deck.model);
         }
+        deck.model.check()?;
         check_outputs(&deck.model)?;
         let space = match bounds {
             Some(space) => {

@@ -502,6 +502,16 @@ impl ShellModel {
         }
     }
 
+    /// Checks the model as [`Simulation::new`](crate::Simulation::new) does before a run,
+    /// without allocating the run's state: every id referenced and defined once, element
+    /// geometry, and every value in range.
+    ///
+    /// # Errors
+    /// As [`Simulation::new`](crate::Simulation::new).
+    pub fn check(&self) -> crate::Result<()> {
+        crate::setup::compile(self).map(|_| ())
+    }
+
     /// Adds a node.
     pub fn add_node(&mut self, id: u64, x: [f64; 3]) -> &mut Self {
         self.nodes.push(Node { id, x });
