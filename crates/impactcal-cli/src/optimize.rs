@@ -307,14 +307,13 @@ fn read_history(
 }
 
 /// The first history value outside its bounds, as a positioned error (line and column of
-/// the file); the optimiser would otherwise name only the point's index. The slack is the
-/// optimiser's own (`1e-12` of the width), so that what passes here passes there.
+/// the file); the optimiser would otherwise name only the point's index. The rule is the
+/// optimiser's own ([`Parameter::admits`](impactcal::core::Parameter::admits)).
 fn check_inside(space: &ParameterSpace, table: &Table, samples: &Samples) -> Result<(), CliError> {
     for (i, &line) in samples.lines.iter().enumerate() {
         for (j, p) in space.parameters().iter().enumerate() {
             let v = samples.points[(i, j)];
-            let slack = 1e-12 * p.width();
-            if v < p.lower - slack || v > p.upper + slack {
+            if !p.admits(v) {
                 return Err(CoreError::Csv {
                     file: table.source().to_string(),
                     row: line,

@@ -53,6 +53,13 @@ impl Parameter {
         self.upper - self.lower
     }
 
+    /// Whether `v` lies in `[lower, upper]` up to `1e-12` of the width (the round-off of a
+    /// value mapped to the unit cube and back); `false` for NaN.
+    pub fn admits(&self, v: f64) -> bool {
+        let slack = 1e-12 * self.width();
+        v >= self.lower - slack && v <= self.upper + slack
+    }
+
     /// Checks the invariants stated on [`Parameter::new`].
     ///
     /// # Errors
@@ -443,6 +450,17 @@ mod tests {
         assert_eq!(s.from_unit(&[0.0, 1.0]).unwrap(), vec![-1.0, 20.0]);
         assert!(s.to_unit(&[1.0]).is_err());
         assert!(s.to_unit(&[f64::NAN, 1.0]).is_err());
+    }
+
+    #[test]
+    fn admits_the_bounds_up_to_round_off() {
+        let p = Parameter::new("t", 1.0, 3.0, 2.0).unwrap();
+        for v in [1.0, 2.5, 3.0, 1.0 - 1e-13, 3.0 + 1e-13] {
+            assert!(p.admits(v), "{v}");
+        }
+        for v in [1.0 - 1e-11, 3.0 + 1e-11, f64::NAN, f64::INFINITY] {
+            assert!(!p.admits(v), "{v}");
+        }
     }
 
     #[test]

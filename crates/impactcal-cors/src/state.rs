@@ -388,8 +388,7 @@ impl CorsState {
                 }
                 .into());
             }
-            let slack = 1e-12 * p.width();
-            if *v < p.lower - slack || *v > p.upper + slack {
+            if !p.admits(*v) {
                 return Err(CorsError::OutOfBounds {
                     what: what.into(),
                     parameter: p.name.clone(),
