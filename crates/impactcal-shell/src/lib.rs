@@ -29,7 +29,7 @@
 //! ```
 //! use impactcal_shell::{
 //!     InitialVelocity, Material, MaterialLaw, RigidWall, Section, ShellModel, Simulation,
-//!     VelocityTarget, WallMethod,
+//!     VelocityTarget,
 //! };
 //!
 //! let mut m = ShellModel::new("strip drop");
@@ -53,11 +53,8 @@
 //! });
 //! m.initial_velocities.push(InitialVelocity::translation(VelocityTarget::All, [0.0, 0.0, -5.0]));
 //! m.walls.push(RigidWall {
-//!     nodes: None,
-//!     point: [0.0; 3],
-//!     head: [0.0, 0.0, 1.0],
 //!     friction: 0.2,
-//!     method: WallMethod::Kinematic,
+//!     ..RigidWall::plane([0.0; 3], [0.0, 0.0, 1.0])
 //! });
 //! m.control.end_time = 4e-3;
 //! m.output.history_nodes = vec![21];
@@ -82,6 +79,7 @@ mod geometry;
 pub mod keyword;
 pub mod material;
 pub mod model;
+mod rigid;
 mod setup;
 pub mod simulation;
 mod validate;
@@ -89,10 +87,11 @@ mod validate;
 pub use deck_model::DeckModel;
 pub use error::{Result, ShellError, UnsupportedAt};
 pub use model::{
-    BodyLoadZ, BulkViscosity, Control, CowperSymonds, Curve, Hourglass, HourglassForm,
-    InitialVelocity, Material, MaterialLaw, Node, NodeSet, NodeTarget, Output, Part,
-    PartStiffnessDamping, PointMass, RigidWall, Section, Shell, ShellModel, Spc, ThicknessRule,
-    VelocityTarget, WallMethod,
+    BodyLoadZ, BulkViscosity, Control, CowperSymonds, Curve, ElementThickness, Hardening,
+    Hourglass, HourglassDef, HourglassForm, InitialVelocity, Material, MaterialLaw, MotionKind,
+    MotionTarget, Node, NodeSet, NodeTarget, Output, Part, PartSet, PartStiffnessDamping,
+    PointMass, PrescribedMotion, RigidConstraints, RigidWall, Section, Shell, ShellModel, Spc,
+    SpotWeld, ThicknessRule, VelocityTarget, WallMethod, WallShape, WeldNodes,
 };
 pub use simulation::{
     Energies, PartEnergies, Progress, Quantity, RunResult, RunSummary, Simulation,

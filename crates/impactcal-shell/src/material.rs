@@ -15,10 +15,12 @@
 //! found by Newton iteration from the radial-return estimate `(s_vm* - s_y) / (3 G + H)`,
 //! safeguarded by bisection, to a relative tolerance of 1e-12 on `F`.
 
-use crate::model::{Material, MaterialLaw};
+use std::sync::Arc;
+
+use crate::model::{Curve, Hardening, Material, MaterialLaw};
 
 /// Material constants prepared for the element loop.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MaterialProps {
     /// Young's modulus.
     pub e: f64,
@@ -38,6 +40,53 @@ pub struct MaterialProps {
     pub rate: (f64, f64),
     /// Plate wave speed `sqrt(E / (rho (1 - nu^2)))`.
     pub wave_speed: f64,
+    /// A piecewise-linear hardening curve `(plastic strain, yield stress)` in place of
+    /// `yield0 + hardening p` (abscissae increasing, stresses not decreasing).
+    pub curve: Option<Arc<[(f64, f64)]>>,
+}
+
+/// The points `(plastic strain, yield stress)` of a hardening, from its curve (with the
+/// curve's scale factors and offsets applied) or its point table, checked: at least two
+/// points, abscissae increasing from at most 0, positive stresses that do not decrease.
+///
+/// # Errors
+/// A message saying what is wrong.
+pub fn hardening_points(h: Hardening, curves: &[Curve]) -> Result<Vec<(f64, f64)>, String> {
+    let pts: Vec<(f64, f64)> = match h {
+        Hardening::Curve(id) => {
+            let c = curves
+                .iter()
+                .find(|c| c.id == id)
+                .ok_or_else(|| format!("curve {id} (LCSS) is not defined"))?;
+            c.points
+                .iter()
+                .map(|&(a, _)| {
+                    let x = (a + c.offa) * c.sfa;
+                    (x, c.eval(x))
+                })
+                .collect()
+        }
+        Hardening::Points { len, points } => points[..len.min(8)].to_vec(),
+    };
+    if pts.len() < 2 {
+        return Err("needs at least 2 points".into());
+    }
+    if pts.iter().any(|p| !(p.0.is_finite() && p.1.is_finite())) {
+        return Err("a point is not finite".into());
+    }
+    if pts.windows(2).any(|w| !(w[1].0 > w[0].0)) {
+        return Err("plastic strains must increase".into());
+    }
+    if !(pts[0].0 <= 0.0) {
+        return Err(format!(
+            "the first point's plastic strain {} must be 0 (or below)",
+            pts[0].0
+        ));
+    }
+    if pts.windows(2).any(|w| w[1].1 < w[0].1) || !(pts[0].1 > 0.0) {
+        return Err("yield stresses must be positive and must not decrease (no softening)".into());
+    }
+    Ok(pts)
 }
 
 impl MaterialProps {
@@ -46,7 +95,13 @@ impl MaterialProps {
         let (e, nu, rho) = (m.youngs, m.poisson, m.density);
         let c11 = e / (1.0 - nu * nu);
         let (yield0, hardening, rate) = match m.law {
-            MaterialLaw::Elastic => (f64::INFINITY, 0.0, (0.0, 0.0)),
+            MaterialLaw::Elastic | MaterialLaw::Rigid { .. } => (f64::INFINITY, 0.0, (0.0, 0.0)),
+            // The curve comes with `with_hardening`; until then the material is elastic.
+            MaterialLaw::PlasticCurve { rate, .. } => (
+                f64::INFINITY,
+                0.0,
+                rate.map_or((0.0, 0.0), |r| (1.0 / r.c, 1.0 / r.p)),
+            ),
             MaterialLaw::Plastic {
                 yield_stress,
                 tangent_modulus,
@@ -67,6 +122,29 @@ impl MaterialProps {
             hardening,
             rate,
             wave_speed: (c11 / rho).sqrt(),
+            curve: None,
+        }
+    }
+
+    /// The same material with the hardening curve `points` (checked as by
+    /// [`hardening_points`]): the initial yield stress is the curve at `p = 0`.
+    ///
+    /// # Errors
+    /// A message when the points are not a usable hardening curve.
+    pub fn with_hardening(mut self, points: Vec<(f64, f64)>) -> Result<Self, String> {
+        let checked = hardening_points(Hardening::Curve(0), &[Curve::new(0, points)])?;
+        self.yield0 = curve_yield(&checked, 0.0).0;
+        self.hardening = 0.0;
+        self.curve = Some(checked.into());
+        Ok(self)
+    }
+
+    /// The yield stress at plastic strain `p` (before rate scaling).
+    #[inline]
+    pub fn yield_stress(&self, p: f64) -> f64 {
+        match &self.curve {
+            Some(c) => curve_yield(c, p).0,
+            None => self.yield0 + self.hardening * p,
         }
     }
 
@@ -106,6 +184,9 @@ impl MaterialProps {
     /// else the returned stress, adding the plastic strain increment to `epsp`.
     #[inline]
     pub fn plastic_return(&self, trial: [f64; 3], epsp: &mut f64, factor: f64) -> [f64; 3] {
+        if let Some(c) = &self.curve {
+            return self.plastic_return_curve(c, trial, epsp, factor);
+        }
         let [sx, sy, txy] = trial;
         let s = sx + sy;
         let d = sx - sy;
@@ -160,6 +241,87 @@ impl MaterialProps {
         let s = p * s;
         let d = q * d;
         *epsp += dp;
+        [0.5 * (s + d), 0.5 * (s - d), q * txy]
+    }
+}
+
+/// The yield stress of a hardening curve at plastic strain `p` and its slope there: linear
+/// between points, the first value below the first point, the last segment's slope past
+/// the last point.
+#[inline]
+fn curve_yield(c: &[(f64, f64)], p: f64) -> (f64, f64) {
+    let n = c.len();
+    if p <= c[0].0 {
+        return (c[0].1, 0.0);
+    }
+    let k = c.partition_point(|q| q.0 <= p).clamp(1, n - 1) - 1;
+    let (a, b) = (c[k], c[k + 1]);
+    let slope = (b.1 - a.1) / (b.0 - a.0);
+    (a.1 + slope * (p - a.0), slope)
+}
+
+impl MaterialProps {
+    /// The return to the yield surface of a curve material: as `plastic_return`, with the
+    /// yield stress `sigma_y(p + dp) factor` and its slope from the curve.
+    fn plastic_return_curve(
+        &self,
+        c: &[(f64, f64)],
+        trial: [f64; 3],
+        epsp: &mut f64,
+        factor: f64,
+    ) -> [f64; 3] {
+        let [sx, sy, txy] = trial;
+        let s = sx + sy;
+        let d = sx - sy;
+        let a = 0.25 * s * s;
+        let b = 0.75 * d * d + 3.0 * txy * txy;
+        let vm2 = a + b;
+        let p0 = *epsp;
+        let sy0 = curve_yield(c, p0).0 * factor;
+        if vm2 <= sy0 * sy0 {
+            return trial;
+        }
+        let (e, c1, c3) = (self.e, 1.0 / (1.0 - self.nu), 3.0 / (1.0 + self.nu));
+        let f_of = |dp: f64| {
+            let (y, h) = curve_yield(c, p0 + dp);
+            let (syn, hf) = (y * factor, h * factor);
+            let inv_syn = 1.0 / syn;
+            let dr = 0.5 * e * dp * inv_syn;
+            let p = 1.0 / (1.0 + c1 * dr);
+            let q = 1.0 / (1.0 + c3 * dr);
+            let (ap2, bq2) = (a * p * p, b * q * q);
+            let f = ap2 + bq2 - syn * syn;
+            let df =
+                -(c1 * ap2 * p + c3 * bq2 * q) * (e - 2.0 * dr * hf) * inv_syn - 2.0 * hf * syn;
+            (f, df, p, q)
+        };
+        let tol = 1e-12 * sy0 * sy0;
+        let (mut lo, mut hi) = (0.0, f64::INFINITY);
+        let mut dp = (vm2.sqrt() - sy0) / (3.0 * self.g + curve_yield(c, p0).1 * factor);
+        let mut fv = f_of(dp);
+        for _ in 0..200 {
+            let (f, df, _, _) = fv;
+            if f.abs() <= tol {
+                break;
+            }
+            if f > 0.0 {
+                lo = dp;
+            } else {
+                hi = dp;
+            }
+            let next = dp - f / df;
+            dp = if next > lo && next < hi {
+                next
+            } else if hi.is_finite() {
+                0.5 * (lo + hi)
+            } else {
+                (2.0 * dp).max(f64::MIN_POSITIVE)
+            };
+            fv = f_of(dp);
+        }
+        let (_, _, p, q) = fv;
+        *epsp += dp;
+        let (s, d) = (p * s, q * d);
         [0.5 * (s + d), 0.5 * (s - d), q * txy]
     }
 }

@@ -46,6 +46,9 @@ pub struct Part {
     pub section: u64,
     /// Material id.
     pub material: u64,
+    /// Hourglass definition id (`*HOURGLASS` HGID, see [`HourglassDef`]); 0 takes the
+    /// model's [`ShellModel::hourglass`].
+    pub hourglass: u64,
 }
 
 /// Through-thickness integration rule.
@@ -96,6 +99,35 @@ pub struct CowperSymonds {
     pub p: f64,
 }
 
+/// The hardening of [`MaterialLaw::PlasticCurve`]: the yield stress as a function of the
+/// equivalent plastic strain, piecewise linear through its points and extended past the
+/// last point with the last segment's slope (below the first point, the first value).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Hardening {
+    /// A `*DEFINE_CURVE` of yield stress (ordinate) against equivalent plastic strain
+    /// (abscissa), with its scale factors and offsets (`*MAT_024` LCSS).
+    Curve(u64),
+    /// Up to eight points `(plastic strain, yield stress)`, the first `len` of `points`
+    /// (`*MAT_024` EPS1-EPS8, ES1-ES8).
+    Points {
+        /// The number of points used, 2 to 8.
+        len: usize,
+        /// The points; those past `len` are unused.
+        points: [(f64, f64); 8],
+    },
+}
+
+/// The global directions in which a rigid body's motion is held (`*MAT_RIGID` CMO = 1 with
+/// CON1 and CON2): translations of its centre of mass along x, y, z, and rotations about x,
+/// y, z.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RigidConstraints {
+    /// Held translations `[x, y, z]`.
+    pub translation: [bool; 3],
+    /// Held rotations `[x, y, z]`.
+    pub rotation: [bool; 3],
+}
+
 /// The material law of a [`Material`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum MaterialLaw {
@@ -111,6 +143,24 @@ pub enum MaterialLaw {
         tangent_modulus: f64,
         /// Optional Cowper-Symonds rate scaling.
         rate: Option<CowperSymonds>,
+    },
+    /// Elastic-plastic like [`MaterialLaw::Plastic`], with the yield stress a
+    /// piecewise-linear function of the equivalent plastic strain
+    /// (`*MAT_PIECEWISE_LINEAR_PLASTICITY` with LCSS or EPS/ES): `sigma_y(p)` from the
+    /// [`Hardening`], which must not decrease, scaled by the Cowper-Symonds factor.
+    PlasticCurve {
+        /// The hardening curve.
+        hardening: Hardening,
+        /// Optional Cowper-Symonds rate scaling.
+        rate: Option<CowperSymonds>,
+    },
+    /// Rigid (`*MAT_RIGID`): the part's nodes move as one rigid body (with the nodes of any
+    /// spot weld or rigid part that shares a node with it); its shells add mass and inertia
+    /// but no stiffness. The density gives the mass; Young's modulus and Poisson's ratio
+    /// are kept for the deck (LS-DYNA uses them for contact stiffness).
+    Rigid {
+        /// Motion held in global directions.
+        constraints: RigidConstraints,
     },
 }
 
@@ -160,6 +210,8 @@ pub enum VelocityTarget {
     Node(u64),
     /// The nodes of the shells of a part.
     Part(u64),
+    /// The nodes of the shells of the parts of a part set.
+    PartSet(u64),
 }
 
 /// An initial velocity: `v = translation + omega * axis x (x - centre)` and the nodal
@@ -234,10 +286,34 @@ pub enum WallMethod {
     },
 }
 
-/// A stationary rigid plane (`*RIGIDWALL_PLANAR`): nodes may not pass to the negative side
-/// of the plane through `point` with normal `normal` (from tail to head).
+/// The shape of a [`RigidWall`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum WallShape {
+    /// The plane through `point` with normal `head - point` (`*RIGIDWALL_PLANAR`): nodes
+    /// stay on the side the normal points to.
+    #[default]
+    Plane,
+    /// A cylinder of radius `radius` about the axis from `point` (the tail) toward `head`
+    /// (`*RIGIDWALL_GEOMETRIC_CYLINDER`): nodes stay outside it. `length > 0` bounds it to
+    /// the axial positions `0 <= s <= length` from the tail; 0 makes it infinite.
+    Cylinder {
+        /// Radius, > 0.
+        radius: f64,
+        /// Length along the axis from the tail (0: infinite).
+        length: f64,
+    },
+}
+
+/// A stationary rigid wall (`*RIGIDWALL_PLANAR`, `*RIGIDWALL_GEOMETRIC_CYLINDER`): the nodes
+/// it checks may not pass into it. For a plane, the negative side of the plane through
+/// `point` with normal `head - point`; for a cylinder, its inside.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RigidWall {
+    /// The wall's id in outputs (`_ID` cards); 0 gives it its 1-based position among the
+    /// model's walls.
+    pub id: u64,
+    /// The shape.
+    pub shape: WallShape,
     /// The nodes checked: `None` for all nodes (NSID = 0), or a node set.
     pub nodes: Option<u64>,
     /// A point of the plane (the tail, XT YT ZT).
@@ -248,6 +324,22 @@ pub struct RigidWall {
     pub friction: f64,
     /// Enforcement method.
     pub method: WallMethod,
+}
+
+impl RigidWall {
+    /// A kinematic, frictionless plane through `point` with normal `head - point`, checking
+    /// every node, with no id of its own.
+    pub fn plane(point: [f64; 3], head: [f64; 3]) -> Self {
+        RigidWall {
+            id: 0,
+            shape: WallShape::Plane,
+            nodes: None,
+            point,
+            head,
+            friction: 0.0,
+            method: WallMethod::Kinematic,
+        }
+    }
 }
 
 /// A piecewise-linear curve `(abscissa, ordinate)` with constant extrapolation
@@ -393,6 +485,100 @@ impl Default for Hourglass {
     }
 }
 
+/// A hourglass control that parts refer to by id (`*HOURGLASS`, `Part::hourglass`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HourglassDef {
+    /// Id (HGID), > 0.
+    pub id: u64,
+    /// The control.
+    pub hourglass: Hourglass,
+}
+
+/// The thickness of one shell in place of its section's (`*ELEMENT_SHELL_THICKNESS`): the
+/// nodal thicknesses `[t1, t2, t3, t4]`, a 0 standing for the section's thickness. The
+/// shell takes the mean over its nodes (three for a triangle), as a section with unequal
+/// nodal thicknesses does.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElementThickness {
+    /// The shell's id.
+    pub shell: u64,
+    /// Nodal thicknesses (0: the section's).
+    pub nodal: [f64; 4],
+}
+
+/// A named list of parts (`*SET_PART_LIST`, `_GENERATE`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartSet {
+    /// Set id.
+    pub id: u64,
+    /// Part ids.
+    pub parts: Vec<u64>,
+}
+
+/// What a prescribed motion drives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotionTarget {
+    /// One node.
+    Node(u64),
+    /// The nodes of a node set.
+    NodeSet(u64),
+    /// The rigid body of a rigid part (its centre of mass and rotation).
+    Rigid(u64),
+}
+
+/// Which quantity a prescribed-motion curve gives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotionKind {
+    /// Velocity (VAD 0).
+    Velocity,
+    /// Acceleration (VAD 1).
+    Acceleration,
+    /// Displacement from the initial position (VAD 2).
+    Displacement,
+}
+
+/// A prescribed motion (`*BOUNDARY_PRESCRIBED_MOTION_NODE|SET|RIGID`): degree of freedom
+/// `dof` (0-2 translations x, y, z; 3-5 rotations about x, y, z) of the target follows
+/// `scale * curve(t)` as a velocity, acceleration or displacement while
+/// `birth <= t <= death`; outside that window the degree of freedom is free.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrescribedMotion {
+    /// What is driven.
+    pub target: MotionTarget,
+    /// The degree of freedom, 0 to 5.
+    pub dof: usize,
+    /// What the curve gives.
+    pub kind: MotionKind,
+    /// Curve id.
+    pub curve: u64,
+    /// Scale factor on the curve.
+    pub scale: f64,
+    /// Start time.
+    pub birth: f64,
+    /// End time.
+    pub death: f64,
+}
+
+/// The nodes of a [`SpotWeld`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WeldNodes {
+    /// Two nodes (`*CONSTRAINED_SPOTWELD` N1, N2).
+    Pair([u64; 2]),
+    /// The nodes of a node set, at least 2 (`*CONSTRAINED_GENERALIZED_WELD_SPOT` NSID).
+    Set(u64),
+}
+
+/// A spot weld (`*CONSTRAINED_SPOTWELD`, `*CONSTRAINED_GENERALIZED_WELD_SPOT`): its nodes
+/// move as one rigid body (with any other weld or rigid part that shares a node), which
+/// never fails.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SpotWeld {
+    /// Weld id (0 when the deck gives none).
+    pub id: u64,
+    /// The welded nodes.
+    pub nodes: WeldNodes,
+}
+
 /// Run controls.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Control {
@@ -474,6 +660,16 @@ pub struct ShellModel {
     pub spcs: Vec<Spc>,
     /// Rigid walls.
     pub walls: Vec<RigidWall>,
+    /// Hourglass definitions that parts refer to.
+    pub hourglass_defs: Vec<HourglassDef>,
+    /// Shells whose thickness is their own rather than their section's.
+    pub element_thickness: Vec<ElementThickness>,
+    /// Part sets.
+    pub part_sets: Vec<PartSet>,
+    /// Prescribed motions.
+    pub prescribed: Vec<PrescribedMotion>,
+    /// Spot welds.
+    pub spot_welds: Vec<SpotWeld>,
     /// Curves.
     pub curves: Vec<Curve>,
     /// Body acceleration along z (gravity).
@@ -483,7 +679,8 @@ pub struct ShellModel {
     /// Bulk viscosity of the shells (`None`: off, as in LS-DYNA, whose default bulk
     /// viscosity acts on solids only).
     pub bulk_viscosity: Option<BulkViscosity>,
-    /// Stiffness-proportional damping per part (at most one entry per part).
+    /// Stiffness-proportional damping per part (at most one entry per part; the reader
+    /// expands `*DAMPING_PART_STIFFNESS_SET` to the parts of the set).
     pub stiffness_damping: Vec<PartStiffnessDamping>,
     /// Hourglass control.
     pub hourglass: Hourglass,
@@ -531,6 +728,7 @@ impl ShellModel {
             title: format!("part {id}"),
             section,
             material,
+            hourglass: 0,
         });
         self
     }

@@ -5,25 +5,56 @@ use std::collections::HashMap;
 use crate::element::{self, ElementFault, PartProps};
 use crate::error::{Result, ShellError};
 use crate::geometry::{dot, norm, sub};
-use crate::model::{NodeTarget, ShellModel, VelocityTarget, WallMethod};
+use crate::model::{
+    Curve, MaterialLaw, MotionKind, MotionTarget, NodeTarget, Section, ShellModel, VelocityTarget,
+    WallMethod, WallShape, WeldNodes,
+};
+use crate::rigid::{RigidDef, rigid_bodies};
 use crate::validate::{check_hourglass, check_material, check_section, non_negative, positive};
 
-/// An element in solver form: node indices, triangle flag, part index.
+/// An element in solver form: node indices, triangle flag, part index and the index of its
+/// constants in `Compiled::props` (the part's, or its own for an element with its own
+/// thickness).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Elem {
     pub nodes: [u32; 4],
     pub tri: bool,
     pub part: u32,
+    pub props: u32,
 }
 
-/// A rigid wall in solver form.
+/// A rigid wall in solver form: its id, shape, nodes, a point of it (the tail), its unit
+/// normal (plane) or axis (cylinder).
 #[derive(Debug, Clone)]
 pub(crate) struct Wall {
+    pub id: u64,
+    pub shape: WallShape,
     pub nodes: Vec<u32>,
     pub point: [f64; 3],
     pub normal: [f64; 3],
     pub mu: f64,
     pub method: WallMethod,
+}
+
+/// What a prescribed motion drives in solver form.
+#[derive(Debug, Clone)]
+pub(crate) enum DriveTarget {
+    /// Node indices.
+    Nodes(Vec<u32>),
+    /// A rigid body index.
+    Body(usize),
+}
+
+/// A prescribed motion in solver form.
+#[derive(Debug, Clone)]
+pub(crate) struct Drive {
+    pub target: DriveTarget,
+    pub dof: usize,
+    pub kind: MotionKind,
+    pub curve: Curve,
+    pub scale: f64,
+    pub birth: f64,
+    pub death: f64,
 }
 
 /// Everything the solver needs, validated.
@@ -32,8 +63,11 @@ pub(crate) struct Compiled {
     pub x0: Vec<[f64; 3]>,
     pub elem_ids: Vec<u64>,
     pub elems: Vec<Elem>,
+    /// Element constants: one per part, then one per element with its own thickness.
     pub parts: Vec<PartProps>,
     pub part_ids: Vec<u64>,
+    pub rigid: Vec<RigidDef>,
+    pub drives: Vec<Drive>,
     pub mass: Vec<f64>,
     pub inertia: Vec<f64>,
     pub fixed: Vec<(u32, [bool; 6])>,
@@ -99,12 +133,28 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
     }
     let hg = &model.hourglass;
     check_hourglass(hg)?;
+    let hg_map = unique(&model.hourglass_defs, |h| h.id, "hourglass definition")?;
+    for h in &model.hourglass_defs {
+        check_hourglass(&h.hourglass)?;
+    }
     let mut parts = Vec::with_capacity(model.parts.len());
+    let mut part_sections = Vec::with_capacity(model.parts.len());
     for p in &model.parts {
         let by = format!("part {}", p.id);
         let sec = &model.sections[lookup(&sec_map, p.section, "section", &by)?];
         let mat = &model.materials[lookup(&mat_map, p.material, "material", &by)?];
-        parts.push(PartProps::new(sec, mat, hg)?);
+        let hg = match p.hourglass {
+            0 => hg,
+            h => &model.hourglass_defs[lookup(&hg_map, h, "hourglass definition", &by)?].hourglass,
+        };
+        let mut props = PartProps::new(sec, mat, hg)?;
+        if let MaterialLaw::PlasticCurve { hardening, .. } = mat.law {
+            let points = crate::material::hardening_points(hardening, &model.curves)
+                .map_err(|m| ShellError::value(format!("material {}, hardening", mat.id), m))?;
+            props = props.with_hardening(points)?;
+        }
+        parts.push(props);
+        part_sections.push(*sec);
     }
     if let Some(b) = model.bulk_viscosity {
         for (name, v) in [("Q1", b.q1), ("Q2", b.q2)] {
@@ -132,6 +182,13 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
             });
         }
         parts[k].stiffness_damping = d.coef;
+    }
+
+    // Elements with their own thickness.
+    let own_thickness = unique(&model.element_thickness, |t| t.shell, "element thickness")?;
+    let shell_ids = unique(&model.shells, |s| s.id, "shell")?;
+    for t in &model.element_thickness {
+        lookup(&shell_ids, t.shell, "shell", "*ELEMENT_SHELL_THICKNESS")?;
     }
 
     // Elements, masses, inertias.
@@ -171,7 +228,27 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
                 }
             },
         })?;
-        let pp = &parts[part];
+        let props = match own_thickness.get(&s.id) {
+            None => part,
+            Some(&k) => {
+                let sec: Section = part_sections[part];
+                let nodal = model.element_thickness[k].nodal;
+                let t = nodal[..distinct]
+                    .iter()
+                    .map(|&v| if v == 0.0 { sec.thickness } else { v })
+                    .sum::<f64>()
+                    / distinct as f64;
+                let pp = parts[part].with_thickness(t, &sec).map_err(|_| {
+                    ShellError::value(
+                        format!("shell {}, thickness", s.id),
+                        format!("must be positive, got {t}"),
+                    )
+                })?;
+                parts.push(pp);
+                parts.len() - 1
+            }
+        };
+        let pp = &parts[props];
         let m = pp.mat.rho * pp.t * area / distinct as f64;
         let inr = m * (pp.t * pp.t / 12.0).max(area / 8.0);
         for &i in &idx[..distinct] {
@@ -182,6 +259,7 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
             nodes: idx,
             tri,
             part: part as u32,
+            props: props as u32,
         });
     }
     for pm in &model.masses {
@@ -203,6 +281,51 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
             .collect()
     };
 
+    // Rigid bodies: rigid parts and spot welds, joined where they share nodes.
+    let mut groups: Vec<(Vec<u32>, Option<usize>)> = Vec::new();
+    for (k, p) in model.parts.iter().enumerate() {
+        let mat = &model.materials[lookup(&mat_map, p.material, "material", "a part")?];
+        if matches!(mat.law, MaterialLaw::Rigid { .. }) {
+            parts[k].rigid = true;
+            let mut on = vec![false; nn];
+            for e in elems.iter().filter(|e| e.part as usize == k) {
+                for &n in &e.nodes {
+                    on[n as usize] = true;
+                }
+            }
+            groups.push((
+                (0..nn as u32).filter(|&i| on[i as usize]).collect(),
+                Some(k),
+            ));
+        }
+    }
+    for e in &mut elems {
+        if parts[e.part as usize].rigid {
+            parts[e.props as usize].rigid = true;
+        }
+    }
+    for (k, w) in model.spot_welds.iter().enumerate() {
+        let by = format!("spot weld {}", if w.id > 0 { w.id } else { k as u64 + 1 });
+        let nodes = match w.nodes {
+            WeldNodes::Pair(p) => p
+                .iter()
+                .map(|&n| lookup(&node_map, n, "node", &by).map(|i| i as u32))
+                .collect::<Result<Vec<_>>>()?,
+            WeldNodes::Set(s) => set_nodes(s, &by)?,
+        };
+        if nodes.len() < 2 {
+            return Err(ShellError::value(by, "welds fewer than 2 nodes"));
+        }
+        groups.push((nodes, None));
+    }
+    let rigid = rigid_bodies(model, &groups, &x0, &mass, &inertia)?;
+    let mut body_of = vec![usize::MAX; nn];
+    for (b, body) in rigid.iter().enumerate() {
+        for &i in &body.nodes {
+            body_of[i as usize] = b;
+        }
+    }
+
     // Constraints.
     let mut fixed_mask = vec![[false; 6]; nn];
     for (k, spc) in model.spcs.iter().enumerate() {
@@ -212,6 +335,15 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
             NodeTarget::NodeSet(s) => set_nodes(s, &by)?,
         };
         for i in nodes {
+            if body_of[i as usize] != usize::MAX && spc.dofs.iter().any(|&d| d) {
+                return Err(ShellError::value(
+                    by,
+                    format!(
+                        "node {} moves with a rigid body: hold the body with *MAT_RIGID CMO, CON1, CON2 or a prescribed motion",
+                        model.nodes[i as usize].id
+                    ),
+                ));
+            }
             for d in 0..6 {
                 fixed_mask[i as usize][d] |= spc.dofs[d];
             }
@@ -219,6 +351,9 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
     }
     // Nodes without mass (not attached to anything) are held fixed.
     for i in 0..nn {
+        if body_of[i] != usize::MAX {
+            continue;
+        }
         if mass[i] <= 0.0 {
             fixed_mask[i] = [true; 6];
         } else if inertia[i] <= 0.0 {
@@ -243,15 +378,11 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
             VelocityTarget::All => (0..nn as u32).collect(),
             VelocityTarget::Node(n) => vec![lookup(&node_map, n, "node", &by)? as u32],
             VelocityTarget::NodeSet(s) => set_nodes(s, &by)?,
-            VelocityTarget::Part(p) => {
-                let pi = lookup(&part_map, p, "part", &by)? as u32;
-                let mut on = vec![false; nn];
-                for e in elems.iter().filter(|e| e.part == pi) {
-                    for &n in &e.nodes {
-                        on[n as usize] = true;
-                    }
-                }
-                (0..nn as u32).filter(|&i| on[i as usize]).collect()
+            VelocityTarget::Part(p) => part_nodes(&[p], &part_map, &elems, nn, &by)?,
+            VelocityTarget::PartSet(s) => {
+                let set_map = unique(&model.part_sets, |s| s.id, "part set")?;
+                let set = &model.part_sets[lookup(&set_map, s, "part set", &by)?];
+                part_nodes(&set.parts, &part_map, &elems, nn, &by)?
             }
         };
         let all = [iv.translation, iv.rotation, iv.centre, iv.axis];
@@ -296,8 +427,28 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
 
     // Walls.
     let mut walls = Vec::with_capacity(model.walls.len());
+    let mut wall_ids: Vec<u64> = Vec::new();
     for (k, w) in model.walls.iter().enumerate() {
-        let by = format!("rigid wall {}", k + 1);
+        let id = if w.id > 0 { w.id } else { k as u64 + 1 };
+        if wall_ids.contains(&id) {
+            return Err(ShellError::Reference {
+                what: "rigid wall",
+                id,
+                message: "defined more than once (walls without an id take their position)".into(),
+            });
+        }
+        wall_ids.push(id);
+        let by = format!("rigid wall {id}");
+        if let WallShape::Cylinder { radius, length } = w.shape
+            && !(radius > 0.0 && radius.is_finite() && length >= 0.0 && length.is_finite())
+        {
+            return Err(ShellError::value(
+                by,
+                format!(
+                    "cylinder radius {radius} must be positive and length {length} non-negative"
+                ),
+            ));
+        }
         let nvec = sub(w.head, w.point);
         let len = norm(nvec);
         if !(len > 0.0 && len.is_finite()) {
@@ -327,13 +478,17 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
                 ));
             }
         }
-        let nodes = match w.nodes {
+        // Walls do not check the nodes of rigid bodies (LS-DYNA's rule for RWPNAL = 0).
+        let nodes: Vec<u32> = match w.nodes {
             None => (0..nn as u32).filter(|&i| mass[i as usize] > 0.0).collect(),
             Some(s) => set_nodes(s, &by)?,
-        };
+        }
+        .into_iter()
+        .filter(|&i| body_of[i as usize] == usize::MAX)
+        .collect();
         let scale_len = model_size(&x0);
         for &i in &nodes {
-            let d = dot(sub(x0[i as usize], w.point), normal);
+            let d = wall_gap(w.shape, x0[i as usize], w.point, normal).0;
             if d < -1e-9 * scale_len {
                 return Err(ShellError::value(
                     by,
@@ -345,6 +500,8 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
             }
         }
         walls.push(Wall {
+            id,
+            shape: w.shape,
             nodes,
             point: w.point,
             normal,
@@ -380,6 +537,68 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         }
     }
     non_negative("damping constant".into(), model.damping)?;
+    let mut drives = Vec::with_capacity(model.prescribed.len());
+    for (k, pm) in model.prescribed.iter().enumerate() {
+        let by = format!("prescribed motion {}", k + 1);
+        let curve = model.curves[lookup(&curve_map, pm.curve, "curve", &by)?].clone();
+        if pm.dof > 5 || !(pm.scale.is_finite() && pm.birth.is_finite() && pm.death.is_finite()) {
+            return Err(ShellError::value(
+                by,
+                "degree of freedom above 5 or a non-finite scale, birth or death",
+            ));
+        }
+        let target = match pm.target {
+            MotionTarget::Node(n) => {
+                DriveTarget::Nodes(vec![lookup(&node_map, n, "node", &by)? as u32])
+            }
+            MotionTarget::NodeSet(s) => DriveTarget::Nodes(set_nodes(s, &by)?),
+            MotionTarget::Rigid(p) => {
+                let pi = lookup(&part_map, p, "part", &by)?;
+                let b = rigid
+                    .iter()
+                    .position(|r| r.parts.contains(&pi))
+                    .ok_or_else(|| {
+                        ShellError::value(by.clone(), format!("part {p} is not rigid (*MAT_RIGID)"))
+                    })?;
+                DriveTarget::Body(b)
+            }
+        };
+        if let DriveTarget::Nodes(nodes) = &target {
+            if let Some(&i) = nodes.iter().find(|&&i| body_of[i as usize] != usize::MAX) {
+                return Err(ShellError::value(
+                    by,
+                    format!(
+                        "node {} moves with a rigid body: prescribe the body's motion (*BOUNDARY_PRESCRIBED_MOTION_RIGID)",
+                        model.nodes[i as usize].id
+                    ),
+                ));
+            }
+            if pm.dof >= 3 && pm.kind == MotionKind::Displacement {
+                return Err(ShellError::value(
+                    by,
+                    "a prescribed rotation angle of nodes (nodes carry no rotation)",
+                ));
+            }
+        }
+        if matches!(target, DriveTarget::Body(_))
+            && pm.dof >= 3
+            && pm.kind == MotionKind::Displacement
+        {
+            return Err(ShellError::value(
+                by,
+                "a prescribed rotation angle of a rigid body",
+            ));
+        }
+        drives.push(Drive {
+            target,
+            dof: pm.dof,
+            kind: pm.kind,
+            curve,
+            scale: pm.scale,
+            birth: pm.birth,
+            death: pm.death,
+        });
+    }
     let c = &model.control;
     positive("end time".into(), c.end_time)?;
     if !(c.tssfac > 0.0 && c.tssfac <= 1.0) {
@@ -408,6 +627,8 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         elems,
         parts,
         part_ids: model.parts.iter().map(|p| p.id).collect(),
+        rigid,
+        drives,
         mass,
         inertia,
         fixed,
@@ -416,6 +637,52 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         w0,
         history,
     })
+}
+
+/// The nodes of the shells of the parts `ids`.
+fn part_nodes(
+    ids: &[u64],
+    part_map: &HashMap<u64, usize>,
+    elems: &[Elem],
+    nn: usize,
+    by: &str,
+) -> Result<Vec<u32>> {
+    let mut on = vec![false; nn];
+    for &p in ids {
+        let pi = lookup(part_map, p, "part", by)? as u32;
+        for e in elems.iter().filter(|e| e.part == pi) {
+            for &n in &e.nodes {
+                on[n as usize] = true;
+            }
+        }
+    }
+    Ok((0..nn as u32).filter(|&i| on[i as usize]).collect())
+}
+
+/// The signed gap of a point `x` to a wall (positive outside, on the side the nodes belong)
+/// and the wall's outward unit normal there: for a plane through `point` with unit normal
+/// `axis`, the distance along it; for a cylinder of axis `axis` through `point`, the
+/// distance to the axis less the radius, with the radial direction (a point outside the
+/// length of a finite cylinder, or on its axis, is reported as far outside).
+pub(crate) fn wall_gap(
+    shape: WallShape,
+    x: [f64; 3],
+    point: [f64; 3],
+    axis: [f64; 3],
+) -> (f64, [f64; 3]) {
+    let r = sub(x, point);
+    match shape {
+        WallShape::Plane => (dot(r, axis), axis),
+        WallShape::Cylinder { radius, length } => {
+            let s = dot(r, axis);
+            let radial = [r[0] - s * axis[0], r[1] - s * axis[1], r[2] - s * axis[2]];
+            let d = norm(radial);
+            if (length > 0.0 && !(0.0..=length).contains(&s)) || !(d > 0.0) {
+                return (f64::INFINITY, axis);
+            }
+            (d - radius, [radial[0] / d, radial[1] / d, radial[2] / d])
+        }
+    }
 }
 
 fn model_size(x: &[[f64; 3]]) -> f64 {

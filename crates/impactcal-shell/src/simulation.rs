@@ -27,8 +27,9 @@ use crate::element::{
 };
 use crate::error::{Result, ShellError};
 use crate::geometry::{dot, sub};
-use crate::model::{Curve, ShellModel, WallMethod};
-use crate::setup::{Compiled, Elem, compile};
+use crate::model::{Curve, MotionKind, ShellModel, WallMethod};
+use crate::rigid::{RigidState, cross, inverse, mul, rotation};
+use crate::setup::{Compiled, DriveTarget, Elem, compile, wall_gap};
 
 /// Elements per rayon task in the element loop; fixed so that scheduling never changes the
 /// arithmetic.
@@ -101,8 +102,11 @@ pub struct RunSummary {
     pub energy_ratio: f64,
     /// Final hourglass energy over internal energy (0 when there is no internal energy).
     pub hourglass_share: f64,
-    /// Largest normal wall force over the run.
+    /// Largest normal force of all walls together over the samples of [`RunResult::walls`]
+    /// (interval means, not the force of a single cycle).
     pub peak_wall_force: f64,
+    /// Each wall's id and its largest sampled normal force.
+    pub wall_peaks: Vec<(u64, f64)>,
     /// Final energies.
     pub energies: Energies,
     /// Number of shells.
@@ -139,6 +143,16 @@ pub struct RunResult {
     /// energy_ratio, wall_force, wall_fx, wall_fy, wall_fz` (the wall force is the force of
     /// the walls on the structure; `wall_force` is its normal component).
     pub energies: Histories,
+    /// The force of each rigid wall on the structure, sampled at the output interval as
+    /// the mean over each interval (LS-DYNA's `rwforc` quantities): channels
+    /// `<wall id>.fx, .fy, .fz` (global components) and `<wall id>.f` (normal force). A
+    /// wall's id is its `_ID` card's, else its 1-based position among the walls. `None`
+    /// for a model without walls.
+    pub walls: Option<Histories>,
+    /// The energies of each part sampled at the output interval (LS-DYNA's `matsum`):
+    /// channels `<part>.internal, <part>.kinetic, <part>.hourglass, <part>.damping`.
+    /// Concentrated masses belong to no part.
+    pub part_energies: Histories,
     /// Final energies of each part, in model order.
     pub parts: Vec<PartEnergies>,
     /// Summary figures.
@@ -235,7 +249,12 @@ pub struct Simulation {
     energies: Energies,
     wall_force: [f64; 3],
     wall_normal: f64,
-    peak_wall: f64,
+    /// Per wall, the impulse given to the structure since the start: `[x, y, z, normal]`.
+    wall_impulse: Vec<[f64; 4]>,
+    /// The rigid bodies' states.
+    bodies: Vec<RigidState>,
+    /// Per element, the mass and rotary inertia it gives each of its nodes.
+    elem_mass: Vec<[f64; 2]>,
     started: bool,
 }
 
@@ -371,7 +390,13 @@ impl Simulation {
             energies: Energies::default(),
             wall_force: [0.0; 3],
             wall_normal: 0.0,
-            peak_wall: 0.0,
+            wall_impulse: vec![[0.0; 4]; c.walls.len()],
+            bodies: c
+                .rigid
+                .iter()
+                .map(|b| RigidState::initial(b, &c.mass, &c.inertia, &c.v0, &c.w0))
+                .collect(),
+            elem_mass: element_masses(&c),
             started: false,
             c,
         };
@@ -458,7 +483,7 @@ impl Simulation {
     pub fn elastic_energy(&self) -> f64 {
         let mut total = 0.0;
         for (k, e) in self.c.elems.iter().enumerate() {
-            let p = &self.c.parts[e.part as usize];
+            let p = &self.c.parts[e.props as usize];
             let n = if e.tri { 3 } else { 4 };
             let xs: Vec<[f64; 3]> = e.nodes[..n].iter().map(|&i| self.x[i as usize]).collect();
             let area = crate::geometry::polygon_area(&xs);
@@ -480,7 +505,7 @@ impl Simulation {
     /// Stress state `[s_xx, s_yy, s_xy, eps_p]` of thickness point `k` of element index `e`
     /// (model order), in the element frame.
     pub fn point_state(&self, e: usize, k: usize) -> Option<[f64; 4]> {
-        let nip = self.c.parts[self.c.elems.get(e)?.part as usize].z.len();
+        let nip = self.c.parts[self.c.elems.get(e)?.props as usize].z.len();
         if k >= nip {
             return None;
         }
@@ -517,7 +542,16 @@ impl Simulation {
                 let mut k = 0;
                 while k < n {
                     let e = &elems[first + k];
-                    let props = &parts[e.part as usize];
+                    let props = &parts[e.props as usize];
+                    if props.rigid {
+                        out[k] = ElementOutput {
+                            dt: f64::INFINITY,
+                            ..ElementOutput::default()
+                        };
+                        faults[k] = None;
+                        k += 1;
+                        continue;
+                    }
                     if e.tri {
                         let g = |a: &[[f64; 3]]| {
                             [
@@ -542,7 +576,7 @@ impl Simulation {
                     };
                     while blk.active < LANES && k + blk.active < n {
                         let f = &elems[first + k + blk.active];
-                        if f.tri || f.part != e.part {
+                        if f.tri || f.props != e.props {
                             break;
                         }
                         blk.nodes[blk.active] = f.nodes;
@@ -614,14 +648,79 @@ impl Simulation {
     /// velocities; returns nothing.
     fn kick(&mut self, h_prev: f64, dt_next: f64) {
         let dt_v = h_prev + 0.5 * dt_next;
+        self.walls(dt_v, dt_next);
+        self.rigid(dt_v, dt_next);
+        self.drive_nodes(dt_v, dt_next);
+        for &(i, mask) in &self.c.fixed {
+            let i = i as usize;
+            for d in 0..3 {
+                if mask[d] {
+                    self.a[i][d] = 0.0;
+                }
+                if mask[3 + d] {
+                    self.alpha[i][d] = 0.0;
+                }
+            }
+        }
+        // Damping energy over the kick, with the mid-step velocities.
+        if self.damping > 0.0 {
+            let e: f64 = chunked_sum(&self.v, &self.c.mass, |v, m| m * dot(*v, *v));
+            self.energies.damping += self.damping * e * dt_v;
+        }
+        // Velocity update, kinetic energy and the finiteness check in one pass over fixed
+        // node chunks, summed in chunk order.
+        let half = 0.5 * dt_next;
+        let (a, al) = (&self.a, &self.alpha);
+        let (mass, inertia) = (&self.c.mass, &self.c.inertia);
+        self.v
+            .par_chunks_mut(NODE_CHUNK)
+            .zip(self.w.par_chunks_mut(NODE_CHUNK))
+            .zip(self.v_int.par_chunks_mut(NODE_CHUNK))
+            .zip(self.w_int.par_chunks_mut(NODE_CHUNK))
+            .zip(self.kick_sums.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, ((((v, w), vi), wi), sum))| {
+                let first = c * NODE_CHUNK;
+                let (mut kt, mut kr, mut bad) = (0.0, 0.0, false);
+                for j in 0..v.len() {
+                    let i = first + j;
+                    for d in 0..3 {
+                        vi[j][d] = v[j][d] + h_prev * a[i][d];
+                        v[j][d] = vi[j][d] + half * a[i][d];
+                        wi[j][d] = w[j][d] + h_prev * al[i][d];
+                        w[j][d] = wi[j][d] + half * al[i][d];
+                    }
+                    kt += 0.5 * mass[i] * dot(vi[j], vi[j]);
+                    kr += 0.5 * inertia[i] * dot(wi[j], wi[j]);
+                    bad |= v[j].iter().any(|x| !x.is_finite());
+                }
+                *sum = KickSum { kt, kr, bad };
+            });
+        let (mut ke_t, mut ke_r) = (0.0, 0.0);
+        self.v_bad = false;
+        for s in &self.kick_sums {
+            ke_t += s.kt;
+            ke_r += s.kr;
+            self.v_bad |= s.bad;
+        }
+        self.energies.kinetic = ke_t + ke_r;
+    }
+
+    /// Rigid walls: corrects the accelerations of the nodes that would enter a wall in the
+    /// next step (kinematic) or that are in it (penalty), books the energy they remove and
+    /// the impulse each wall gives.
+    fn walls(&mut self, dt_v: f64, dt_next: f64) {
         let mut force = [0.0; 3];
         let mut normal_force = 0.0;
-        for wall in &self.c.walls {
+        for (w, wall) in self.c.walls.iter().enumerate() {
+            let mut impulse = [0.0; 4];
             for &i in &wall.nodes {
                 let i = i as usize;
                 let m = self.c.mass[i];
-                let n = wall.normal;
-                let d0 = dot(sub(self.x[i], wall.point), n);
+                let (d0, n) = wall_gap(wall.shape, self.x[i], wall.point, wall.normal);
+                if !d0.is_finite() {
+                    continue;
+                }
                 let vold = self.v[i];
                 let mut vs = [0.0; 3];
                 for k in 0..3 {
@@ -687,67 +786,165 @@ impl Simulation {
                 for k in 0..3 {
                     let f = m * (vnew[k] - vs[k]) / dt_v;
                     force[k] += f;
+                    impulse[k] += imp[k];
                     self.a[i][k] = (vnew[k] - vold[k]) / dt_v;
                 }
                 normal_force += m * dvn / dt_v;
+                impulse[3] += m * dvn;
+            }
+            for k in 0..4 {
+                self.wall_impulse[w][k] += impulse[k];
             }
         }
         self.wall_force = force;
         self.wall_normal = normal_force;
-        self.peak_wall = self.peak_wall.max(normal_force);
-        for &(i, mask) in &self.c.fixed {
-            let i = i as usize;
-            for d in 0..3 {
-                if mask[d] {
-                    self.a[i][d] = 0.0;
+    }
+
+    /// The value of drive `d` at time `t` on the scale of its curve, and whether it acts.
+    fn drive_value(&self, d: &crate::setup::Drive, t: f64) -> Option<f64> {
+        (t >= d.birth && t <= d.death).then(|| d.scale * d.curve.eval(t))
+    }
+
+    /// Rigid bodies: from the accelerations the nodes have (internal forces of the shells
+    /// around them, gravity, damping), advances each body's velocity and angular momentum,
+    /// applies held directions and prescribed motions, moves its pose to the end of the
+    /// next step and gives each of its nodes the velocity and angular velocity that take it
+    /// there. The work of held and prescribed motions is booked as external work.
+    fn rigid(&mut self, dt_v: f64, dt_next: f64) {
+        let t = self.time;
+        for b in 0..self.bodies.len() {
+            let def = &self.c.rigid[b];
+            let st = self.bodies[b];
+            let mut f = [0.0; 3];
+            let mut torque = [0.0; 3];
+            for &i in &def.nodes {
+                let i = i as usize;
+                let m = self.c.mass[i];
+                let fi = [m * self.a[i][0], m * self.a[i][1], m * self.a[i][2]];
+                let r = crate::rigid::sub(self.x[i], st.centre);
+                let ri = cross(r, fi);
+                for d in 0..3 {
+                    f[d] += fi[d];
+                    torque[d] += ri[d] + self.c.inertia[i] * self.alpha[i][d];
                 }
-                if mask[3 + d] {
-                    self.alpha[i][d] = 0.0;
+            }
+            let j = st.inertia(def);
+            let l = mul(&j, st.w);
+            let mut v = [0.0; 3];
+            let mut lnew = [0.0; 3];
+            for d in 0..3 {
+                v[d] = st.v[d] + dt_v * f[d] / def.mass;
+                lnew[d] = l[d] + dt_v * torque[d];
+            }
+            let mut w = mul(&inverse(&j), lnew);
+            let (free_v, free_w) = (v, w);
+            let mut held = st;
+            held.v = v;
+            held.w = w;
+            held.hold(&def.constraints);
+            v = held.v;
+            w = held.w;
+            for dr in &self.c.drives {
+                if !matches!(dr.target, DriveTarget::Body(k) if k == b) {
+                    continue;
+                }
+                let (k, lin) = if dr.dof < 3 {
+                    (dr.dof, true)
+                } else {
+                    (dr.dof - 3, false)
+                };
+                let cur = if lin { st.v[k] } else { st.w[k] };
+                let target = match dr.kind {
+                    MotionKind::Velocity => self.drive_value(dr, t + 0.5 * dt_next),
+                    MotionKind::Acceleration => self.drive_value(dr, t).map(|a| cur + dt_v * a),
+                    MotionKind::Displacement => self
+                        .drive_value(dr, t + dt_next)
+                        .map(|u| (def.centre[k] + u - st.centre[k]) / dt_next),
+                };
+                if let Some(val) = target {
+                    if lin {
+                        v[k] = val;
+                    } else {
+                        w[k] = val;
+                    }
+                }
+            }
+            // Work of the held and prescribed components: the impulse that changed the
+            // free motion into the imposed one, with the mean velocity over the kick.
+            let dl = mul(&j, [w[0] - free_w[0], w[1] - free_w[1], w[2] - free_w[2]]);
+            for d in 0..3 {
+                self.energies.external_work +=
+                    def.mass * (v[d] - free_v[d]) * 0.5 * (st.v[d] + v[d]);
+                self.energies.external_work += dl[d] * 0.5 * (st.w[d] + w[d]);
+            }
+            let centre = [
+                st.centre[0] + dt_next * v[0],
+                st.centre[1] + dt_next * v[1],
+                st.centre[2] + dt_next * v[2],
+            ];
+            let rot = crate::rigid::matmul(
+                &rotation([dt_next * w[0], dt_next * w[1], dt_next * w[2]]),
+                &st.rotation,
+            );
+            for (k, &i) in def.nodes.iter().enumerate() {
+                let i = i as usize;
+                let r = mul(&rot, def.offsets[k]);
+                for d in 0..3 {
+                    let target = (centre[d] + r[d] - self.x[i][d]) / dt_next;
+                    self.a[i][d] = (target - self.v[i][d]) / dt_v;
+                    self.alpha[i][d] = (w[d] - self.w[i][d]) / dt_v;
+                }
+            }
+            self.bodies[b] = RigidState {
+                centre,
+                rotation: rot,
+                v,
+                w,
+            };
+        }
+    }
+
+    /// Prescribed motions of nodes: sets the driven components of the accelerations so
+    /// that velocity, displacement or acceleration follow their curves over the next step,
+    /// booking the work of the imposed change as external work.
+    fn drive_nodes(&mut self, dt_v: f64, dt_next: f64) {
+        let t = self.time;
+        for dr in &self.c.drives {
+            let DriveTarget::Nodes(nodes) = &dr.target else {
+                continue;
+            };
+            let (k, lin) = if dr.dof < 3 {
+                (dr.dof, true)
+            } else {
+                (dr.dof - 3, false)
+            };
+            for &i in nodes {
+                let i = i as usize;
+                let (vcur, acur, m) = if lin {
+                    (self.v[i][k], self.a[i][k], self.c.mass[i])
+                } else {
+                    (self.w[i][k], self.alpha[i][k], self.c.inertia[i])
+                };
+                let a = match dr.kind {
+                    MotionKind::Velocity => self
+                        .drive_value(dr, t + 0.5 * dt_next)
+                        .map(|v| (v - vcur) / dt_v),
+                    MotionKind::Acceleration => self.drive_value(dr, t),
+                    MotionKind::Displacement => self.drive_value(dr, t + dt_next).map(|u| {
+                        let target = (self.c.x0[i][k] + u - self.x[i][k]) / dt_next;
+                        (target - vcur) / dt_v
+                    }),
+                };
+                let Some(a) = a else { continue };
+                let vnew = vcur + dt_v * a;
+                self.energies.external_work += m * (a - acur) * dt_v * 0.5 * (vcur + vnew);
+                if lin {
+                    self.a[i][k] = a;
+                } else {
+                    self.alpha[i][k] = a;
                 }
             }
         }
-        // Damping energy over the kick, with the mid-step velocities.
-        if self.damping > 0.0 {
-            let e: f64 = chunked_sum(&self.v, &self.c.mass, |v, m| m * dot(*v, *v));
-            self.energies.damping += self.damping * e * dt_v;
-        }
-        // Velocity update, kinetic energy and the finiteness check in one pass over fixed
-        // node chunks, summed in chunk order.
-        let half = 0.5 * dt_next;
-        let (a, al) = (&self.a, &self.alpha);
-        let (mass, inertia) = (&self.c.mass, &self.c.inertia);
-        self.v
-            .par_chunks_mut(NODE_CHUNK)
-            .zip(self.w.par_chunks_mut(NODE_CHUNK))
-            .zip(self.v_int.par_chunks_mut(NODE_CHUNK))
-            .zip(self.w_int.par_chunks_mut(NODE_CHUNK))
-            .zip(self.kick_sums.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, ((((v, w), vi), wi), sum))| {
-                let first = c * NODE_CHUNK;
-                let (mut kt, mut kr, mut bad) = (0.0, 0.0, false);
-                for j in 0..v.len() {
-                    let i = first + j;
-                    for d in 0..3 {
-                        vi[j][d] = v[j][d] + h_prev * a[i][d];
-                        v[j][d] = vi[j][d] + half * a[i][d];
-                        wi[j][d] = w[j][d] + h_prev * al[i][d];
-                        w[j][d] = wi[j][d] + half * al[i][d];
-                    }
-                    kt += 0.5 * mass[i] * dot(vi[j], vi[j]);
-                    kr += 0.5 * inertia[i] * dot(wi[j], wi[j]);
-                    bad |= v[j].iter().any(|x| !x.is_finite());
-                }
-                *sum = KickSum { kt, kr, bad };
-            });
-        let (mut ke_t, mut ke_r) = (0.0, 0.0);
-        self.v_bad = false;
-        for s in &self.kick_sums {
-            ke_t += s.kt;
-            ke_r += s.kr;
-            self.v_bad |= s.bad;
-        }
-        self.energies.kinetic = ke_t + ke_r;
     }
 
     /// First step: stress-free forces, time step, `a^0` and the half-step velocities.
@@ -940,8 +1137,13 @@ impl Simulation {
         let hist = self.c.history.clone();
         let nh = hist.len();
         let mut samples: Vec<Vec<f64>> = Vec::with_capacity(n_samples);
+        // The per-part energies of every sample, interpolated like the rest between the
+        // cycles around it; they cost a pass over elements and nodes, so they are taken
+        // only ahead of a step that may reach a sample.
+        let mut part_samples: Vec<Vec<f64>> = Vec::with_capacity(n_samples);
         let mut prev_t = self.time;
         let mut prev = self.snapshot(&hist);
+        let mut prev_parts = (self.time, self.part_snapshot());
         let mut next = 0usize;
         let mut next_report = 0.0;
         while next < n_samples {
@@ -960,6 +1162,18 @@ impl Simulation {
                         .map(|(a, b)| a + s * (b - a))
                         .collect(),
                 );
+                let cur_parts = self.part_snapshot();
+                let from = if prev_parts.0 == prev_t {
+                    &prev_parts.1
+                } else {
+                    &cur_parts
+                };
+                part_samples.push(
+                    from.iter()
+                        .zip(&cur_parts)
+                        .map(|(a, b)| a + s * (b - a))
+                        .collect(),
+                );
                 next += 1;
                 continue;
             }
@@ -968,6 +1182,9 @@ impl Simulation {
             }
             prev_t = self.time;
             prev = self.snapshot(&hist);
+            if ts <= (self.time + self.dt_half) * (1.0 + 1e-9) {
+                prev_parts = (self.time, self.part_snapshot());
+            }
             self.step()?;
             if self.time >= next_report {
                 progress(&Progress {
@@ -981,6 +1198,7 @@ impl Simulation {
         }
         if samples.is_empty() {
             samples.push(self.snapshot(&hist));
+            part_samples.push(self.part_snapshot());
         }
         let column = |r: usize| -> Vec<f64> { samples.iter().map(|s| s[r]).collect() };
         let axes = ["x", "y", "z"];
@@ -1012,9 +1230,30 @@ impl Simulation {
             0.0,
             "energy",
         )?;
+        let walls = self.wall_histories(&samples, 9 * nh + ENERGY_LABELS.len(), interval)?;
+        let part_energies = self.part_histories(&part_samples, interval)?;
+        let mut wall_peaks = Vec::with_capacity(self.c.walls.len());
+        let mut peak_total: f64 = 0.0;
+        if let Some(walls) = &walls {
+            for k in 0..walls.samples() {
+                let total: f64 = (0..self.c.walls.len())
+                    .map(|w| walls.value(4 * w + 3, k))
+                    .sum();
+                peak_total = peak_total.max(total);
+            }
+            for (w, wall) in self.c.walls.iter().enumerate() {
+                let peak = walls
+                    .channel(4 * w + 3)
+                    .iter()
+                    .fold(0.0_f64, |a, &b| a.max(b));
+                wall_peaks.push((wall.id, peak));
+            }
+        }
         let e = self.energies;
         let mut it = nodal.into_iter();
         Ok(RunResult {
+            walls,
+            part_energies,
             parts: self.part_energies(),
             displacement: it.next().flatten(),
             velocity: it.next().flatten(),
@@ -1036,7 +1275,8 @@ impl Simulation {
                 } else {
                     0.0
                 },
-                peak_wall_force: self.peak_wall,
+                peak_wall_force: peak_total,
+                wall_peaks,
                 energies: e,
                 elements: self.c.elems.len(),
                 mass: self.c.mass.iter().sum(),
@@ -1069,7 +1309,86 @@ impl Simulation {
             self.wall_force[1],
             self.wall_force[2],
         ]);
+        for j in &self.wall_impulse {
+            s.extend_from_slice(j);
+        }
         s
+    }
+
+    /// Per part, `[internal, kinetic, hourglass, damping]` now: the element sums of the
+    /// accumulated energies, and the kinetic energy of the mass (and rotary inertia) each
+    /// element gives its nodes, at the velocities of the last completed cycle.
+    fn part_snapshot(&self) -> Vec<f64> {
+        let np = self.c.part_ids.len();
+        let mut out = vec![0.0; 4 * np];
+        for (k, (e, acc)) in self.c.elems.iter().zip(&self.elem_energy).enumerate() {
+            let p = 4 * e.part as usize;
+            out[p] += acc[0];
+            out[p + 2] += acc[1];
+            out[p + 3] += acc[2];
+            let [m, inr] = self.elem_mass[k];
+            let n = if e.tri { 3 } else { 4 };
+            for &i in &e.nodes[..n] {
+                let (v, w) = (self.v_int[i as usize], self.w_int[i as usize]);
+                out[p + 1] += 0.5 * (m * dot(v, v) + inr * dot(w, w));
+            }
+        }
+        out
+    }
+
+    /// The force of each wall on the structure sampled at the output interval: sample `k`
+    /// is the impulse the wall gave between samples `k - 1` and `k` over the interval (0 at
+    /// `t = 0`, the impulse of the first cycle counting in the first interval); channels
+    /// `<id>.fx, <id>.fy, <id>.fz` (global components) and `<id>.f` (the normal force: the
+    /// sum over nodes of the force along the wall's normal at each node).
+    fn wall_histories(
+        &self,
+        samples: &[Vec<f64>],
+        at: usize,
+        dt: f64,
+    ) -> Result<Option<Histories>> {
+        let nw = self.c.walls.len();
+        if nw == 0 {
+            return Ok(None);
+        }
+        let mut labels = Vec::with_capacity(4 * nw);
+        let mut chans = Vec::with_capacity(4 * nw);
+        for (w, wall) in self.c.walls.iter().enumerate() {
+            for (k, name) in ["fx", "fy", "fz", "f"].iter().enumerate() {
+                labels.push(format!("{}.{name}", wall.id));
+                let col = at + 4 * w + k;
+                let mut prev = 0.0;
+                chans.push(
+                    samples
+                        .iter()
+                        .enumerate()
+                        .map(|(j, s)| {
+                            let f = if j == 0 { 0.0 } else { (s[col] - prev) / dt };
+                            prev = s[col];
+                            f
+                        })
+                        .collect(),
+                );
+            }
+        }
+        Ok(Some(Histories::from_channels(labels, chans, dt, 0.0, "force")?))
+    }
+
+    /// The per-part energies sampled at the output interval: channels
+    /// `<part>.internal, <part>.kinetic, <part>.hourglass, <part>.damping`.
+    fn part_histories(&self, samples: &[Vec<f64>], dt: f64) -> Result<Histories> {
+        let mut labels = Vec::new();
+        let mut chans = Vec::new();
+        for (p, id) in self.c.part_ids.iter().enumerate() {
+            for (k, name) in ["internal", "kinetic", "hourglass", "damping"]
+                .iter()
+                .enumerate()
+            {
+                labels.push(format!("{id}.{name}"));
+                chans.push(samples.iter().map(|s| s[4 * p + k]).collect());
+            }
+        }
+        Ok(Histories::from_channels(labels, chans, dt, 0.0, "energy")?)
     }
 
     /// Estimates the largest natural circular frequency `omega_max` of the undeformed,
@@ -1114,13 +1433,16 @@ impl Simulation {
             let om: Vec<[f64; 3]> = u.iter().map(|r| [r[3], r[4], r[5]]).collect();
             let mut f = vec![[0.0; 6]; nn];
             for e in &self.c.elems {
+                if self.c.parts[e.props as usize].rigid {
+                    continue;
+                }
                 let mut st = vec![0.0; self.stride];
                 let out = eval_element(
                     e,
                     &self.c.x0,
                     &vel,
                     &om,
-                    &self.c.parts[e.part as usize],
+                    &self.c.parts[e.props as usize],
                     &mut st,
                     1.0,
                     self.kernel,
@@ -1158,6 +1480,22 @@ impl Simulation {
         }
         lambda.max(0.0).sqrt()
     }
+}
+
+/// Per element, the mass `rho t A / n` and rotary inertia `m max(t^2/12, A/8)` it gives
+/// each of its `n` nodes, on the initial geometry (as the model's set-up lumps them).
+fn element_masses(c: &Compiled) -> Vec<[f64; 2]> {
+    c.elems
+        .iter()
+        .map(|e| {
+            let n = if e.tri { 3 } else { 4 };
+            let xs: Vec<[f64; 3]> = e.nodes[..n].iter().map(|&i| c.x0[i as usize]).collect();
+            let area = crate::geometry::polygon_area(&xs);
+            let p = &c.parts[e.props as usize];
+            let m = p.mat.rho * p.t * area / n as f64;
+            [m, m * (p.t * p.t / 12.0).max(area / 8.0)]
+        })
+        .collect()
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -58,6 +58,10 @@ pub(crate) fn check_material(m: &Material) -> Result<()> {
             positive(w("Cowper-Symonds p"), r.p)?;
         }
     }
+    if let MaterialLaw::PlasticCurve { rate: Some(r), .. } = m.law {
+        positive(w("Cowper-Symonds C"), r.c)?;
+        positive(w("Cowper-Symonds p"), r.p)?;
+    }
     Ok(())
 }
 

@@ -109,6 +109,8 @@ fn square_tube_mean_crush_force_matches_wierzbicki_abramowicz() {
         });
     }
     m.walls.push(RigidWall {
+        id: 0,
+        shape: impactcal_shell::WallShape::Plane,
         nodes: None,
         point: [0.0; 3],
         head: [0.0, 0.0, 1.0],

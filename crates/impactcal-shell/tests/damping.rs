@@ -138,6 +138,8 @@ fn damped_penalty_wall_rebounds_like_a_spring_dashpot() {
             [0.0, 0.0, -v0],
         ));
         m.walls.push(RigidWall {
+            id: 0,
+            shape: impactcal_shell::WallShape::Plane,
             nodes: None,
             point: [0.0; 3],
             head: [0.0, 0.0, 1.0],
@@ -225,6 +227,8 @@ fn invariant_numbering_makes_results_independent_of_node_order() {
         [2.0, 1.0, -20.0],
     ));
     m.walls.push(RigidWall {
+        id: 0,
+        shape: impactcal_shell::WallShape::Plane,
         nodes: None,
         point: [0.0; 3],
         head: [0.0, 0.0, 1.0],
@@ -321,6 +325,8 @@ fn new_options_are_bit_identical_for_any_thread_count() {
     }
     let mut m = tilted;
     m.walls.push(RigidWall {
+        id: 0,
+        shape: impactcal_shell::WallShape::Plane,
         nodes: None,
         point: [0.0; 3],
         head: [0.0, 0.0, 1.0],

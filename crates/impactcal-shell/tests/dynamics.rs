@@ -16,6 +16,8 @@ use impactcal_shell::{
 
 fn floor(normal: [f64; 3], mu: f64) -> RigidWall {
     RigidWall {
+        id: 0,
+        shape: impactcal_shell::WallShape::Plane,
         nodes: None,
         point: [0.0; 3],
         head: normal,

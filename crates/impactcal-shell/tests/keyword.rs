@@ -75,6 +75,8 @@ fn full_model() -> impactcal_shell::ShellModel {
     n.rotation = [0.1, 0.0, -0.2];
     m.initial_velocities.push(n);
     m.walls.push(RigidWall {
+        id: 0,
+        shape: impactcal_shell::WallShape::Plane,
         nodes: None,
         point: [0.0; 3],
         head: [0.0, 0.0, 1.0],
@@ -82,6 +84,8 @@ fn full_model() -> impactcal_shell::ShellModel {
         method: WallMethod::Kinematic,
     });
     m.walls.push(RigidWall {
+        id: 0,
+        shape: impactcal_shell::WallShape::Plane,
         nodes: Some(7),
         point: [-1.0, 0.0, 0.0],
         head: [0.0, 0.0, 0.0],

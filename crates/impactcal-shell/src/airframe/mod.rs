@@ -47,7 +47,7 @@ pub use catalogue::{
 use crate::error::{Result, ShellError};
 use crate::model::{
     BulkViscosity, CowperSymonds, InitialVelocity, Material, MaterialLaw, Part, RigidWall, Section,
-    ShellModel, VelocityTarget, WallMethod,
+    ShellModel, VelocityTarget,
 };
 use crate::simulation::{RunResult, Simulation};
 use mesh::{Counts, MassSite, Mesh};
@@ -410,6 +410,7 @@ impl Airframe {
                 title: part.name().to_string(),
                 section: id,
                 material: id,
+                hourglass: 0,
             });
             m.sections.push(Section {
                 nip: THICKNESS_POINTS,
@@ -453,11 +454,8 @@ impl Airframe {
         m.control.invariant_numbering = true;
         m.bulk_viscosity = Some(BulkViscosity::default());
         m.walls.push(RigidWall {
-            nodes: None,
-            point: [0.0; 3],
-            head: [0.0, 0.0, 1.0],
             friction: values.global("ground.friction"),
-            method: WallMethod::Kinematic,
+            ..RigidWall::plane([0.0; 3], [0.0, 0.0, 1.0])
         });
         m.control.end_time = o.end_time;
         m.output.interval = o.output_interval;

@@ -3,7 +3,18 @@
 use crate::error::{Result, ShellError};
 use crate::geometry::thickness_rule;
 use crate::material::MaterialProps;
-use crate::model::{Hourglass, HourglassForm, Material, Section, ThicknessRule};
+use crate::model::{Hourglass, HourglassForm, Material, MaterialLaw, Section, ThicknessRule};
+
+/// A material with the elastic constants of `m` (for re-checking a section).
+fn material_of(m: &MaterialProps) -> Material {
+    Material {
+        id: 0,
+        density: m.rho,
+        youngs: m.e,
+        poisson: m.nu,
+        law: MaterialLaw::Elastic,
+    }
+}
 use crate::validate::{check_hourglass, check_material, check_section};
 
 /// Number of state values ahead of the thickness points: transverse shear resultants
@@ -43,6 +54,12 @@ pub struct PartProps {
     /// Shell bulk viscosity coefficients `[Q1, Q2]` (`[0, 0]`: none), see
     /// [`crate::model::BulkViscosity`].
     pub(crate) bulk: [f64; 2],
+    /// A rigid part: its elements are not evaluated (they carry no stress).
+    pub(crate) rigid: bool,
+    /// The part's section and hourglass control, to make the constants of a shell with its
+    /// own thickness.
+    pub(crate) section: Section,
+    pub(crate) hourglass: Hourglass,
 }
 
 impl PartProps {
@@ -78,7 +95,41 @@ impl PartProps {
             stiffness_damping: 0.0,
             z_moments,
             bulk: [0.0, 0.0],
+            rigid: false,
+            section: *section,
+            hourglass: *hourglass,
         })
+    }
+
+    /// The same part with the thickness `t` (a shell of `*ELEMENT_SHELL_THICKNESS`): the
+    /// thickness points scale with it; everything else is kept.
+    ///
+    /// # Errors
+    /// [`ShellError::Value`] when `t` is not finite and positive.
+    pub(crate) fn with_thickness(&self, t: f64, section: &Section) -> Result<Self> {
+        let sec = Section {
+            thickness: t,
+            ..*section
+        };
+        let mut p = PartProps::new(&sec, &material_of(&self.mat), &self.hourglass)?;
+        p.mat = self.mat.clone();
+        p.stiffness_damping = self.stiffness_damping;
+        p.bulk = self.bulk;
+        p.rigid = self.rigid;
+        Ok(p)
+    }
+
+    /// The same part with a piecewise-linear hardening curve `(plastic strain, yield
+    /// stress)` (see [`MaterialProps::with_hardening`]).
+    ///
+    /// # Errors
+    /// [`ShellError::Value`] when the curve is not usable.
+    pub(crate) fn with_hardening(mut self, points: Vec<(f64, f64)>) -> Result<Self> {
+        self.mat = self
+            .mat
+            .with_hardening(points)
+            .map_err(|m| ShellError::value("hardening curve", m))?;
+        Ok(self)
     }
 
     /// The same part with stiffness-proportional damping `coef` (see

@@ -435,6 +435,9 @@ mod tests {
             stiffness_damping: 0.0,
             z_moments: [0.0, 0.1 * 0.2025 * t * t * 2.0 + 0.2 * 0.0625 * t * t * 2.0],
             bulk: [0.0, 0.0],
+            rigid: false,
+            section: crate::model::Section::new(1, t),
+            hourglass: crate::model::Hourglass::default(),
         }
     }
 

@@ -4,8 +4,17 @@ use std::path::Path;
 
 use crate::error::{Result, ShellError};
 use crate::model::{
-    HourglassForm, MaterialLaw, NodeTarget, ShellModel, ThicknessRule, VelocityTarget, WallMethod,
+    Hardening, Hourglass, HourglassForm, MaterialLaw, MotionKind, MotionTarget, NodeTarget,
+    ShellModel, ThicknessRule, VelocityTarget, WallMethod, WallShape, WeldNodes,
 };
+
+/// The IHQ of a hourglass form (1 viscous, 4 stiffness).
+fn ihq(h: &Hourglass) -> u64 {
+    match h.form {
+        HourglassForm::Viscous => 1,
+        HourglassForm::Stiffness => 4,
+    }
+}
 
 /// Formats `v` right-aligned in `w` characters with as many digits as fit; the shortest
 /// exact representation when it fits.
@@ -110,11 +119,22 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
         ));
     }
     w("*CONTROL_HOURGLASS".into());
-    let ihq = match hg.form {
-        HourglassForm::Viscous => 1,
-        HourglassForm::Stiffness => 4,
-    };
-    w(format!("{}{}", int(ihq, 10), real(hg.membrane, 10)));
+    w(format!("{}{}", int(ihq(hg), 10), real(hg.membrane, 10)));
+    for h in &model.hourglass_defs {
+        let q = &h.hourglass;
+        w("*HOURGLASS".into());
+        w(format!(
+            "{}{}{}{}{}{}{}{}",
+            int(h.id, 10),
+            int(ihq(q), 10),
+            real(q.membrane, 10),
+            int(0, 10),
+            real(0.0, 10),
+            real(0.0, 10),
+            real(q.rotation, 10),
+            real(q.transverse, 10)
+        ));
+    }
     if model.damping != 0.0 {
         w("*DAMPING_GLOBAL".into());
         w(format!("{}{}", int(0, 10), real(model.damping, 10)));
@@ -189,6 +209,65 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                 let (c, p) = rate.map_or((0.0, 0.0), |r| (r.c, r.p));
                 w(format!("{}{}", real(c, 10), real(p, 10)));
             }
+            MaterialLaw::PlasticCurve { hardening, rate } => {
+                w("*MAT_PIECEWISE_LINEAR_PLASTICITY".into());
+                w(format!(
+                    "{}{}{}{}",
+                    int(m.id, 10),
+                    real(m.density, 10),
+                    real(m.youngs, 10),
+                    real(m.poisson, 10)
+                ));
+                let (c, p) = rate.map_or((0.0, 0.0), |r| (r.c, r.p));
+                let lcss = match hardening {
+                    Hardening::Curve(id) => id,
+                    Hardening::Points { .. } => 0,
+                };
+                w(format!("{}{}{}", real(c, 10), real(p, 10), int(lcss, 10)));
+                let (mut eps, mut es) = (String::new(), String::new());
+                if let Hardening::Points { len, points } = hardening {
+                    for &(e, y) in &points[..len.min(8)] {
+                        eps.push_str(&real(e, 10));
+                        es.push_str(&real(y, 10));
+                    }
+                }
+                w(eps);
+                w(es);
+            }
+            MaterialLaw::Rigid { constraints } => {
+                w("*MAT_RIGID".into());
+                w(format!(
+                    "{}{}{}{}",
+                    int(m.id, 10),
+                    real(m.density, 10),
+                    real(m.youngs, 10),
+                    real(m.poisson, 10)
+                ));
+                let code = |d: [bool; 3]| -> u64 {
+                    match d {
+                        [false, false, false] => 0,
+                        [true, false, false] => 1,
+                        [false, true, false] => 2,
+                        [false, false, true] => 3,
+                        [true, true, false] => 4,
+                        [false, true, true] => 5,
+                        [true, false, true] => 6,
+                        [true, true, true] => 7,
+                    }
+                };
+                let held = constraints
+                    .translation
+                    .iter()
+                    .chain(&constraints.rotation)
+                    .any(|&b| b);
+                w(format!(
+                    "{}{}{}",
+                    real(if held { 1.0 } else { 0.0 }, 10),
+                    int(code(constraints.translation), 10),
+                    int(code(constraints.rotation), 10)
+                ));
+                w(String::new());
+            }
         }
     }
     for sec in &model.sections {
@@ -213,11 +292,20 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
         w("*PART".into());
         w(p.title.clone());
         w(format!(
-            "{}{}{}",
+            "{}{}{}{}{}",
             int(p.id, 10),
             int(p.section, 10),
-            int(p.material, 10)
+            int(p.material, 10),
+            int(0, 10),
+            int(p.hourglass, 10)
         ));
+    }
+    for set in &model.part_sets {
+        w("*SET_PART_LIST".into());
+        w(int(set.id, 10));
+        for chunk in set.parts.chunks(8) {
+            w(chunk.iter().map(|&n| int(n, 10)).collect());
+        }
     }
     for c in &model.curves {
         w("*DEFINE_CURVE".into());
@@ -257,7 +345,11 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
         ));
     }
     w("*ELEMENT_SHELL".into());
-    for e in &model.shells {
+    for e in model
+        .shells
+        .iter()
+        .filter(|e| !model.element_thickness.iter().any(|t| t.shell == e.id))
+    {
         w(format!(
             "{}{}{}{}{}{}",
             int(e.id, 8),
@@ -267,6 +359,27 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             int(e.nodes[2], 8),
             int(e.nodes[3], 8)
         ));
+    }
+    if !model.element_thickness.is_empty() {
+        w("*ELEMENT_SHELL_THICKNESS".into());
+        for t in &model.element_thickness {
+            let Some(e) = model.shells.iter().find(|e| e.id == t.shell) else {
+                return Err(unrepresentable(
+                    format!("element thickness of shell {}", t.shell),
+                    "the shell does not exist",
+                ));
+            };
+            w(format!(
+                "{}{}{}{}{}{}",
+                int(e.id, 8),
+                int(e.part, 8),
+                int(e.nodes[0], 8),
+                int(e.nodes[1], 8),
+                int(e.nodes[2], 8),
+                int(e.nodes[3], 8)
+            ));
+            w(t.nodal.iter().map(|&v| real(v, 16)).collect());
+        }
     }
     if !model.masses.is_empty() {
         w("*ELEMENT_MASS".into());
@@ -310,8 +423,10 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                 w(int(nsid, 10));
                 w(format!("{}{}", v(iv.translation), v(iv.rotation)));
             }
-            (VelocityTarget::Part(_), _) | (VelocityTarget::NodeSet(_), true) => {
+            (VelocityTarget::Part(_) | VelocityTarget::PartSet(_), _)
+            | (VelocityTarget::NodeSet(_), true) => {
                 let (id, styp) = match iv.target {
+                    VelocityTarget::PartSet(p) => (p, 1),
                     VelocityTarget::Part(p) => (p, 2),
                     VelocityTarget::NodeSet(s) => (s, 3),
                     _ => (0, 0),
@@ -347,7 +462,15 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                 "friction >= 1 (FRIC = 1 means no sliding)",
             ));
         }
-        w("*RIGIDWALL_PLANAR".into());
+        let suffix = if wall.id > 0 { "_ID" } else { "" };
+        let kw = match wall.shape {
+            WallShape::Plane => "*RIGIDWALL_PLANAR",
+            WallShape::Cylinder { .. } => "*RIGIDWALL_GEOMETRIC_CYLINDER",
+        };
+        w(format!("{kw}{suffix}"));
+        if wall.id > 0 {
+            w(int(wall.id, 10));
+        }
         w(int(wall.nodes.unwrap_or(0), 10));
         let fric = if wall.friction.is_infinite() {
             1.0
@@ -361,6 +484,63 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             .map(|&c| real(c, 10))
             .collect();
         w(format!("{p}{}", real(fric, 10)));
+        if let WallShape::Cylinder { radius, length } = wall.shape {
+            w(format!("{}{}", real(radius, 10), real(length, 10)));
+        }
+    }
+    for weld in &model.spot_welds {
+        match weld.nodes {
+            WeldNodes::Pair([a, b]) => {
+                w(if weld.id > 0 {
+                    "*CONSTRAINED_SPOTWELD_ID"
+                } else {
+                    "*CONSTRAINED_SPOTWELD"
+                }
+                .into());
+                if weld.id > 0 {
+                    w(int(weld.id, 10));
+                }
+                w(format!("{}{}", int(a, 10), int(b, 10)));
+            }
+            WeldNodes::Set(s) => {
+                w(if weld.id > 0 {
+                    "*CONSTRAINED_GENERALIZED_WELD_SPOT_ID"
+                } else {
+                    "*CONSTRAINED_GENERALIZED_WELD_SPOT"
+                }
+                .into());
+                if weld.id > 0 {
+                    w(int(weld.id, 10));
+                }
+                w(int(s, 10));
+                w(String::new());
+            }
+        }
+    }
+    for pm in &model.prescribed {
+        let (kw, id) = match pm.target {
+            MotionTarget::Node(n) => ("*BOUNDARY_PRESCRIBED_MOTION_NODE", n),
+            MotionTarget::NodeSet(s) => ("*BOUNDARY_PRESCRIBED_MOTION_SET", s),
+            MotionTarget::Rigid(p) => ("*BOUNDARY_PRESCRIBED_MOTION_RIGID", p),
+        };
+        let dof = if pm.dof < 3 { pm.dof + 1 } else { pm.dof + 2 } as u64;
+        let vad = match pm.kind {
+            MotionKind::Velocity => 0,
+            MotionKind::Acceleration => 1,
+            MotionKind::Displacement => 2,
+        };
+        w(kw.into());
+        w(format!(
+            "{}{}{}{}{}{}{}{}",
+            int(id, 10),
+            int(dof, 10),
+            int(vad, 10),
+            int(pm.curve, 10),
+            real(pm.scale, 10),
+            int(0, 10),
+            real(pm.death, 10),
+            real(pm.birth, 10)
+        ));
     }
     w("*END".into());
     Ok(s)
