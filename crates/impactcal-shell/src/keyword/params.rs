@@ -64,11 +64,12 @@ pub(crate) fn parameters(
             // (name field, value field or expression)
             let mut defs: Vec<(String, String, std::result::Result<f64, String>)> = Vec::new();
             if expression {
-                let (head, rest) = if c.text.contains(',') {
+                let w = ctx.format.width(10);
+                let head_has_comma = c.text.chars().take(w).any(|ch| ch == ',');
+                let (head, rest) = if head_has_comma {
                     let (h, r) = c.text.split_once(',').unwrap_or((c.text, ""));
                     (h.trim().to_string(), r.trim().to_string())
                 } else {
-                    let w = ctx.format.width(10);
                     let cut = w.min(c.text.len());
                     let cut = (cut..=c.text.len())
                         .find(|&k| c.text.is_char_boundary(k))
