@@ -987,6 +987,12 @@ impl Simulation {
             Some(dt) => dt,
             None => self.control.tssfac * min,
         };
+        if dt.is_infinite() && min.is_infinite() {
+            return Err(ShellError::value(
+                "time step",
+                "every part is rigid, so no element sets a stable step: give a fixed step (Control::fixed_dt)",
+            ));
+        }
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(self.unstable(arg, format!("time step {dt} is not positive")));
         }
@@ -1371,7 +1377,9 @@ impl Simulation {
                 );
             }
         }
-        Ok(Some(Histories::from_channels(labels, chans, dt, 0.0, "force")?))
+        Ok(Some(Histories::from_channels(
+            labels, chans, dt, 0.0, "force",
+        )?))
     }
 
     /// The per-part energies sampled at the output interval: channels

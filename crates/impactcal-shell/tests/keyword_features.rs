@@ -51,7 +51,8 @@ fn strip(parts: &str, extra: &str) -> String {
     s
 }
 
-const TWO_PARTS: &str = "*PART\nleft\n         1         1         1\n*PART\nright\n         2         1         1\n";
+const TWO_PARTS: &str =
+    "*PART\nleft\n         1         1         1\n*PART\nright\n         2         1         1\n";
 
 fn velocity_bits(text: &str) -> Vec<u64> {
     let deck = parse_deck(text, "t.k").unwrap();
@@ -249,7 +250,10 @@ fn per_part_hourglass_definitions_are_honoured() {
     assert_eq!(velocity_bits(&control), velocity_bits(&by_part));
     // QB and QW: the bending and warping coefficients default to QM.
     let deck = parse_deck(
-        &strip(parts_hg, "*HOURGLASS\n         5         4      0.07         0       0.0       0.0      0.03\n"),
+        &strip(
+            parts_hg,
+            "*HOURGLASS\n         5         4      0.07         0       0.0       0.0      0.03\n",
+        ),
         "qb.k",
     )
     .unwrap();
@@ -269,7 +273,9 @@ fn per_part_hourglass_definitions_are_honoured() {
     );
     let model = parse_deck(&bad, "bad.k").unwrap().model;
     match Simulation::new(&model).err().unwrap() {
-        ShellError::Reference { what, id, .. } => assert_eq!((what, id), ("hourglass definition", 9)),
+        ShellError::Reference { what, id, .. } => {
+            assert_eq!((what, id), ("hourglass definition", 9))
+        }
         e => panic!("{e}"),
     }
 }
@@ -288,23 +294,30 @@ fn element_thickness_replaces_the_section_thickness() {
         .take(4)
         .collect();
     for l in &shells {
-        cards += &format!("{l}\n{:>16}{:>16}{:>16}{:>16}\n", "0.003", "0.003", "0.003", "0.003");
+        cards += &format!(
+            "{l}\n{:>16}{:>16}{:>16}{:>16}\n",
+            "0.003", "0.003", "0.003", "0.003"
+        );
     }
-    let own = base.replace(
-        &format!("*ELEMENT_SHELL\n{}\n", shells.join("\n")),
-        &cards,
-    );
+    let own = base.replace(&format!("*ELEMENT_SHELL\n{}\n", shells.join("\n")), &cards);
     assert_eq!(velocity_bits(&three), velocity_bits(&own));
     // Two shells thicker: the mass is rho sum t_e A_e.
     let mut half = String::from("*ELEMENT_SHELL\n");
     half += &format!("{}\n{}\n*ELEMENT_SHELL_THICKNESS\n", shells[0], shells[1]);
     for l in &shells[2..] {
-        half += &format!("{l}\n{:>16}{:>16}{:>16}{:>16}\n", "0.004", "0.0", "0.004", "0.004");
+        half += &format!(
+            "{l}\n{:>16}{:>16}{:>16}{:>16}\n",
+            "0.004", "0.0", "0.004", "0.004"
+        );
     }
     let text = base.replace(&format!("*ELEMENT_SHELL\n{}\n", shells.join("\n")), &half);
     let deck = parse_deck(&text, "half.k").unwrap();
     // A zero nodal thickness is the section's, and unequal values are warned.
-    assert!(deck.warnings.iter().any(|w| w.contains("unequal nodal thicknesses")));
+    assert!(
+        deck.warnings
+            .iter()
+            .any(|w| w.contains("unequal nodal thicknesses"))
+    );
     let sim = Simulation::new(&deck.model).unwrap();
     let total: f64 = sim.masses().iter().sum();
     // Areas of the warped strip elements from the model's own geometry.
@@ -377,7 +390,10 @@ fn parameter_expressions_follow_the_parameters_before_them() {
     let bad = text.replace("R t2      2*thk", "R t2      2*t3");
     match parse_deck(&bad, "bad.k").unwrap_err() {
         ShellError::Keyword { message, .. } => {
-            assert!(message.contains("`t3` is no parameter defined before"), "{message}")
+            assert!(
+                message.contains("`t3` is no parameter defined before"),
+                "{message}"
+            )
         }
         e => panic!("{e}"),
     }
@@ -420,7 +436,10 @@ fn piecewise_plasticity_follows_its_curve_and_matches_the_bilinear_material() {
             let [sx, sy, txy, p] = sim.point_state(e, k).unwrap();
             let vm = (sx * sx + sy * sy - sx * sy + 3.0 * txy * txy).sqrt();
             let y = 2.5e7 + 1.225e9 * p;
-            assert!(vm <= y * (1.0 + 1e-9), "element {e} point {k}: {vm} above {y}");
+            assert!(
+                vm <= y * (1.0 + 1e-9),
+                "element {e} point {k}: {vm} above {y}"
+            );
             if p > 0.0 {
                 yielded += 1;
             }
@@ -431,7 +450,10 @@ fn piecewise_plasticity_follows_its_curve_and_matches_the_bilinear_material() {
     let soft = lcss.replace("1.25e+9\n", "1.0e+6\n");
     let model = parse_deck(&soft, "soft.k").unwrap().model;
     let e = Simulation::new(&model).err().unwrap().to_string();
-    assert!(e.contains("material 1, hardening") && e.contains("softening"), "{e}");
+    assert!(
+        e.contains("material 1, hardening") && e.contains("softening"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -441,12 +463,17 @@ fn sensors_and_output_keywords_are_skipped_with_a_warning() {
         "*SENSOR_DEFINE_FORCE\n         1RWALL              2X                  0\n*DATABASE_RBDOUT\n   1.0e-5\n*DATABASE_BINARY_RUNRSF\n      1000\n",
     );
     let deck = parse_deck(&text, "s.k").unwrap();
-    for kw in ["*SENSOR_DEFINE_FORCE", "*DATABASE_RBDOUT", "*DATABASE_BINARY_RUNRSF"] {
+    for kw in [
+        "*SENSOR_DEFINE_FORCE",
+        "*DATABASE_RBDOUT",
+        "*DATABASE_BINARY_RUNRSF",
+    ] {
         assert!(
-            deck.warnings.iter().any(|w| w.contains(kw) && w.contains("ignored")),
+            deck.warnings
+                .iter()
+                .any(|w| w.contains(kw) && w.contains("ignored")),
             "{kw}: {:?}",
             deck.warnings
         );
     }
 }
-

@@ -116,11 +116,7 @@ fn every_unsupported_keyword_is_listed_in_one_error_with_its_line() {
         "*PART\n",
         "*CONTACT_AUTOMATIC_SINGLE_SURFACE\n         1\n*SECTION_SOLID\n         2\n*PART\n",
     );
-    let text = edit(
-        &text,
-        "*END\n",
-        "*MAT_SPOTWELD\n         3\n*END\n",
-    );
+    let text = edit(&text, "*END\n", "*MAT_SPOTWELD\n         3\n*END\n");
     match parse_deck(&text, "many.k").unwrap_err() {
         ShellError::UnsupportedKeywords { file, found } => {
             assert_eq!(file, "many.k");
