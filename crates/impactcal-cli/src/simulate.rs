@@ -116,9 +116,19 @@ pub struct Args {
     /// nodes) here (wide CSV, labels `<node>.<x|y|z>`).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write the energies and the wall force here (wide CSV).
+    /// Write the global energies (LS-DYNA's glstat quantities) and the walls' total force
+    /// here (wide CSV).
     #[arg(long)]
     pub energies: Option<PathBuf>,
+    /// Write the force of each rigid wall on the structure here, sampled at the output
+    /// interval as the mean over each interval (wide CSV, columns `<wall id>.fx|fy|fz|f`,
+    /// `f` the normal force).
+    #[arg(long)]
+    pub wall_forces: Option<PathBuf>,
+    /// Write the energies of each part here (wide CSV, columns
+    /// `<part>.internal|kinetic|hourglass|damping`).
+    #[arg(long)]
+    pub part_energies: Option<PathBuf>,
     /// The nodal quantity written to `--out`.
     #[arg(long, value_enum, default_value_t)]
     pub quantity: QuantityArg,
@@ -195,10 +205,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some(path) = &args.energies {
         result.energies.write_csv(path)?;
     }
+    if let Some(path) = &args.wall_forces {
+        let w = result.walls.as_ref().ok_or_else(|| {
+            CliError::input(format!("{name}: --wall-forces needs a rigid wall in the model"))
+        })?;
+        w.write_csv(path)?;
+    }
+    if let Some(path) = &args.part_energies {
+        result.part_energies.write_csv(path)?;
+    }
     let s = &result.summary;
     eprintln!(
         "impactcal: {} shells, {} cycles to t = {:.4e}; time step {:.3e} (first {:.3e}, max {:.3e}); \
-         energy ratio {:.4}; {}; peak wall force {:.4e}; \
+         energy ratio {:.4}; {}; peak wall force {:.4e}{}; \
          {:.2} s wall time on {} threads ({:.3} us per element-cycle)",
         s.elements,
         s.cycles,
@@ -209,11 +228,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
         s.energy_ratio,
         hourglass_message(&s.energies, s.hourglass_share),
         s.peak_wall_force,
+        wall_peaks(&s.wall_peaks),
         wall,
         pool.current_num_threads(),
         1e6 * wall / (s.cycles.max(1) as f64 * s.elements.max(1) as f64)
     );
     Ok(())
+}
+
+/// Each wall's sampled peak, when there are several walls.
+fn wall_peaks(peaks: &[(u64, f64)]) -> String {
+    if peaks.len() < 2 {
+        return String::new();
+    }
+    let each: Vec<String> = peaks
+        .iter()
+        .map(|(id, f)| format!("wall {id} {f:.4e}"))
+        .collect();
+    format!(" ({})", each.join(", "))
 }
 
 /// The hourglass share of the internal energy, or a note that the internal energy is

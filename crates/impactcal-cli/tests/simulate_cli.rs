@@ -111,7 +111,7 @@ fn every_unsupported_keyword_is_named_on_one_line() {
     let bad = dir.path().join("many.k");
     std::fs::write(
         &bad,
-        "*KEYWORD\n*CONTACT_AUTOMATIC_SINGLE_SURFACE\n1\n*SECTION_SOLID\n2\n*MAT_024\n3\n*END\n",
+        "*KEYWORD\n*CONTACT_AUTOMATIC_SINGLE_SURFACE\n1\n*SECTION_SOLID\n2\n*MAT_SPOTWELD\n3\n*END\n",
     )
     .unwrap();
     let out = impactcal(&["simulate", "--deck", bad.to_str().unwrap()]);
@@ -121,7 +121,7 @@ fn every_unsupported_keyword_is_named_on_one_line() {
     for (kw, line) in [
         ("*CONTACT_AUTOMATIC_SINGLE_SURFACE", 2),
         ("*SECTION_SOLID", 4),
-        ("*MAT_024", 6),
+        ("*MAT_SPOTWELD", 6),
     ] {
         assert!(err.contains(&format!("{kw} (")), "{err}");
         assert!(err.contains(&format!("line {line})")), "{err}");
@@ -161,4 +161,47 @@ fn a_latin1_deck_runs_with_a_warning_and_a_motion_without_strain_has_no_hourglas
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("hourglass/internal"), "{err}");
+}
+
+/// `--wall-forces` and `--part-energies`: the wall's sampled force integrates to the
+/// momentum the strip lost and regained, the part energies add up to the global ones.
+#[test]
+fn simulate_writes_wall_forces_and_part_energies() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, p, e) = (
+        dir.path().join("w.csv"),
+        dir.path().join("p.csv"),
+        dir.path().join("e.csv"),
+    );
+    let d = example_file("decks", "strip_drop.k");
+    let out = impactcal(&[
+        "simulate",
+        "--deck",
+        d.to_str().unwrap(),
+        "--wall-forces",
+        w.to_str().unwrap(),
+        "--part-energies",
+        p.to_str().unwrap(),
+        "--energies",
+        e.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let walls = Histories::read_csv(&w).unwrap();
+    assert_eq!(walls.labels(), ["1.fx", "1.fy", "1.fz", "1.f"]);
+    let fz = walls.channel_by_label("1.fz").unwrap();
+    assert_eq!(fz[0], 0.0);
+    assert!(fz.iter().all(|&f| f >= 0.0));
+    let parts = Histories::read_csv(&p).unwrap();
+    let energies = Histories::read_csv(&e).unwrap();
+    let internal = energies.channel_by_label("internal").unwrap();
+    let part_internal = parts.channel_by_label("1.internal").unwrap();
+    for (a, b) in internal.iter().zip(part_internal) {
+        assert!((a - b).abs() <= 1e-9 * a.abs().max(1e-12), "{a} vs {b}");
+    }
+    let kinetic = energies.channel_by_label("kinetic").unwrap();
+    let part_kinetic = parts.channel_by_label("1.kinetic").unwrap();
+    // The deck has no concentrated masses, so its one part holds all the kinetic energy.
+    for (a, b) in kinetic.iter().zip(part_kinetic) {
+        assert!((a - b).abs() <= 1e-9 * a.abs(), "{a} vs {b}");
+    }
 }
