@@ -207,7 +207,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     if let Some(path) = &args.wall_forces {
         let w = result.walls.as_ref().ok_or_else(|| {
-            CliError::input(format!("{name}: --wall-forces needs a rigid wall in the model"))
+            CliError::input(format!(
+                "{name}: --wall-forces needs a rigid wall in the model"
+            ))
         })?;
         w.write_csv(path)?;
     }

@@ -185,7 +185,11 @@ fn simulate_writes_wall_forces_and_part_energies() {
         "--energies",
         e.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let walls = Histories::read_csv(&w).unwrap();
     assert_eq!(walls.labels(), ["1.fx", "1.fy", "1.fz", "1.f"]);
     let fz = walls.channel_by_label("1.fz").unwrap();

@@ -16,8 +16,10 @@
 //! quantity = "velocity"    # built-in solver: the nodal quantity written
 //!
 //! [solver.output]
-//! format = "csv"           # "csv" | "nodout" | "user-csv"
+//! format = "csv"           # "csv" | "nodout" | "binout" | "user-csv"
 //! file = "out.csv"
+//! # binout: branch = "nodout" (or "glstat", "matsum", "rwforc/forces", ...) and
+//! # channels = ["x_velocity", "167.z_velocity"] (variables or `<id>.<variable>` labels)
 //!
 //! [executor]
 //! kind = "processes"       # "local" | "processes" | "slurm"

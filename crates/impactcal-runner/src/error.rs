@@ -152,6 +152,16 @@ pub enum RunnerError {
         /// What is wrong.
         message: String,
     },
+    /// An LS-DYNA result file (`binout` or `nodout`) that cannot be read: not the format,
+    /// a feature the reader does not cover, cut short, or a branch, variable or id that is
+    /// not there.
+    #[error("{}: {message}", path.display())]
+    Result {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, with the byte offset or line where there is one.
+        message: String,
+    },
     /// The batch was interrupted (Ctrl-C); the journal holds everything done so far and a
     /// rerun resumes.
     #[error("interrupted; {message}")]
@@ -180,7 +190,8 @@ impl RunnerError {
             | RunnerError::SolverStart { .. }
             | RunnerError::Scheduler { .. }
             | RunnerError::Submit { .. }
-            | RunnerError::Journal { .. } => ErrorKind::BadInput,
+            | RunnerError::Journal { .. }
+            | RunnerError::Result { .. } => ErrorKind::BadInput,
             RunnerError::RunIo { .. } | RunnerError::Io { .. } => ErrorKind::Io,
             RunnerError::SolverExit { .. }
             | RunnerError::Timeout { .. }

@@ -37,10 +37,12 @@
 //! ```
 
 pub mod batch;
+pub mod binout;
 pub mod config;
 pub mod error;
 pub mod executor;
 pub mod journal;
+pub mod lsda;
 pub mod model;
 pub mod outputs;
 pub mod solver;
@@ -48,10 +50,11 @@ pub mod template;
 pub mod workdir;
 
 pub use batch::{Batch, BatchReport, Cancel, Hooks, OnFinished, RunResult};
+pub use binout::Binout;
 pub use config::BatchConfig;
 pub use error::{Result, RunnerError};
 pub use executor::{Executor, ProcessOptions, SlurmOptions, run_batch, run_batch_with};
 pub use model::SolverModel;
-pub use outputs::{NodalQuantity, OutputFormat, OutputSpec};
+pub use outputs::{NodalQuantity, OutputFormat, OutputSpec, read_nodout};
 pub use solver::{Solver, SolverCommand, fingerprint};
 pub use template::Template;

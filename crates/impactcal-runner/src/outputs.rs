@@ -3,9 +3,10 @@
 //!
 //! Time bases: our CSV must be uniform (as everywhere in the workspace). LS-DYNA writes a
 //! `nodout` block at the first cycle past each output interval, so its time stamps stray by
-//! up to one solver step; a `nodout` or user CSV whose steps are not uniform is put on the
-//! uniform base of its median step by linear interpolation
-//! ([`impactcal_core::signal::resample_uniform`]).
+//! up to one solver step; a `nodout`, `binout` or user CSV whose steps are not uniform is
+//! put on the uniform base of their mean step by linear interpolation (same number of
+//! samples, same first and last time), or of the smallest step when the steps differ by
+//! more than half of it (an output interval that changed during the run), with a note.
 //!
 //! The `nodout` layout read here is the one LS-DYNA documents and its `l2a` translator
 //! writes: a block per output time headed `n o d a l   p r i n t   o u t   f o r   t i m e
@@ -17,7 +18,6 @@
 
 use std::path::{Path, PathBuf};
 
-use impactcal_core::signal::resample_uniform;
 use impactcal_core::{CoreError, Histories, Table, TableOptions};
 use serde::{Deserialize, Serialize};
 
@@ -32,6 +32,9 @@ pub enum OutputFormat {
     Csv,
     /// LS-DYNA's ASCII `nodout`.
     Nodout,
+    /// A branch of LS-DYNA's `binout` (LSDA) files ([`crate::binout`]): `branch` and
+    /// `channels` name what to read.
+    Binout,
     /// A CSV with a header, its time column and channel columns named in the configuration.
     UserCsv,
 }
@@ -64,6 +67,12 @@ pub struct OutputSpec {
     /// `nodout`: the nodes to keep (all by default), in this order.
     #[serde(default)]
     pub nodes: Option<Vec<u64>>,
+    /// `binout`: the branch (`nodout`, `glstat`, `matsum`, `rwforc/forces`, ...).
+    #[serde(default)]
+    pub branch: Option<String>,
+    /// `binout`: the channels, variable names or `<id>.<variable>` labels (all by default).
+    #[serde(default)]
+    pub channels: Option<Vec<String>>,
     /// `user-csv`: the time column (`time` by default).
     #[serde(default)]
     pub time_column: Option<String>,
@@ -88,6 +97,8 @@ impl OutputSpec {
             file: file.into(),
             quantity: NodalQuantity::default(),
             nodes: None,
+            branch: None,
+            channels: None,
             time_column: None,
             columns: None,
             end_time: None,
@@ -115,6 +126,12 @@ impl OutputSpec {
                 ),
             });
         }
+        if self.format == OutputFormat::Binout && self.branch.as_deref().is_none_or(str::is_empty) {
+            return Err(RunnerError::Config {
+                file: file.into(),
+                message: "output format `binout` needs `branch` (for example \"nodout\")".into(),
+            });
+        }
         if let Some(t) = self.end_time {
             if !(t.is_finite() && t > 0.0) {
                 return Err(RunnerError::Config {
@@ -139,6 +156,19 @@ impl OutputSpec {
             path: path.clone(),
             message,
         };
+        if self.format == OutputFormat::Binout {
+            if !path.exists() {
+                return Err(fail("the solver wrote no output file".into()));
+            }
+            let b = crate::binout::Binout::open(&path).map_err(|e| fail(e.to_string()))?;
+            let (h, _) = b
+                .histories(
+                    self.branch.as_deref().unwrap_or(""),
+                    self.channels.as_deref().unwrap_or(&[]),
+                )
+                .map_err(|e| fail(e.to_string()))?;
+            return self.finish(h, fail);
+        }
         let text = match std::fs::read(&path) {
             Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
@@ -153,9 +183,16 @@ impl OutputSpec {
         let h = match self.format {
             OutputFormat::Csv => Histories::parse_csv(&text, &name).map_err(|e| fail(position(e))),
             OutputFormat::Nodout => parse_nodout(&text, self.quantity, self.nodes.as_deref())
+                .map(|(h, _)| h)
                 .map_err(|(line, m)| fail(format!("line {line}: {m}"))),
             OutputFormat::UserCsv => self.parse_user_csv(&text, &name).map_err(fail),
+            OutputFormat::Binout => Err(fail("binout is not text".into())),
         }?;
+        self.finish(h, fail)
+    }
+
+    /// The end-time check and the unit of histories read back.
+    fn finish(&self, h: Histories, fail: impl Fn(String) -> RunnerError) -> Result<Histories> {
         if let Some(end) = self.end_time {
             let last = h.start() + (h.samples() - 1) as f64 * h.dt();
             if last < end - 0.5 * h.dt() {
@@ -204,7 +241,9 @@ impl OutputSpec {
             .map(|n| table.rows().iter().map(|r| r[col(n)]).collect())
             .collect();
         let labels = channel_names.iter().map(|s| s.to_string()).collect();
-        uniform(labels, &times, channels, table.lines()).map_err(|(l, m)| format!("row {l}: {m}"))
+        uniform(labels, &times, channels, table.lines())
+            .map(|(h, _)| h)
+            .map_err(|(l, m)| format!("row {l}: {m}"))
     }
 }
 
@@ -222,14 +261,14 @@ fn position(e: CoreError) -> String {
     }
 }
 
-/// Histories from channels at `times`, resampled when the steps are not uniform. `lines`
-/// gives the source line of each time for messages.
-fn uniform(
+/// Histories from channels at `times`, resampled when the steps are not uniform, with a
+/// note saying so. `lines` gives the source line of each time for messages.
+pub(crate) fn uniform(
     labels: Vec<String>,
     times: &[f64],
     channels: Vec<Vec<f64>>,
     lines: &[usize],
-) -> std::result::Result<Histories, (usize, String)> {
+) -> std::result::Result<(Histories, Option<String>), (usize, String)> {
     let first = lines.first().copied().unwrap_or(1);
     if times.len() < 2 {
         return Err((first, "need at least two output times".into()));
@@ -251,13 +290,54 @@ fn uniform(
     let is_uniform = times
         .windows(2)
         .all(|w| ((w[1] - w[0]) - mean).abs() <= 1e-6 * mean);
-    let (channels, dt) = if is_uniform {
-        (channels, mean)
+    let (lo, hi) = times
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .fold((f64::INFINITY, 0.0_f64), |(a, b), d| (a.min(d), b.max(d)));
+    let (channels, dt, note) = if is_uniform {
+        (channels, mean, None)
+    } else if hi <= 1.5 * lo {
+        // Steps that stray by a solver step about one output interval: their mean, which
+        // keeps the number of samples and the first and last times.
+        let c = resample_at(times, &channels, mean);
+        let note = format!(
+            "output steps from {lo:e} to {hi:e}: resampled by linear interpolation onto their mean {mean:e} ({} samples)",
+            c.first().map_or(0, Vec::len)
+        );
+        (c, mean, Some(note))
     } else {
-        let (c, r) = resample_uniform(times, &channels).map_err(|e| (first, e.to_string()))?;
-        (c, r.dt)
+        // Output intervals that changed during the run: the smallest keeps every value.
+        let c = resample_at(times, &channels, lo);
+        let note = format!(
+            "output steps from {lo:e} to {hi:e} (the interval changed during the run): resampled by linear interpolation onto the smallest step ({} samples)",
+            c.first().map_or(0, Vec::len)
+        );
+        (c, lo, Some(note))
     };
-    Histories::from_channels(labels, channels, dt, times[0], "").map_err(|e| (first, e.to_string()))
+    Histories::from_channels(labels, channels, dt, times[0], "")
+        .map(|h| (h, note))
+        .map_err(|e| (first, e.to_string()))
+}
+
+/// Linear interpolation of `channels` at `times[0] + k dt` for every `k` up to the last time
+/// (within `1e-9` of a step).
+fn resample_at(times: &[f64], channels: &[Vec<f64>], dt: f64) -> Vec<Vec<f64>> {
+    let span = times[times.len() - 1] - times[0];
+    let n = (span / dt + 1e-9).floor() as usize + 1;
+    channels
+        .iter()
+        .map(|c| {
+            (0..n)
+                .map(|k| {
+                    let t = times[0] + k as f64 * dt;
+                    let j = times.partition_point(|&x| x <= t).clamp(1, times.len() - 1);
+                    let (t0, t1) = (times[j - 1], times[j]);
+                    let s = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+                    c[j - 1] + s * (c[j] - c[j - 1])
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// A number as LS-DYNA's Fortran output writes it: `1.2345E-03`, or `1.2345-100` when the
@@ -273,6 +353,74 @@ fn fortran_number(s: &str) -> Option<f64> {
     format!("{mantissa}e{exponent}").parse().ok()
 }
 
+/// The numbers of a line of LS-DYNA's fixed-width output, which may run together
+/// (`0.00000E+00-1.50000E+00` is two numbers) and may drop the exponent letter
+/// (`-1.5000-345`): each number is an optional sign, digits with a decimal point, and an
+/// optional exponent (a letter `E`/`D` and signed digits, or a sign and digits right after
+/// the mantissa).
+fn scan_numbers(s: &str) -> std::result::Result<Vec<f64>, String> {
+    let b = s.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    let digits = |mut i: usize| {
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        i
+    };
+    while i < b.len() {
+        if b[i] == b' ' || b[i] == b'\t' {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        if b[i] == b'+' || b[i] == b'-' {
+            i += 1;
+        }
+        let m0 = i;
+        i = digits(i);
+        if i < b.len() && b[i] == b'.' {
+            i = digits(i + 1);
+        }
+        if i == m0 || (i == m0 + 1 && b[m0] == b'.') {
+            return Err(format!("`{}` is not a number", &s[start..]));
+        }
+        let mantissa = &s[start..i];
+        let mut exponent = String::new();
+        if i < b.len() && matches!(b[i], b'E' | b'e' | b'D' | b'd') {
+            let e0 = i + 1;
+            let mut j = e0;
+            if j < b.len() && (b[j] == b'+' || b[j] == b'-') {
+                j += 1;
+            }
+            let k = digits(j);
+            if k == j {
+                return Err(format!("`{}` has an exponent without digits", &s[start..k]));
+            }
+            exponent = s[e0..k].to_string();
+            i = k;
+        } else if i + 1 < b.len()
+            && (b[i] == b'+' || b[i] == b'-')
+            && b[i + 1].is_ascii_digit()
+            && mantissa.contains('.')
+        {
+            let k = digits(i + 1);
+            exponent = s[i..k].to_string();
+            i = k;
+        }
+        let text = if exponent.is_empty() {
+            mantissa.to_string()
+        } else {
+            format!("{mantissa}e{exponent}")
+        };
+        out.push(
+            text.parse::<f64>()
+                .map_err(|_| format!("`{}` is not a number", &s[start..i]))?,
+        );
+    }
+    Ok(out)
+}
+
 /// One output time of a `nodout` file: its header line, its time, and (node, x/y/z) in file
 /// order.
 type Step = (usize, f64, Vec<(u64, [f64; 3])>);
@@ -283,7 +431,7 @@ fn parse_nodout(
     text: &str,
     quantity: NodalQuantity,
     nodes: Option<&[u64]>,
-) -> std::result::Result<Histories, (usize, String)> {
+) -> std::result::Result<(Histories, Option<String>), (usize, String)> {
     #[derive(PartialEq)]
     enum Block {
         None,
@@ -340,25 +488,31 @@ fn parse_nodout(
         if block != Block::Translation {
             continue;
         }
-        let fields: Vec<&str> = trimmed.split_whitespace().collect();
-        if fields.len() < 13 {
+        let (id, rest) = trimmed
+            .split_once(char::is_whitespace)
+            .unwrap_or((trimmed, ""));
+        let node: u64 = id
+            .parse()
+            .map_err(|_| (n, format!("node id `{id}` is not a whole number")))?;
+        let values = scan_numbers(rest).map_err(|m| (n, m))?;
+        if values.len() < 12 {
             return Err((
                 n,
                 format!(
                     "a node record with {} of 13 fields (truncated?)",
-                    fields.len()
+                    values.len() + 1
                 ),
             ));
         }
-        let node: u64 = fields[0]
-            .parse()
-            .map_err(|_| (n, format!("node id `{}` is not a whole number", fields[0])))?;
         let mut xyz = [0.0; 3];
         for (c, v) in xyz.iter_mut().enumerate() {
-            let f = fields[1 + offset + c];
-            *v = fortran_number(f)
-                .filter(|v| v.is_finite())
-                .ok_or((n, format!("`{f}` is not a finite number")))?;
+            *v = values[offset + c];
+            if !v.is_finite() {
+                return Err((
+                    n,
+                    format!("value {} of node {node} is not finite", offset + c + 1),
+                ));
+            }
         }
         if let Some(step) = steps.last_mut() {
             step.2.push((node, xyz));
@@ -412,6 +566,26 @@ fn parse_nodout(
     let times: Vec<f64> = steps.iter().map(|s| s.1).collect();
     let lines: Vec<usize> = steps.iter().map(|s| s.0).collect();
     uniform(labels, &times, channels, &lines)
+}
+
+/// Reads an ASCII `nodout` file: the `quantity` of the `nodes` (all by default) as
+/// histories labelled `<node>.<x|y|z>`, on a uniform time base, with a note when the output
+/// times had to be resampled (see the module docs).
+///
+/// # Errors
+/// [`RunnerError::Io`] when the file cannot be read; [`RunnerError::Result`] naming the
+/// line of a malformed, truncated or mixed record or a node that is not in the file.
+pub fn read_nodout(
+    path: &Path,
+    quantity: NodalQuantity,
+    nodes: Option<&[u64]>,
+) -> Result<(Histories, Option<String>)> {
+    let bytes = std::fs::read(path).map_err(crate::error::io(path))?;
+    let text = String::from_utf8_lossy(&bytes);
+    parse_nodout(&text, quantity, nodes).map_err(|(line, m)| RunnerError::Result {
+        path: path.to_path_buf(),
+        message: format!("line {line}: {m}"),
+    })
 }
 
 /// The path of the output of a run in `dir`.
@@ -481,7 +655,7 @@ mod tests {
     fn nodout_reads_the_documented_layout() {
         let times: Vec<f64> = (0..6).map(|k| k as f64 * 1e-4).collect();
         let text = nodout(&times, &[21, 42], v);
-        let h = parse_nodout(&text, NodalQuantity::Velocity, None).unwrap();
+        let (h, _) = parse_nodout(&text, NodalQuantity::Velocity, None).unwrap();
         assert_eq!(h.labels(), ["21.x", "21.y", "21.z", "42.x", "42.y", "42.z"]);
         assert_eq!(h.samples(), 6);
         assert!((h.dt() - 1e-4).abs() < 1e-12);
@@ -492,7 +666,7 @@ mod tests {
             "{}",
             h.value(4, 3)
         );
-        let d = parse_nodout(&text, NodalQuantity::Displacement, Some(&[42])).unwrap();
+        let (d, _) = parse_nodout(&text, NodalQuantity::Displacement, Some(&[42])).unwrap();
         assert_eq!(d.labels(), ["42.x", "42.y", "42.z"]);
         let e = parse_nodout(&text, NodalQuantity::Velocity, Some(&[7])).unwrap_err();
         assert!(e.1.contains("node 7 is not in the file"), "{e:?}");
@@ -513,9 +687,11 @@ mod tests {
             e.1.contains("lists 1 nodes where the first lists 3"),
             "{e:?}"
         );
-        // Output times a solver step late: resampled onto the median step.
+        // Output times a solver step late: resampled onto the mean step.
         let late = [0.0, 1.02e-4, 2.01e-4, 3.03e-4, 4.0e-4];
-        let h = parse_nodout(&nodout(&late, &[1], v), NodalQuantity::Velocity, None).unwrap();
+        let (h, note) =
+            parse_nodout(&nodout(&late, &[1], v), NodalQuantity::Velocity, None).unwrap();
+        assert!(note.unwrap().contains("resampled"));
         assert!((h.dt() - 1e-4).abs() < 3e-6, "{}", h.dt());
         // Velocity is linear in t, so the interpolated samples stay on the line.
         for k in 0..h.samples() {
