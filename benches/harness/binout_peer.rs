@@ -9,7 +9,9 @@ use std::path::Path;
 use impactcal::runner::Binout;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let json = std::env::args().nth(1).ok_or("usage: binout_peer LASSO.json")?;
+    let json = std::env::args()
+        .nth(1)
+        .ok_or("usage: binout_peer LASSO.json")?;
     let peer: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json)?)?;
     let files = peer.as_object().ok_or("not a JSON object")?;
     println!(
@@ -44,7 +46,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
             };
             if b.times.len() != times.len() {
-                println!("{file:<48} {branch:<20} {} times here, {} in lasso", b.times.len(), times.len());
+                println!(
+                    "{file:<48} {branch:<20} {} times here, {} in lasso",
+                    b.times.len(),
+                    times.len()
+                );
                 worst = f64::INFINITY;
                 continue;
             }
@@ -70,13 +76,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .map(|(k, (_, c))| (k, c))
                     .collect();
                 if ours_cols.len() != width {
-                    println!("{file:<48} {branch:<20} {name}: {} columns here, {width} in lasso", ours_cols.len());
+                    println!(
+                        "{file:<48} {branch:<20} {name}: {} columns here, {width} in lasso",
+                        ours_cols.len()
+                    );
                     worst = f64::INFINITY;
                     continue;
                 }
                 for (j, (_, col)) in ours_cols.iter().enumerate() {
                     for (s, row) in rows.iter().enumerate() {
-                        let v = row.as_array().and_then(|r| r[j].as_f64()).unwrap_or(f64::NAN);
+                        let v = row
+                            .as_array()
+                            .and_then(|r| r[j].as_f64())
+                            .unwrap_or(f64::NAN);
                         cmp(col[s], v);
                     }
                 }

@@ -132,6 +132,10 @@ pub struct Args {
     /// The nodal quantity written to `--out`.
     #[arg(long, value_enum, default_value_t)]
     pub quantity: QuantityArg,
+    /// Stop after this many cycles (a quick check that a model runs; the outputs end
+    /// there).
+    #[arg(long)]
+    pub end_cycles: Option<u64>,
     /// Number of threads of the element loop (results do not depend on it).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -164,7 +168,10 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, CliError
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let (model, name) = load(&args)?;
+    let (mut model, name) = load(&args)?;
+    if let Some(n) = args.end_cycles {
+        model.control.end_cycles = n;
+    }
     let pool = thread_pool(args.threads)?;
     let started = std::time::Instant::now();
     let result = pool.install(|| -> Result<_, ShellError> {

@@ -304,11 +304,12 @@ fn quantities(model: &ShellModel) -> Result<Vec<DeckQuantity>> {
 }
 
 /// The real parameters of a parameterised deck as quantities (+-20 % about the deck's
-/// value; one that is 0 is left out).
+/// value; one that is 0 is left out, and so is one computed by `*PARAMETER_EXPRESSION`,
+/// which follows the parameters it is computed from).
 fn deck_quantities(deck: &Deck) -> Vec<DeckQuantity> {
     deck.parameters
         .iter()
-        .filter(|p| !p.integer && p.value != 0.0)
+        .filter(|p| !p.integer && p.value != 0.0 && p.expression.is_none())
         .filter_map(|p| {
             let (lo, hi) = twenty_percent(p.value);
             Some(DeckQuantity {
@@ -380,7 +381,11 @@ impl DeckModel {
     /// the deck does not define (or the deck defines none), or a deck value of 0 would be
     /// bounded without bounds given.
     pub fn from_deck(deck: Deck, bounds: Option<&ParameterSpace>) -> Result<Self> {
-        let reals: Vec<_> = deck.parameters.iter().filter(|p| !p.integer).collect();
+        let reals: Vec<_> = deck
+            .parameters
+            .iter()
+            .filter(|p| !p.integer && p.expression.is_none())
+            .collect();
         if reals.is_empty() {
             if bounds.is_some() {
                 return Err(ShellError::value(

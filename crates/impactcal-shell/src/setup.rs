@@ -128,8 +128,15 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
     for m in &model.materials {
         check_material(m)?;
     }
+    // A section of thickness 0 serves shells that give their own thickness
+    // (*ELEMENT_SHELL_THICKNESS); its other fields are checked here, and a shell that
+    // takes its thickness from it is an error below.
+    let placeholder = |s: &Section| Section {
+        thickness: if s.thickness == 0.0 { 1.0 } else { s.thickness },
+        ..*s
+    };
     for s in &model.sections {
-        check_section(s)?;
+        check_section(&placeholder(s))?;
     }
     let hg = &model.hourglass;
     check_hourglass(hg)?;
@@ -147,7 +154,7 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
             0 => hg,
             h => &model.hourglass_defs[lookup(&hg_map, h, "hourglass definition", &by)?].hourglass,
         };
-        let mut props = PartProps::new(sec, mat, hg)?;
+        let mut props = PartProps::new(&placeholder(sec), mat, hg)?;
         if let MaterialLaw::PlasticCurve { hardening, .. } = mat.law {
             let points = crate::material::hardening_points(hardening, &model.curves)
                 .map_err(|m| ShellError::value(format!("material {}, hardening", mat.id), m))?;
@@ -229,6 +236,15 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
             },
         })?;
         let props = match own_thickness.get(&s.id) {
+            None if part_sections[part].thickness == 0.0 => {
+                return Err(ShellError::value(
+                    format!("shell {}, thickness", s.id),
+                    format!(
+                        "its section {} has thickness 0 and the shell gives none (*ELEMENT_SHELL_THICKNESS)",
+                        part_sections[part].id
+                    ),
+                ));
+            }
             None => part,
             Some(&k) => {
                 let sec: Section = part_sections[part];

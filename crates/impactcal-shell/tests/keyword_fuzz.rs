@@ -206,7 +206,10 @@ fn apply(bytes: &[u8], m: &Mutation) -> Vec<u8> {
         }
         Mutation::DropKeywordLine(f) => {
             let start = at(f);
-            if let Some(k) = (start..n).chain(0..start).find(|&k| lines[k].first() == Some(&b'*')) {
+            if let Some(k) = (start..n)
+                .chain(0..start)
+                .find(|&k| lines[k].first() == Some(&b'*'))
+            {
                 lines.remove(k);
             }
         }
@@ -282,6 +285,9 @@ fn includes_that_loop_are_an_error_naming_the_chain() {
     std::fs::write(dir.join("b.k"), "*KEYWORD\n*INCLUDE\nc.k\na.k\n*END\n").unwrap();
     std::fs::write(dir.join("c.k"), "*KEYWORD\n*TITLE\nc\n*END\n").unwrap();
     let e = read_deck(dir.join("a.k")).unwrap_err().to_string();
-    assert!(e.contains("include each other") && e.contains("a.k -> "), "{e}");
+    assert!(
+        e.contains("include each other") && e.contains("a.k -> "),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

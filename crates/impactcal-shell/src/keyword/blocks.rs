@@ -20,6 +20,9 @@ pub(crate) struct Block<'a> {
     pub kw: String,
     pub format: Format,
     pub cards: Vec<Card<'a>>,
+    /// The lines of the blank lines that ended the keyword: not cards, but a card the
+    /// keyword requires may be one of them (a card of defaults written as a blank line).
+    pub blank_tail: Vec<usize>,
 }
 
 /// The deck's blocks, and warnings about `*KEYWORD` options.
@@ -82,8 +85,10 @@ pub(crate) fn blocks(src: &Source) -> (Vec<Block<'_>>, Vec<String>) {
             }
             lines.next();
         }
-        // Trailing blank lines are not cards.
-        while cards.last().is_some_and(|c| c.text.trim().is_empty()) {
+        // Trailing blank lines are not cards (unless a required card is missing).
+        let mut blank_tail = Vec::new();
+        while let Some(c) = cards.last().filter(|c| c.text.trim().is_empty()) {
+            blank_tail.insert(0, c.line);
             cards.pop();
         }
         let end = name == "END";
@@ -93,6 +98,7 @@ pub(crate) fn blocks(src: &Source) -> (Vec<Block<'_>>, Vec<String>) {
             kw: format!("*{name}"),
             format,
             cards,
+            blank_tail,
         });
         if end {
             break;

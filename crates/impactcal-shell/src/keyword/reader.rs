@@ -142,6 +142,8 @@ pub(super) struct Kw<'b> {
     options: Vec<String>,
     cards: &'b [Card<'b>],
     pos: usize,
+    /// The trailing blank lines still available as required cards.
+    blank: &'b [usize],
 }
 
 impl<'b> Kw<'b> {
@@ -158,8 +160,15 @@ impl<'b> Kw<'b> {
         c
     }
 
-    /// The next card, or an error saying which card is missing.
+    /// The next card (a trailing blank line when the cards are used up: a card of
+    /// defaults), or an error saying which card is missing.
     pub fn take(&mut self, what: &str) -> Result<Card<'b>> {
+        if self.pos == self.cards.len()
+            && let Some((&line, rest)) = self.blank.split_first()
+        {
+            self.blank = rest;
+            return Ok(Card { line, text: "" });
+        }
         self.next().ok_or_else(|| {
             self.ctx.err(
                 self.line,
@@ -451,6 +460,7 @@ fn read_block(r: &mut Reader<'_>, src: &Source, b: &Block<'_>, how: Resolved) ->
         options,
         cards: &b.cards,
         pos: 0,
+        blank: &b.blank_tail,
     };
     let result = (entry.parse)(r, &mut kw);
     let left = kw.more().then(|| {

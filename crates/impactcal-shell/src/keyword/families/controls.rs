@@ -125,7 +125,8 @@ pub(crate) fn termination(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
 }
 
 /// `*CONTROL_TIMESTEP`: DTINIT (ignored), TSSFAC (default 0.9), ISDO (0 or 1), TSLIMT
-/// (ignored), DT2MS (0), LCTM (0).
+/// (ignored), DT2MS (0), LCTM (0); optional card DT2MSF (0), DT2MSLC (0), IMSCL (0) and
+/// fields past them (ignored).
 pub(crate) fn timestep(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     let c = kw.take("the card DTINIT, TSSFAC, ISDO, TSLIMT, DT2MS, LCTM")?;
     let f = kw.fields(&c, W10);
@@ -138,6 +139,13 @@ pub(crate) fn timestep(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     };
     f.must_be_zero(4, "DT2MS")?;
     f.must_be_zero(5, "LCTM")?;
+    // The optional second card holds further mass-scaling controls: none may be set.
+    if let Some(d) = kw.next() {
+        let g = kw.fields(&d, W10);
+        for (k, name) in ["DT2MSF", "DT2MSLC", "IMSCL"].iter().enumerate() {
+            g.must_be_zero(k, name)?;
+        }
+    }
     Ok(())
 }
 
