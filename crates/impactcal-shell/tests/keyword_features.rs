@@ -477,3 +477,50 @@ fn sensors_and_output_keywords_are_skipped_with_a_warning() {
         );
     }
 }
+
+#[test]
+fn a_deck_with_the_new_keywords_is_written_and_read_back_the_same() {
+    use impactcal_shell::keyword::write_deck;
+    let extra = "\
+*HOURGLASS
+         5         4      0.07         0       0.0       0.0      0.03      0.06
+*SET_PART_LIST
+         7
+         1         2
+*INITIAL_VELOCITY_GENERATION
+         7         1       0.0       0.0       0.0      -3.0
+       0.0       0.0       0.0       0.0       0.0       1.0
+*MAT_RIGID
+         9    7850.0   2.1e+11       0.3
+       1.0         7         0
+*MAT_PIECEWISE_LINEAR_PLASTICITY
+         8    7850.0   2.1e+11       0.3
+       0.0       0.0
+       0.0       0.1       0.5
+     2.5e7     3.0e7     4.0e7
+*RIGIDWALL_GEOMETRIC_CYLINDER_ID
+        12
+         0
+       0.0      -1.0      -0.2       0.0       1.0      -0.2       0.1
+      0.15       0.0
+*CONSTRAINED_SPOTWELD
+         1         2
+*DEFINE_CURVE
+         3
+                 0.0                 0.0
+                 1.0                 1.0
+*BOUNDARY_PRESCRIBED_MOTION_NODE
+         4         3         0         3      -2.0
+*ELEMENT_SHELL_THICKNESS
+      11       1       6       7      12      11
+           0.003           0.003           0.003           0.003
+";
+    let parts = "*PART\nleft\n         1         1         1         0         5\n*PART\nright\n         2         1         1\n";
+    let text = strip(parts, extra);
+    let deck = parse_deck(&text, "new.k").unwrap();
+    assert!(!deck.model.spot_welds.is_empty() && !deck.model.prescribed.is_empty());
+    let written = write_deck(&deck.model).unwrap();
+    let back = parse_deck(&written, "written.k").unwrap();
+    assert_eq!(back.model, deck.model);
+    assert_eq!(write_deck(&back.model).unwrap(), written);
+}
