@@ -1169,7 +1169,7 @@ impl Simulation {
                         .collect(),
                 );
                 let cur_parts = self.part_snapshot();
-                let from = if prev_parts.0 == prev_t {
+                let from = if prev_parts.0.to_bits() == prev_t.to_bits() {
                     &prev_parts.1
                 } else {
                     &cur_parts

@@ -85,27 +85,46 @@ fn unrepresentable(what: impl Into<String>, why: &str) -> ShellError {
 /// mixed with kinematic walls), a fixed time step, different hourglass coefficients per mode, initial spins on single nodes or on all nodes, an ids too large
 /// for its field.
 pub fn write_deck(model: &ShellModel) -> Result<String> {
-    let mut s = String::new();
-    let mut w = |line: String| {
-        s.push_str(line.trim_end());
-        s.push('\n');
-    };
-    w("*KEYWORD".into());
-    w("*TITLE".into());
-    w(model.title.clone());
+    let mut o = Out(String::new());
+    write_controls(model, &mut o)?;
+    write_materials(model, &mut o)?;
+    write_parts(model, &mut o)?;
+    write_mesh(model, &mut o)?;
+    write_conditions(model, &mut o)?;
+    write_walls(model, &mut o)?;
+    o.w("*END".into());
+    Ok(o.0)
+}
+
+/// The deck being written, line by line.
+struct Out(String);
+
+impl Out {
+    /// Adds a line, trailing blanks dropped.
+    fn w(&mut self, line: String) {
+        self.0.push_str(line.trim_end());
+        self.0.push('\n');
+    }
+}
+
+/// The title, controls, hourglass definitions, damping and output requests.
+fn write_controls(model: &ShellModel, o: &mut Out) -> Result<()> {
+    o.w("*KEYWORD".into());
+    o.w("*TITLE".into());
+    o.w(model.title.clone());
     let c = &model.control;
     if c.fixed_dt.is_some() {
         return Err(unrepresentable("control", "a fixed time step"));
     }
-    w("*CONTROL_TERMINATION".into());
-    w(format!(
+    o.w("*CONTROL_TERMINATION".into());
+    o.w(format!(
         "{}{}{}",
         real(c.end_time, 10),
         int(c.end_cycles, 10),
         real(c.dtmin_factor, 10)
     ));
-    w("*CONTROL_TIMESTEP".into());
-    w(format!(
+    o.w("*CONTROL_TIMESTEP".into());
+    o.w(format!(
         "{}{}{}",
         real(0.0, 10),
         real(c.tssfac, 10),
@@ -118,12 +137,12 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             "different coefficients per mode",
         ));
     }
-    w("*CONTROL_HOURGLASS".into());
-    w(format!("{}{}", int(ihq(hg), 10), real(hg.membrane, 10)));
+    o.w("*CONTROL_HOURGLASS".into());
+    o.w(format!("{}{}", int(ihq(hg), 10), real(hg.membrane, 10)));
     for h in &model.hourglass_defs {
         let q = &h.hourglass;
-        w("*HOURGLASS".into());
-        w(format!(
+        o.w("*HOURGLASS".into());
+        o.w(format!(
             "{}{}{}{}{}{}{}{}",
             int(h.id, 10),
             int(ihq(q), 10),
@@ -136,13 +155,13 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
         ));
     }
     if model.damping != 0.0 {
-        w("*DAMPING_GLOBAL".into());
-        w(format!("{}{}", int(0, 10), real(model.damping, 10)));
+        o.w("*DAMPING_GLOBAL".into());
+        o.w(format!("{}{}", int(0, 10), real(model.damping, 10)));
     }
     if !model.stiffness_damping.is_empty() {
-        w("*DAMPING_PART_STIFFNESS".into());
+        o.w("*DAMPING_PART_STIFFNESS".into());
         for d in &model.stiffness_damping {
-            w(format!("{}{}", int(d.part, 10), real(d.coef, 10)));
+            o.w(format!("{}{}", int(d.part, 10), real(d.coef, 10)));
         }
     }
     if let Some(b) = model.bulk_viscosity {
@@ -152,8 +171,8 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                 "a zero coefficient (0 means the default in *CONTROL_BULK_VISCOSITY)",
             ));
         }
-        w("*CONTROL_BULK_VISCOSITY".into());
-        w(format!(
+        o.w("*CONTROL_BULK_VISCOSITY".into());
+        o.w(format!(
             "{}{}{}",
             real(b.q1, 10),
             real(b.q2, 10),
@@ -161,28 +180,33 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
         ));
     }
     if c.invariant_numbering {
-        w("*CONTROL_ACCURACY".into());
-        w(format!("{}{}", int(0, 10), int(2, 10)));
+        o.w("*CONTROL_ACCURACY".into());
+        o.w(format!("{}{}", int(0, 10), int(2, 10)));
     }
     if let Some(alpha) = penalty_factor(model)? {
-        w("*CONTROL_CONTACT".into());
-        w(format!("{}{}", real(0.0, 10), real(alpha, 10)));
+        o.w("*CONTROL_CONTACT".into());
+        o.w(format!("{}{}", real(0.0, 10), real(alpha, 10)));
     }
     if model.output.interval > 0.0 {
-        w("*DATABASE_NODOUT".into());
-        w(real(model.output.interval, 10));
+        o.w("*DATABASE_NODOUT".into());
+        o.w(real(model.output.interval, 10));
     }
     if !model.output.history_nodes.is_empty() {
-        w("*DATABASE_HISTORY_NODE".into());
+        o.w("*DATABASE_HISTORY_NODE".into());
         for chunk in model.output.history_nodes.chunks(8) {
-            w(chunk.iter().map(|&n| int(n, 10)).collect());
+            o.w(chunk.iter().map(|&n| int(n, 10)).collect());
         }
     }
+    Ok(())
+}
+
+/// The materials.
+fn write_materials(model: &ShellModel, o: &mut Out) -> Result<()> {
     for m in &model.materials {
         match m.law {
             MaterialLaw::Elastic => {
-                w("*MAT_ELASTIC".into());
-                w(format!(
+                o.w("*MAT_ELASTIC".into());
+                o.w(format!(
                     "{}{}{}{}",
                     int(m.id, 10),
                     real(m.density, 10),
@@ -195,8 +219,8 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                 tangent_modulus,
                 rate,
             } => {
-                w("*MAT_PLASTIC_KINEMATIC".into());
-                w(format!(
+                o.w("*MAT_PLASTIC_KINEMATIC".into());
+                o.w(format!(
                     "{}{}{}{}{}{}{}",
                     int(m.id, 10),
                     real(m.density, 10),
@@ -207,11 +231,11 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                     real(1.0, 10)
                 ));
                 let (c, p) = rate.map_or((0.0, 0.0), |r| (r.c, r.p));
-                w(format!("{}{}", real(c, 10), real(p, 10)));
+                o.w(format!("{}{}", real(c, 10), real(p, 10)));
             }
             MaterialLaw::PlasticCurve { hardening, rate } => {
-                w("*MAT_PIECEWISE_LINEAR_PLASTICITY".into());
-                w(format!(
+                o.w("*MAT_PIECEWISE_LINEAR_PLASTICITY".into());
+                o.w(format!(
                     "{}{}{}{}",
                     int(m.id, 10),
                     real(m.density, 10),
@@ -223,7 +247,7 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                     Hardening::Curve(id) => id,
                     Hardening::Points { .. } => 0,
                 };
-                w(format!("{}{}{}", real(c, 10), real(p, 10), int(lcss, 10)));
+                o.w(format!("{}{}{}", real(c, 10), real(p, 10), int(lcss, 10)));
                 let (mut eps, mut es) = (String::new(), String::new());
                 if let Hardening::Points { len, points } = hardening {
                     for &(e, y) in &points[..len.min(8)] {
@@ -231,12 +255,12 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                         es.push_str(&real(y, 10));
                     }
                 }
-                w(eps);
-                w(es);
+                o.w(eps);
+                o.w(es);
             }
             MaterialLaw::Rigid { constraints } => {
-                w("*MAT_RIGID".into());
-                w(format!(
+                o.w("*MAT_RIGID".into());
+                o.w(format!(
                     "{}{}{}{}",
                     int(m.id, 10),
                     real(m.density, 10),
@@ -260,16 +284,21 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                     .iter()
                     .chain(&constraints.rotation)
                     .any(|&b| b);
-                w(format!(
+                o.w(format!(
                     "{}{}{}",
                     real(if held { 1.0 } else { 0.0 }, 10),
                     int(code(constraints.translation), 10),
                     int(code(constraints.rotation), 10)
                 ));
-                w(String::new());
+                o.w(String::new());
             }
         }
     }
+    Ok(())
+}
+
+/// Sections, parts, part sets, curves, the body load and node sets.
+fn write_parts(model: &ShellModel, o: &mut Out) -> Result<()> {
     for sec in &model.sections {
         if sec.rule == ThicknessRule::Lobatto {
             return Err(unrepresentable(
@@ -277,8 +306,8 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                 "Lobatto integration",
             ));
         }
-        w("*SECTION_SHELL".into());
-        w(format!(
+        o.w("*SECTION_SHELL".into());
+        o.w(format!(
             "{}{}{}{}",
             int(sec.id, 10),
             int(2, 10),
@@ -286,12 +315,12 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             int(sec.nip as u64, 10)
         ));
         let t = real(sec.thickness, 10);
-        w(format!("{t}{t}{t}{t}"));
+        o.w(format!("{t}{t}{t}{t}"));
     }
     for p in &model.parts {
-        w("*PART".into());
-        w(p.title.clone());
-        w(format!(
+        o.w("*PART".into());
+        o.w(p.title.clone());
+        o.w(format!(
             "{}{}{}{}{}",
             int(p.id, 10),
             int(p.section, 10),
@@ -301,15 +330,15 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
         ));
     }
     for set in &model.part_sets {
-        w("*SET_PART_LIST".into());
-        w(int(set.id, 10));
+        o.w("*SET_PART_LIST".into());
+        o.w(int(set.id, 10));
         for chunk in set.parts.chunks(8) {
-            w(chunk.iter().map(|&n| int(n, 10)).collect());
+            o.w(chunk.iter().map(|&n| int(n, 10)).collect());
         }
     }
     for c in &model.curves {
-        w("*DEFINE_CURVE".into());
-        w(format!(
+        o.w("*DEFINE_CURVE".into());
+        o.w(format!(
             "{}{}{}{}{}{}",
             int(c.id, 10),
             int(0, 10),
@@ -318,25 +347,30 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             real(c.offa, 10),
             real(c.offo, 10)
         ));
-        for &(a, o) in &c.points {
-            w(format!("{}{}", real(a, 20), real(o, 20)));
+        for &(a, y) in &c.points {
+            o.w(format!("{}{}", real(a, 20), real(y, 20)));
         }
     }
     if let Some(b) = &model.body_load_z {
-        w("*LOAD_BODY_Z".into());
-        w(format!("{}{}", int(b.curve, 10), real(b.scale, 10)));
+        o.w("*LOAD_BODY_Z".into());
+        o.w(format!("{}{}", int(b.curve, 10), real(b.scale, 10)));
     }
     for set in &model.node_sets {
-        w("*SET_NODE_LIST".into());
-        w(int(set.id, 10));
+        o.w("*SET_NODE_LIST".into());
+        o.w(int(set.id, 10));
         for chunk in set.nodes.chunks(8) {
-            w(chunk.iter().map(|&n| int(n, 10)).collect());
+            o.w(chunk.iter().map(|&n| int(n, 10)).collect());
         }
     }
+    Ok(())
+}
+
+/// Nodes, shells (with their own thicknesses) and concentrated masses.
+fn write_mesh(model: &ShellModel, o: &mut Out) -> Result<()> {
     check_width(model)?;
-    w("*NODE".into());
+    o.w("*NODE".into());
     for n in &model.nodes {
-        w(format!(
+        o.w(format!(
             "{}{}{}{}",
             int(n.id, 8),
             real(n.x[0], 16),
@@ -344,13 +378,13 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             real(n.x[2], 16)
         ));
     }
-    w("*ELEMENT_SHELL".into());
+    o.w("*ELEMENT_SHELL".into());
     for e in model
         .shells
         .iter()
         .filter(|e| !model.element_thickness.iter().any(|t| t.shell == e.id))
     {
-        w(format!(
+        o.w(format!(
             "{}{}{}{}{}{}",
             int(e.id, 8),
             int(e.part, 8),
@@ -361,7 +395,7 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
         ));
     }
     if !model.element_thickness.is_empty() {
-        w("*ELEMENT_SHELL_THICKNESS".into());
+        o.w("*ELEMENT_SHELL_THICKNESS".into());
         for t in &model.element_thickness {
             let Some(e) = model.shells.iter().find(|e| e.id == t.shell) else {
                 return Err(unrepresentable(
@@ -369,7 +403,7 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                     "the shell does not exist",
                 ));
             };
-            w(format!(
+            o.w(format!(
                 "{}{}{}{}{}{}",
                 int(e.id, 8),
                 int(e.part, 8),
@@ -378,13 +412,13 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                 int(e.nodes[2], 8),
                 int(e.nodes[3], 8)
             ));
-            w(t.nodal.iter().map(|&v| real(v, 16)).collect());
+            o.w(t.nodal.iter().map(|&v| real(v, 16)).collect());
         }
     }
     if !model.masses.is_empty() {
-        w("*ELEMENT_MASS".into());
+        o.w("*ELEMENT_MASS".into());
         for m in &model.masses {
-            w(format!(
+            o.w(format!(
                 "{}{}{}",
                 int(m.id, 8),
                 int(m.node, 8),
@@ -392,22 +426,27 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             ));
         }
     }
+    Ok(())
+}
+
+/// Constraints and initial velocities.
+fn write_conditions(model: &ShellModel, o: &mut Out) -> Result<()> {
     for spc in &model.spcs {
         let (kw, id) = match spc.target {
             NodeTarget::Node(n) => ("*BOUNDARY_SPC_NODE", n),
             NodeTarget::NodeSet(s) => ("*BOUNDARY_SPC_SET", s),
         };
-        w(kw.into());
+        o.w(kw.into());
         let dofs: String = spc.dofs.iter().map(|&d| int(u64::from(d), 10)).collect();
-        w(format!("{}{}{dofs}", int(id, 10), int(0, 10)));
+        o.w(format!("{}{}{dofs}", int(id, 10), int(0, 10)));
     }
     for (k, iv) in model.initial_velocities.iter().enumerate() {
         let v = |a: [f64; 3]| -> String { a.iter().map(|&c| real(c, 10)).collect() };
         let spin = iv.omega != 0.0;
         match (iv.target, spin) {
             (VelocityTarget::Node(n), false) => {
-                w("*INITIAL_VELOCITY_NODE".into());
-                w(format!(
+                o.w("*INITIAL_VELOCITY_NODE".into());
+                o.w(format!(
                     "{}{}{}",
                     int(n, 10),
                     v(iv.translation),
@@ -419,9 +458,9 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                     VelocityTarget::NodeSet(s) => s,
                     _ => 0,
                 };
-                w("*INITIAL_VELOCITY".into());
-                w(int(nsid, 10));
-                w(format!("{}{}", v(iv.translation), v(iv.rotation)));
+                o.w("*INITIAL_VELOCITY".into());
+                o.w(int(nsid, 10));
+                o.w(format!("{}{}", v(iv.translation), v(iv.rotation)));
             }
             (VelocityTarget::Part(_) | VelocityTarget::PartSet(_), _)
             | (VelocityTarget::NodeSet(_), true) => {
@@ -437,15 +476,15 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
                         "nodal rotations with a generation",
                     ));
                 }
-                w("*INITIAL_VELOCITY_GENERATION".into());
-                w(format!(
+                o.w("*INITIAL_VELOCITY_GENERATION".into());
+                o.w(format!(
                     "{}{}{}{}",
                     int(id, 10),
                     int(styp, 10),
                     real(iv.omega, 10),
                     v(iv.translation)
                 ));
-                w(format!("{}{}", v(iv.centre), v(iv.axis)));
+                o.w(format!("{}{}", v(iv.centre), v(iv.axis)));
             }
             (_, true) => {
                 return Err(unrepresentable(
@@ -455,6 +494,11 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             }
         }
     }
+    Ok(())
+}
+
+/// Walls, spot welds and prescribed motions.
+fn write_walls(model: &ShellModel, o: &mut Out) -> Result<()> {
     for (k, wall) in model.walls.iter().enumerate() {
         if !(wall.friction.is_infinite() || wall.friction < 1.0) {
             return Err(unrepresentable(
@@ -467,11 +511,11 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             WallShape::Plane => "*RIGIDWALL_PLANAR",
             WallShape::Cylinder { .. } => "*RIGIDWALL_GEOMETRIC_CYLINDER",
         };
-        w(format!("{kw}{suffix}"));
+        o.w(format!("{kw}{suffix}"));
         if wall.id > 0 {
-            w(int(wall.id, 10));
+            o.w(int(wall.id, 10));
         }
-        w(int(wall.nodes.unwrap_or(0), 10));
+        o.w(int(wall.nodes.unwrap_or(0), 10));
         let fric = if wall.friction.is_infinite() {
             1.0
         } else {
@@ -483,37 +527,37 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             .chain(&wall.head)
             .map(|&c| real(c, 10))
             .collect();
-        w(format!("{p}{}", real(fric, 10)));
+        o.w(format!("{p}{}", real(fric, 10)));
         if let WallShape::Cylinder { radius, length } = wall.shape {
-            w(format!("{}{}", real(radius, 10), real(length, 10)));
+            o.w(format!("{}{}", real(radius, 10), real(length, 10)));
         }
     }
     for weld in &model.spot_welds {
         match weld.nodes {
             WeldNodes::Pair([a, b]) => {
-                w(if weld.id > 0 {
+                o.w(if weld.id > 0 {
                     "*CONSTRAINED_SPOTWELD_ID"
                 } else {
                     "*CONSTRAINED_SPOTWELD"
                 }
                 .into());
                 if weld.id > 0 {
-                    w(int(weld.id, 10));
+                    o.w(int(weld.id, 10));
                 }
-                w(format!("{}{}", int(a, 10), int(b, 10)));
+                o.w(format!("{}{}", int(a, 10), int(b, 10)));
             }
             WeldNodes::Set(s) => {
-                w(if weld.id > 0 {
+                o.w(if weld.id > 0 {
                     "*CONSTRAINED_GENERALIZED_WELD_SPOT_ID"
                 } else {
                     "*CONSTRAINED_GENERALIZED_WELD_SPOT"
                 }
                 .into());
                 if weld.id > 0 {
-                    w(int(weld.id, 10));
+                    o.w(int(weld.id, 10));
                 }
-                w(int(s, 10));
-                w(String::new());
+                o.w(int(s, 10));
+                o.w(String::new());
             }
         }
     }
@@ -529,8 +573,8 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             MotionKind::Acceleration => 1,
             MotionKind::Displacement => 2,
         };
-        w(kw.into());
-        w(format!(
+        o.w(kw.into());
+        o.w(format!(
             "{}{}{}{}{}{}{}{}",
             int(id, 10),
             int(dof, 10),
@@ -542,8 +586,7 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
             real(pm.birth, 10)
         ));
     }
-    w("*END".into());
-    Ok(s)
+    Ok(())
 }
 
 fn check_width(model: &ShellModel) -> Result<()> {
