@@ -322,4 +322,53 @@ mod tests {
             "{e}"
         );
     }
+
+    #[test]
+    fn per_process_files_and_continuations_read_as_one_branch() {
+        let dir = tempfile::tempdir().unwrap();
+        let state = |d: &'static str, t: f64, big: bool| {
+            vec![
+                Var {
+                    dir: d,
+                    name: "time",
+                    code: 10,
+                    items: reals(&[t], big),
+                    len: 1,
+                },
+                Var {
+                    dir: d,
+                    name: "kinetic_energy",
+                    code: 10,
+                    items: reals(&[100.0 - t], big),
+                    len: 1,
+                },
+            ]
+        };
+        let mut first = state("/glstat/d000001", 0.0, false);
+        first.extend(state("/glstat/d000002", 1.0, false));
+        std::fs::write(dir.path().join("binout0000"), file(&first, 8, false)).unwrap();
+        // The second file big-endian with 4-byte fields: each file has its own header.
+        std::fs::write(
+            dir.path().join("binout0001"),
+            file(&state("/glstat/d000003", 2.0, true), 4, true),
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("binout0000%001"),
+            file(&state("/glstat/d000004", 3.0, false), 8, false),
+        )
+        .unwrap();
+        let b = Binout::open(&dir.path().join("binout0000")).unwrap();
+        let (h, _) = b.histories("glstat", &[]).unwrap();
+        assert_eq!(h.labels(), ["kinetic_energy"]);
+        assert_eq!(h.channel(0), [100.0, 99.0, 98.0, 97.0]);
+        // A file cut short is an error naming the byte, not a panic.
+        let whole = std::fs::read(dir.path().join("binout0001")).unwrap();
+        for cut in [0, 5, 9, 20, whole.len() - 3] {
+            let p = dir.path().join("cut");
+            std::fs::write(&p, &whole[..cut]).unwrap();
+            let r = Binout::open(&p).and_then(|b| b.histories("glstat", &[]).map(|_| ()));
+            assert!(r.is_err(), "cut at {cut}");
+        }
+    }
 }
