@@ -184,23 +184,44 @@ impl MaterialProps {
     /// else the returned stress, adding the plastic strain increment to `epsp`.
     #[inline]
     pub fn plastic_return(&self, trial: [f64; 3], epsp: &mut f64, factor: f64) -> [f64; 3] {
-        if let Some(c) = &self.curve {
-            return self.plastic_return_curve(c, trial, epsp, factor);
+        match &self.curve {
+            Some(c) => {
+                let p0 = *epsp;
+                self.return_to(trial, epsp, |dp| {
+                    let (y, h) = curve_yield(c, p0 + dp);
+                    (y * factor, h * factor)
+                })
+            }
+            None => {
+                let hf = self.hardening * factor;
+                let sy0 = (self.yield0 + self.hardening * *epsp) * factor;
+                self.return_to(trial, epsp, move |dp| (sy0 + hf * dp, hf))
+            }
         }
+    }
+
+    /// The return for the yield stress `yield_at(dp) = (sigma_y, d sigma_y / d dp)` after a
+    /// plastic strain increment `dp` (scaled by the rate factor).
+    #[inline(always)]
+    fn return_to(
+        &self,
+        trial: [f64; 3],
+        epsp: &mut f64,
+        yield_at: impl Fn(f64) -> (f64, f64),
+    ) -> [f64; 3] {
         let [sx, sy, txy] = trial;
         let s = sx + sy;
         let d = sx - sy;
         let a = 0.25 * s * s;
         let b = 0.75 * d * d + 3.0 * txy * txy;
         let vm2 = a + b;
-        let hf = self.hardening * factor;
-        let sy0 = (self.yield0 + self.hardening * *epsp) * factor;
+        let (sy0, h0) = yield_at(0.0);
         if vm2 <= sy0 * sy0 {
             return trial;
         }
         let (e, c1, c3) = (self.e, 1.0 / (1.0 - self.nu), 3.0 / (1.0 + self.nu));
         let f_of = |dp: f64| {
-            let syn = sy0 + hf * dp;
+            let (syn, hf) = yield_at(dp);
             let inv_syn = 1.0 / syn;
             let dr = 0.5 * e * dp * inv_syn;
             let p = 1.0 / (1.0 + c1 * dr);
@@ -215,7 +236,7 @@ impl MaterialProps {
         // and F decreases, so every evaluation narrows the bracket [lo, hi] of the root.
         let tol = 1e-12 * sy0 * sy0;
         let (mut lo, mut hi) = (0.0, f64::INFINITY);
-        let mut dp = (vm2.sqrt() - sy0) / (3.0 * self.g + hf);
+        let mut dp = (vm2.sqrt() - sy0) / (3.0 * self.g + h0);
         let mut fv = f_of(dp);
         for _ in 0..100 {
             let (f, df, _, _) = fv;
@@ -258,72 +279,6 @@ fn curve_yield(c: &[(f64, f64)], p: f64) -> (f64, f64) {
     let (a, b) = (c[k], c[k + 1]);
     let slope = (b.1 - a.1) / (b.0 - a.0);
     (a.1 + slope * (p - a.0), slope)
-}
-
-impl MaterialProps {
-    /// The return to the yield surface of a curve material: as `plastic_return`, with the
-    /// yield stress `sigma_y(p + dp) factor` and its slope from the curve.
-    fn plastic_return_curve(
-        &self,
-        c: &[(f64, f64)],
-        trial: [f64; 3],
-        epsp: &mut f64,
-        factor: f64,
-    ) -> [f64; 3] {
-        let [sx, sy, txy] = trial;
-        let s = sx + sy;
-        let d = sx - sy;
-        let a = 0.25 * s * s;
-        let b = 0.75 * d * d + 3.0 * txy * txy;
-        let vm2 = a + b;
-        let p0 = *epsp;
-        let sy0 = curve_yield(c, p0).0 * factor;
-        if vm2 <= sy0 * sy0 {
-            return trial;
-        }
-        let (e, c1, c3) = (self.e, 1.0 / (1.0 - self.nu), 3.0 / (1.0 + self.nu));
-        let f_of = |dp: f64| {
-            let (y, h) = curve_yield(c, p0 + dp);
-            let (syn, hf) = (y * factor, h * factor);
-            let inv_syn = 1.0 / syn;
-            let dr = 0.5 * e * dp * inv_syn;
-            let p = 1.0 / (1.0 + c1 * dr);
-            let q = 1.0 / (1.0 + c3 * dr);
-            let (ap2, bq2) = (a * p * p, b * q * q);
-            let f = ap2 + bq2 - syn * syn;
-            let df =
-                -(c1 * ap2 * p + c3 * bq2 * q) * (e - 2.0 * dr * hf) * inv_syn - 2.0 * hf * syn;
-            (f, df, p, q)
-        };
-        let tol = 1e-12 * sy0 * sy0;
-        let (mut lo, mut hi) = (0.0, f64::INFINITY);
-        let mut dp = (vm2.sqrt() - sy0) / (3.0 * self.g + curve_yield(c, p0).1 * factor);
-        let mut fv = f_of(dp);
-        for _ in 0..200 {
-            let (f, df, _, _) = fv;
-            if f.abs() <= tol {
-                break;
-            }
-            if f > 0.0 {
-                lo = dp;
-            } else {
-                hi = dp;
-            }
-            let next = dp - f / df;
-            dp = if next > lo && next < hi {
-                next
-            } else if hi.is_finite() {
-                0.5 * (lo + hi)
-            } else {
-                (2.0 * dp).max(f64::MIN_POSITIVE)
-            };
-            fv = f_of(dp);
-        }
-        let (_, _, p, q) = fv;
-        *epsp += dp;
-        let (s, d) = (p * s, q * d);
-        [0.5 * (s + d), 0.5 * (s - d), q * txy]
-    }
 }
 
 /// Von Mises stress of a plane-stress state `[s_xx, s_yy, s_xy]`.

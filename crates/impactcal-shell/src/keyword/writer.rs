@@ -533,32 +533,20 @@ fn write_walls(model: &ShellModel, o: &mut Out) -> Result<()> {
         }
     }
     for weld in &model.spot_welds {
-        match weld.nodes {
-            WeldNodes::Pair([a, b]) => {
-                o.w(if weld.id > 0 {
-                    "*CONSTRAINED_SPOTWELD_ID"
-                } else {
-                    "*CONSTRAINED_SPOTWELD"
-                }
-                .into());
-                if weld.id > 0 {
-                    o.w(int(weld.id, 10));
-                }
-                o.w(format!("{}{}", int(a, 10), int(b, 10)));
-            }
-            WeldNodes::Set(s) => {
-                o.w(if weld.id > 0 {
-                    "*CONSTRAINED_GENERALIZED_WELD_SPOT_ID"
-                } else {
-                    "*CONSTRAINED_GENERALIZED_WELD_SPOT"
-                }
-                .into());
-                if weld.id > 0 {
-                    o.w(int(weld.id, 10));
-                }
-                o.w(int(s, 10));
-                o.w(String::new());
-            }
+        let (kw, card) = match weld.nodes {
+            WeldNodes::Pair([a, b]) => (
+                "*CONSTRAINED_SPOTWELD",
+                format!("{}{}", int(a, 10), int(b, 10)),
+            ),
+            WeldNodes::Set(s) => ("*CONSTRAINED_GENERALIZED_WELD_SPOT", int(s, 10)),
+        };
+        o.w(format!("{kw}{}", if weld.id > 0 { "_ID" } else { "" }));
+        if weld.id > 0 {
+            o.w(int(weld.id, 10));
+        }
+        o.w(card);
+        if matches!(weld.nodes, WeldNodes::Set(_)) {
+            o.w(String::new());
         }
     }
     for pm in &model.prescribed {

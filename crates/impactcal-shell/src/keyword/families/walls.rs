@@ -155,15 +155,19 @@ fn never_fails(r: &mut Reader<'_>, kw: &Kw<'_>, line: usize, id: u64, f: &[(&str
     }
 }
 
+/// The id of a weld from its `_ID` card (WID), or 0.
+fn weld_id(kw: &mut Kw<'_>) -> Result<u64> {
+    if !kw.has("ID") {
+        return Ok(0);
+    }
+    let c = kw.take("the id card WID")?;
+    kw.fields(&c, W10).id(0, "WID")
+}
+
 /// `*CONSTRAINED_SPOTWELD` (`_ID`: a WID card ahead of each): N1, N2, SN, SS, N, M, TF, EP.
 pub(crate) fn spotweld(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     while kw.more() {
-        let id = if kw.has("ID") {
-            let c = kw.take("the id card WID")?;
-            kw.fields(&c, W10).id(0, "WID")?
-        } else {
-            0
-        };
+        let id = weld_id(kw)?;
         let c = kw.take("the card N1, N2, SN, SS, N, M, TF, EP")?;
         let f = kw.fields(&c, W10);
         let pair = [f.id(0, "N1")?, f.id(1, "N2")?];
@@ -185,12 +189,7 @@ pub(crate) fn spotweld(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
 /// FILTER, WINDOW, NPR, NPRT; TFAIL, EPSF, SN, SS, N, M.
 pub(crate) fn generalized_weld(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     while kw.more() {
-        let id = if kw.has("ID") {
-            let c = kw.take("the id card WID")?;
-            kw.fields(&c, W10).id(0, "WID")?
-        } else {
-            0
-        };
+        let id = weld_id(kw)?;
         let c = kw.take("the card NSID, CID, FILTER, WINDOW, NPR, NPRT")?;
         let f = kw.fields(&c, W10);
         let nsid = f.id(0, "NSID")?;
