@@ -29,6 +29,23 @@ sheet forming (pydyna example)|$pydyna|examples/Metalforming/output/model.k|ansy
 airbag, mechanics (pydyna test)|$pydyna|tests/testfiles/standard/mech.k|ansys/pydyna@7dce3c04 tests/testfiles/standard/mech.k
 Workbench deck (pydyna test)|$pydyna|tests/testfiles/keywords/test_node_sets.k|ansys/pydyna@5f75f6c3 tests/testfiles/keywords/test_node_sets.k"
 
+# An error line for the table: a list of unsupported keywords as their distinct names with
+# their count, anything else as it is (cut at 300 characters).
+condense() {
+    python3 -c '
+import re, sys
+line = sys.stdin.read().strip()
+m = re.match(r"^(.*?): (\d+) unsupported keywords: (.*)$", line)
+if m:
+    names = []
+    for k in re.findall(r"(\*[A-Z0-9_]+) \(", m.group(3)):
+        if k not in names:
+            names.append(k)
+    line = f"{m.group(2)} unsupported keywords: " + ", ".join(f"`{k}`" for k in names)
+print(line[:300].replace("|", "\\|"))
+'
+}
+
 # The outcome of one binary on one deck, as table text.
 outcome() {
     local bin=$1 deck=$2 extra=$3 limit=$4
@@ -38,7 +55,7 @@ outcome() {
     case $rc in
         0) echo "runs" ;;
         124) echo "runs (stopped after ${limit} s)" ;;
-        2) echo "refused: $(grep -v '^impactcal: warning' "$err" | head -1 | sed -e 's/^impactcal: //' -e "s|$(dirname "$deck")/||g" -e 's/|/\\|/g' | cut -c1-400)" ;;
+        2) echo "refused: $(grep -v '^impactcal: warning' "$err" | head -1 | sed -e 's/^impactcal: error: //' -e "s|$(dirname "$deck")/||g" | condense)" ;;
         *) echo "fails (exit $rc): $(grep -v '^impactcal: warning' "$err" | head -1 | sed -e 's/^impactcal: //' -e 's/|/\\|/g' | cut -c1-300)" ;;
     esac
 }
