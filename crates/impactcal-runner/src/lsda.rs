@@ -146,10 +146,7 @@ impl Cursor<'_> {
                 let mut b = vec![0u8; n as usize];
                 self.file.read_exact(&mut b).map(|_| b)
             })
-            .map(|b| {
-                self.pos += n;
-                b
-            })
+            .inspect(|_| self.pos += n)
             .map_err(|e| fault(self.path, format!("byte {}: {e}", self.pos)))
     }
 
