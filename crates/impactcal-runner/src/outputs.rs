@@ -306,7 +306,19 @@ pub(crate) fn uniform(
         );
         (c, mean, Some(note))
     } else {
-        // Output intervals that changed during the run: the smallest keeps every value.
+        // Output intervals that changed during the run: the smallest keeps every value,
+        // unless that would make far more samples than the file holds (times that are not
+        // output times: a corrupt file), which is refused before anything is allocated.
+        let samples = ((times[n - 1] - times[0]) / lo).min(1e18).floor() + 1.0;
+        let values = samples * channels.len().max(1) as f64;
+        if samples > 100.0 * n as f64 + 1000.0 || values > 5e7 {
+            return Err((
+                first,
+                format!(
+                    "output steps from {lo:e} to {hi:e}: the smallest step would give {samples:e} samples for {n} output times (the times look corrupt)"
+                ),
+            ));
+        }
         let c = resample_at(times, &channels, lo);
         let note = format!(
             "output steps from {lo:e} to {hi:e} (the interval changed during the run): resampled by linear interpolation onto the smallest step ({} samples)",

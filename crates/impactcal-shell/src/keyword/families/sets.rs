@@ -26,7 +26,7 @@ fn members(kw: &mut Kw<'_>, what: &str) -> Result<(u64, Vec<u64>)> {
                 if b == 0 && e == 0 {
                     continue;
                 }
-                if b == 0 || e < b || e - b > 100_000_000 {
+                if b == 0 || e < b || e - b > 10_000_000 {
                     return Err(f.err(format!(
                         "range B{0}BEG {b} to B{0}END {e} is not a range of {what} ids",
                         k + 1
