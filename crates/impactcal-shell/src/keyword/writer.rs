@@ -384,15 +384,7 @@ fn write_mesh(model: &ShellModel, o: &mut Out) -> Result<()> {
         .iter()
         .filter(|e| !model.element_thickness.iter().any(|t| t.shell == e.id))
     {
-        o.w(format!(
-            "{}{}{}{}{}{}",
-            int(e.id, 8),
-            int(e.part, 8),
-            int(e.nodes[0], 8),
-            int(e.nodes[1], 8),
-            int(e.nodes[2], 8),
-            int(e.nodes[3], 8)
-        ));
+        o.w(shell_card(e));
     }
     if !model.element_thickness.is_empty() {
         o.w("*ELEMENT_SHELL_THICKNESS".into());
@@ -403,15 +395,7 @@ fn write_mesh(model: &ShellModel, o: &mut Out) -> Result<()> {
                     "the shell does not exist",
                 ));
             };
-            o.w(format!(
-                "{}{}{}{}{}{}",
-                int(e.id, 8),
-                int(e.part, 8),
-                int(e.nodes[0], 8),
-                int(e.nodes[1], 8),
-                int(e.nodes[2], 8),
-                int(e.nodes[3], 8)
-            ));
+            o.w(shell_card(e));
             o.w(t.nodal.iter().map(|&v| real(v, 16)).collect());
         }
     }
@@ -575,6 +559,19 @@ fn write_walls(model: &ShellModel, o: &mut Out) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// The `*ELEMENT_SHELL` card of a shell.
+fn shell_card(e: &crate::model::Shell) -> String {
+    format!(
+        "{}{}{}{}{}{}",
+        int(e.id, 8),
+        int(e.part, 8),
+        int(e.nodes[0], 8),
+        int(e.nodes[1], 8),
+        int(e.nodes[2], 8),
+        int(e.nodes[3], 8)
+    )
 }
 
 fn check_width(model: &ShellModel) -> Result<()> {

@@ -29,13 +29,13 @@ fn never_dies(f: &Fields<'_>, k: usize) -> Result<()> {
     Ok(())
 }
 
-/// The id of a wall from its `_ID` card (ID, HEADING), or 0.
-fn wall_id(kw: &mut Kw<'_>) -> Result<u64> {
+/// The id of a definition from its `_ID` card (field `name`, then a heading), or 0.
+fn id_card(kw: &mut Kw<'_>, name: &str) -> Result<u64> {
     if !kw.has("ID") {
         return Ok(0);
     }
-    let c = kw.take("the id card ID, HEADING")?;
-    kw.fields(&c, W10).id(0, "ID")
+    let c = kw.take(&format!("the id card {name}"))?;
+    kw.fields(&c, W10).id(0, name)
 }
 
 /// `*RIGIDWALL_PLANAR` (`_ID`): NSID (0 = all nodes), NSIDEX (0), BOXID (0), OFFSET (0),
@@ -45,7 +45,7 @@ pub(crate) fn planar(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
         return Err(kw.err(kw.line, "a wall needs two cards"));
     }
     while kw.more() {
-        let id = wall_id(kw)?;
+        let id = id_card(kw, "ID")?;
         let c = kw.take("the card NSID, NSIDEX, BOXID, OFFSET, BIRTH, DEATH")?;
         let f = kw.fields(&c, W10);
         let nsid = f.opt_id(0, "NSID")?;
@@ -94,7 +94,7 @@ pub(crate) fn cylinder(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
         ));
     }
     while kw.more() {
-        let id = wall_id(kw)?;
+        let id = id_card(kw, "ID")?;
         let c = kw.take("the card NSID, NSIDEX, BOXID, BIRTH, DEATH")?;
         let d = kw.take("the card XT, YT, ZT, XH, YH, ZH, FRIC")?;
         let e = kw.take("the card RADCYL, LENCYL, NSEGS")?;
@@ -155,19 +155,10 @@ fn never_fails(r: &mut Reader<'_>, kw: &Kw<'_>, line: usize, id: u64, f: &[(&str
     }
 }
 
-/// The id of a weld from its `_ID` card (WID), or 0.
-fn weld_id(kw: &mut Kw<'_>) -> Result<u64> {
-    if !kw.has("ID") {
-        return Ok(0);
-    }
-    let c = kw.take("the id card WID")?;
-    kw.fields(&c, W10).id(0, "WID")
-}
-
 /// `*CONSTRAINED_SPOTWELD` (`_ID`: a WID card ahead of each): N1, N2, SN, SS, N, M, TF, EP.
 pub(crate) fn spotweld(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     while kw.more() {
-        let id = weld_id(kw)?;
+        let id = id_card(kw, "WID")?;
         let c = kw.take("the card N1, N2, SN, SS, N, M, TF, EP")?;
         let f = kw.fields(&c, W10);
         let pair = [f.id(0, "N1")?, f.id(1, "N2")?];
@@ -189,7 +180,7 @@ pub(crate) fn spotweld(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
 /// FILTER, WINDOW, NPR, NPRT; TFAIL, EPSF, SN, SS, N, M.
 pub(crate) fn generalized_weld(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     while kw.more() {
-        let id = weld_id(kw)?;
+        let id = id_card(kw, "WID")?;
         let c = kw.take("the card NSID, CID, FILTER, WINDOW, NPR, NPRT")?;
         let f = kw.fields(&c, W10);
         let nsid = f.id(0, "NSID")?;
