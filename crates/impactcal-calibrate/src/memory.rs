@@ -78,6 +78,24 @@ pub fn human(bytes: u64) -> String {
     }
 }
 
+/// The line a study or loop shows once its memory plan is made: the peak it plans beside
+/// what the process holds, and the limit.
+pub(crate) fn plan_line(what: &str, peak: u64, limit: Option<u64>) -> String {
+    let held = resident_bytes().unwrap_or(0);
+    let limit = match limit {
+        Some(l) => format!("the limit given is {}", human(l)),
+        None => available_bytes().map_or_else(
+            || "the machine does not say what it has available".to_string(),
+            |a| format!("the machine has {} available", human(a)),
+        ),
+    };
+    format!(
+        "memory: {what} plans about {} at its peak ({} held now); {limit}",
+        human(held.saturating_add(peak)),
+        human(held)
+    )
+}
+
 /// What a stage needs, from its shapes.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Need {

@@ -74,7 +74,7 @@ use impactcal_core::noise::{JitterOptions, SimulationNoise, jitter_points};
 use impactcal_core::{Cfc, ChannelMap, Enrichable, Histories, Model};
 
 use crate::error::{CalibrateError, Result};
-use crate::memory::Guard;
+use crate::memory::{self, Guard};
 use crate::metrics::{CurveMetrics, Iso18571};
 use crate::study::TestData;
 use crate::study::channels::test_on_model;
@@ -234,6 +234,11 @@ pub fn run_loop_on<M: Enrichable>(
         guard: Guard::new(options.max_memory),
     };
     plan.check_all()?;
+    observer.step(&memory::plan_line(
+        "the loop",
+        plan.shapes.peak_bytes(),
+        options.max_memory,
+    ));
     let runner = Journaled {
         plan: Some(&plan),
         ..runner

@@ -46,7 +46,7 @@ use impactcal_core::sampling::sample;
 use impactcal_core::{Cfc, ChannelMap, Histories, Model, SamplingMethod};
 
 use crate::error::{CalibrateError, Result};
-use crate::memory::Guard;
+use crate::memory::{self, Guard};
 use crate::metrics::{CurveMetrics, Iso18571};
 
 pub use execute::{Executor, InProcess, Observer, RunOutcome, Runner, Silent, Worker};
@@ -171,6 +171,11 @@ pub fn run(
         guard: Guard::new(options.max_memory),
     };
     plan.check_all()?;
+    observer.step(&memory::plan_line(
+        "the study",
+        plan.shapes.peak_bytes(),
+        options.max_memory,
+    ));
     let jitter = JitterOptions::new(options.noise_runs, options.noise_eps, options.seed);
     let jitter_pts = jitter_points(&space, &nominal_point, &jitter)?;
     let noise_runs = runs.stage("noise", &jitter_pts)?;
