@@ -13,12 +13,12 @@
 
 use std::path::Path;
 
+use impactcal::calibrate::CalibrateError;
 use impactcal::calibrate::closeloop::{
     Holdout, LoopOptions, LoopShapes, Verdict, estimated_peak, run_loop,
 };
 use impactcal::calibrate::memory::{peak_resident_bytes, resident_bytes};
 use impactcal::calibrate::study::{Silent, TestData};
-use impactcal::calibrate::CalibrateError;
 use impactcal::core::enrich::Enrichable;
 use impactcal::core::synthetic::{Measurement, measured};
 use impactcal::core::{Cfc, Model};
@@ -121,8 +121,10 @@ fn a_loop_on_all_1215_channels_stays_within_its_memory_bound() {
         r.verdict, samples
     );
     assert!(grown < BOUND, "{grown} bytes");
+    // (Measured when this test was written: 39.9 MB grown, 30.4 MB planned; the model's
+    // own working memory, about 8 MB per run of the coarse airframe, is not in the plan.)
     assert!(
-        plan >= grown / 2 && plan <= 4 * grown.max(1),
+        plan >= grown / 2 && plan <= 2 * grown,
         "plan {plan} against measured {grown}"
     );
 
@@ -137,6 +139,9 @@ fn a_loop_on_all_1215_channels_stays_within_its_memory_bound() {
     let err = run_loop(&m, "guard", data, None, &small, &dir2, &Silent).unwrap_err();
     let text = err.to_string();
     assert!(matches!(err, CalibrateError::Memory { .. }), "{text}");
-    assert!(text.contains("needs about") && text.contains("fewer channels"), "{text}");
+    assert!(
+        text.contains("needs about") && text.contains("fewer channels"),
+        "{text}"
+    );
     assert!(!dir2.join("runs/noise").exists(), "{text}");
 }

@@ -25,7 +25,10 @@ fn status_field(name: &str) -> Option<u64> {
 /// `<name>: <value> kB` of a `/proc` file's text, in bytes.
 fn kilobytes(text: &str, name: &str) -> Option<u64> {
     let line = text.lines().find(|l| l.starts_with(name))?;
-    let value = line[name.len()..].trim_start_matches(':').split_whitespace().next()?;
+    let value = line[name.len()..]
+        .trim_start_matches(':')
+        .split_whitespace()
+        .next()?;
     Some(value.parse::<u64>().ok()? * 1024)
 }
 
@@ -176,8 +179,14 @@ mod tests {
         };
         let e = Guard::new(Some(1_000_000_000)).check(&need).unwrap_err();
         let text = e.to_string();
-        assert!(text.contains("r0-gn0-jac") && text.contains("5.0 GB"), "{text}");
-        assert!(text.contains("1.0 GB") && text.contains("use fewer channels"), "{text}");
+        assert!(
+            text.contains("r0-gn0-jac") && text.contains("5.0 GB"),
+            "{text}"
+        );
+        assert!(
+            text.contains("1.0 GB") && text.contains("use fewer channels"),
+            "{text}"
+        );
         assert_eq!(e.kind(), impactcal_core::ErrorKind::BadInput);
         let small = Need {
             bytes: 1000,

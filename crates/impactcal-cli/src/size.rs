@@ -20,12 +20,11 @@ pub fn parse_bytes(text: &str) -> Result<u64, String> {
         Some('t') => (&body[..body.len() - 1], 1 << 40),
         _ => (body, 1),
     };
-    let bad = || {
-        format!("`{t}` is not a size: give bytes or a number with K, M, G or T (2G, 512M)")
-    };
+    let bad =
+        || format!("`{t}` is not a size: give bytes or a number with K, M, G or T (2G, 512M)");
     let value: f64 = number.trim().parse().map_err(|_| bad())?;
     let bytes = value * factor as f64;
-    if !(bytes.is_finite() && bytes >= 1.0 && bytes < 1.8e19) {
+    if !(bytes.is_finite() && (1.0..1.8e19).contains(&bytes)) {
         return Err(bad());
     }
     Ok(bytes as u64)

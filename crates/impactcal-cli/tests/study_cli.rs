@@ -251,6 +251,49 @@ fn bad_input_exits_with_code_two_and_writes_nothing() {
     assert_eq!(std::fs::read(out.join("study.json")).unwrap(), before);
 }
 
+/// `--max-memory` below what the study plans: stopped after its nominal run, before any
+/// other stage, with the guard's line (stage, estimate, what to change); a size that does
+/// not parse is refused before anything runs.
+#[test]
+fn a_memory_limit_below_the_plan_stops_the_study_before_its_stages() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let config = strip_study(
+        d,
+        "ensemble = 4\nsensors = 2\nshapes = 1\nreconcile_runs = 0\nnoise_runs = 2",
+    );
+    let out = d.join("small");
+    let args = |limit: &str| {
+        impactcal(&[
+            "study",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--max-memory",
+            limit,
+        ])
+    };
+    let o = args("1M");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let last = err.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("impactcal: error:")
+            && last.contains("needs about")
+            && last.contains("--max-memory"),
+        "{err}"
+    );
+    assert!(out.join("runs/nominal").exists() && !out.join("runs/noise").exists());
+    let o = args("lots");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("not a size"), "{err}");
+    // With room, the same study in the same folder resumes from its nominal run.
+    let o = args("4G");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 /// Spawns `impactcal study`, SIGKILLs it once `journal` records `after` results, and
 /// returns how many it had recorded by then.
 fn kill_study_after(config: &Path, out: &Path, journal: &Path, after: usize) -> usize {

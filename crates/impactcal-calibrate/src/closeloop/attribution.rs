@@ -496,7 +496,9 @@ mod tests {
             .collect();
         let dense = vec![
             (0..n).map(|i| w[i] * (i as f64 * 0.05).sin()).collect(),
-            (0..n).map(|i| w[i] * ((i % t) as f64 / t as f64).powi(2)).collect(),
+            (0..n)
+                .map(|i| w[i] * ((i % t) as f64 / t as f64).powi(2))
+                .collect(),
         ];
         (Jacobian::new(t, dense, &[&w, &gain]).unwrap(), channels, t)
     }
@@ -514,7 +516,8 @@ mod tests {
     fn a_direction_on_one_channel_gives_the_whole_vector_numbers() {
         let (jac, channels, t) = jacobian();
         let n = channels * t;
-        let drift = |s: usize| -> Vec<f64> { (0..t).map(|k| (k as f64 + s as f64) * 0.1).collect() };
+        let drift =
+            |s: usize| -> Vec<f64> { (0..t).map(|k| (k as f64 + s as f64) * 0.1).collect() };
         let y: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
         let dense: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).sin().powi(3)).collect();
         let (_, _, hd) = Unfitted::of(Shape::Dense(dense.clone()), &jac);
@@ -548,7 +551,10 @@ mod tests {
         }
         let cross = Unfitted::inner((&local[0].0, &[]), (&local[1].0, &[]), t);
         let expect = dot(&local[0].1, &local[1].1);
-        assert!(expect.abs() > 1e-6, "the two drifts must share something for the test");
+        assert!(
+            expect.abs() > 1e-6,
+            "the two drifts must share something for the test"
+        );
         assert!((cross - expect).abs() <= 1e-10 * expect.abs().max(1.0));
     }
 }

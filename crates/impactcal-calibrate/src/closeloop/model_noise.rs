@@ -120,7 +120,7 @@ impl ModelNoise {
         fit: &Fit,
         frame: &Frame,
         chi2: Option<usize>,
-        products: Option<&dyn Fn(&[f64], &[f64]) -> Vec<f64>>,
+        products: Option<&Products<'_>>,
     ) -> Result<DrawStats> {
         let base = nuisance::apply(&fit.y, frame, &fit.terms);
         let mut out = DrawStats {
@@ -150,6 +150,10 @@ impl ModelNoise {
         Ok(out)
     }
 }
+
+/// The inner products a pass over the draws takes of each whitened draw, given the draw and
+/// its coefficients on the Jacobian's dense basis.
+pub(crate) type Products<'a> = dyn Fn(&[f64], &[f64]) -> Vec<f64> + 'a;
 
 /// What one pass over the draws gives ([`ModelNoise::stats`]); every statistic is 0 without
 /// draws.

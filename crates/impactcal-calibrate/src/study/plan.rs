@@ -48,8 +48,7 @@ pub struct StudyShapes {
 impl StudyShapes {
     /// Values held through the study (beside what the process holds when it is planned).
     pub fn held(&self) -> u64 {
-        (4 * self.run_values + 2 * self.channels * self.samples + self.runs * self.samples)
-            as u64
+        (4 * self.run_values + 2 * self.channels * self.samples + self.runs * self.samples) as u64
     }
 
     /// Each stage with the values it adds at its peak, in the study's order.
@@ -70,11 +69,11 @@ impl StudyShapes {
         vec![
             ("the model's runs", 6 * r * (self.threads as u64).max(1)),
             ("the spread of the jitter ensemble", 8 * r),
-            ("sensor placement on the ensemble's impact shapes", placement + 6 * r),
             (
-                "the surrogates",
-                4 * n * self.sensors as u64 * t + 6 * r,
+                "sensor placement on the ensemble's impact shapes",
+                placement + 6 * r,
             ),
+            ("the surrogates", 4 * n * self.sensors as u64 * t + 6 * r),
             (
                 "the Sobol' indices over time",
                 2 * (self.sobol_rows * (self.parameters + 2)) as u64 * t,
