@@ -81,22 +81,100 @@ pub fn human(bytes: u64) -> String {
     }
 }
 
-/// The line a study or loop shows once its memory plan is made: the peak it plans beside
-/// what the process holds, and the limit.
-pub(crate) fn plan_line(what: &str, peak: u64, limit: Option<u64>) -> String {
-    let held = resident_bytes().unwrap_or(0);
-    let limit = match limit {
-        Some(l) => format!("the limit given is {}", human(l)),
-        None => available_bytes().map_or_else(
-            || "the machine does not say what it has available".to_string(),
-            |a| format!("the machine has {} available", human(a)),
-        ),
-    };
-    format!(
-        "memory: {what} plans about {} at its peak ({} held now); {limit}",
-        human(held.saturating_add(peak)),
-        human(held)
-    )
+/// The stages of a study or loop as formulas of its shapes: what it holds throughout and
+/// what each kind of stage adds at its peak, in values of 8 bytes, and what to change when
+/// one does not fit.
+pub(crate) trait Stages {
+    /// Who plans (`the loop`, `the study`), for the messages.
+    const WHO: &'static str;
+
+    /// Values held throughout (beside what the process holds when it is planned).
+    fn held(&self) -> u64;
+
+    /// Each kind of stage with the values it adds at its peak, in order.
+    fn stages(&self) -> Vec<(&'static str, u64)>;
+
+    /// What the stage of kind `kind` grows with and what to change.
+    fn advice(&self, kind: &str) -> String;
+
+    /// The bytes added at the peak to what the process holds when planned: the held part
+    /// and the largest stage.
+    fn peak(&self) -> u64 {
+        let stage = self.stages().iter().map(|s| s.1).max().unwrap_or(0);
+        F64 * (self.held() + stage)
+    }
+}
+
+/// The memory plan of one study or loop: its shapes and the guard that checks them.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Plan<S> {
+    pub shapes: S,
+    pub guard: Guard,
+}
+
+impl<S: Stages> Plan<S> {
+    /// The need of stage `kind` named `stage` (a journal stage, or the step).
+    fn need(&self, kind: &str, stage: &str) -> Need {
+        let values = self
+            .shapes
+            .stages()
+            .into_iter()
+            .find(|s| s.0 == kind)
+            .map_or(0, |s| s.1);
+        Need {
+            stage: stage.to_string(),
+            bytes: F64 * values,
+            advice: self.shapes.advice(kind),
+        }
+    }
+
+    /// Checks every stage before the first: what the process holds, the held part and the
+    /// stage together.
+    ///
+    /// # Errors
+    /// [`CalibrateError::Memory`] naming the first stage that would not fit.
+    pub fn check_all(&self) -> Result<()> {
+        let held = F64 * self.shapes.held();
+        for (kind, values) in self.shapes.stages() {
+            let mut need = self.need(kind, kind);
+            need.bytes = held + F64 * values;
+            need.advice = format!(
+                "{} ({} holds about {} throughout)",
+                need.advice,
+                S::WHO,
+                human(held)
+            );
+            self.guard.check(&need)?;
+        }
+        Ok(())
+    }
+
+    /// Checks stage `kind`, named `stage`, against what the process holds now.
+    ///
+    /// # Errors
+    /// [`CalibrateError::Memory`] when it would not fit.
+    pub fn check(&self, kind: &str, stage: &str) -> Result<()> {
+        self.guard.check(&self.need(kind, stage))
+    }
+
+    /// The line shown once the plan is made: the peak it plans beside what the process
+    /// holds, and the limit.
+    pub fn line(&self) -> String {
+        let held = resident_bytes().unwrap_or(0);
+        let limit = match self.guard.limit {
+            Some(l) => format!("the limit given is {}", human(l)),
+            None => available_bytes().map_or_else(
+                || "the machine does not say what it has available".to_string(),
+                |a| format!("the machine has {} available", human(a)),
+            ),
+        };
+        format!(
+            "memory: {} plans about {} at its peak ({} held now); {limit}",
+            S::WHO,
+            human(held.saturating_add(self.shapes.peak())),
+            human(held)
+        )
+    }
 }
 
 /// What a stage needs, from its shapes.

@@ -43,13 +43,20 @@ fn strip_study(dir: &Path, study: &str) -> PathBuf {
 }
 
 fn study(config: &Path, out: &Path) -> std::process::Output {
-    impactcal(&[
+    study_with(config, out, &[])
+}
+
+/// `impactcal study` with `extra` arguments.
+fn study_with(config: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
         "study",
         "--config",
         config.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-    ])
+    ];
+    args.extend_from_slice(extra);
+    impactcal(&args)
 }
 
 /// The results a runner journal records (complete lines only).
@@ -60,6 +67,9 @@ fn results_in(journal: &Path) -> usize {
             .count()
     })
 }
+
+/// A study of four runs without reconciliation.
+const SMALL: &str = "ensemble = 4\nsensors = 2\nshapes = 1\nreconcile_runs = 0\nnoise_runs = 2";
 
 const STRIP: &str = "ensemble = 160\nsensors = 3\nshapes = 2\nsensitivity_samples = 64\n\
                      reconcile_runs = 6\nnoise_runs = 3";
@@ -203,10 +213,7 @@ fn refused(config: &Path, out: &Path, what: &str) {
 fn bad_input_exits_with_code_two_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let config = strip_study(
-        d,
-        "ensemble = 4\nsensors = 2\nshapes = 1\nreconcile_runs = 0\nnoise_runs = 2",
-    );
+    let config = strip_study(d, SMALL);
     let text = std::fs::read_to_string(&config).unwrap();
     let variant = |name: &str, from: &str, to: &str| -> PathBuf {
         let p = d.join(name);
@@ -258,22 +265,9 @@ fn bad_input_exits_with_code_two_and_writes_nothing() {
 fn a_memory_limit_below_the_plan_stops_the_study_before_its_stages() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let config = strip_study(
-        d,
-        "ensemble = 4\nsensors = 2\nshapes = 1\nreconcile_runs = 0\nnoise_runs = 2",
-    );
+    let config = strip_study(d, SMALL);
     let out = d.join("small");
-    let args = |limit: &str| {
-        impactcal(&[
-            "study",
-            "--config",
-            config.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--max-memory",
-            limit,
-        ])
-    };
+    let args = |limit: &str| study_with(&config, &out, &["--max-memory", limit]);
     let o = args("1M");
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");

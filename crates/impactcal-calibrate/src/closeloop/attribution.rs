@@ -246,7 +246,7 @@ pub(crate) fn attribute<M: Enrichable>(
         .filter(|c| allowed(c.name()))
         .collect();
     if let Some(plan) = ctx.runner.plan {
-        plan.check("an attribution", &format!("{prefix}-candidates"))?;
+        plan.check(super::plan::ATTRIBUTION, &format!("{prefix}-candidates"))?;
     }
     let frame = &ctx.frame;
     let jac = &fit.jac;

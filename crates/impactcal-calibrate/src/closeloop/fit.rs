@@ -67,7 +67,7 @@ impl<'a> Journaled<'a> {
         points: &[Vec<f64>],
     ) -> Result<Outcomes> {
         if let Some(plan) = self.plan {
-            plan.check("the model's runs", stage)?;
+            plan.check(super::plan::RUNS, stage)?;
         }
         let exec = Dispatch {
             model,
@@ -250,7 +250,7 @@ fn polish_from<M: Model>(
             .collect();
         let stage = format!("{prefix}-gn{it}-jac");
         if let Some(plan) = ctx.runner.plan {
-            plan.check("a Gauss-Newton Jacobian", &stage)?;
+            plan.check(super::plan::JACOBIAN, &stage)?;
         }
         let outs = ctx.runner.stage(model, &stage, &pts)?;
         let base = nuisance::apply(&y, &ctx.frame, &terms);

@@ -309,18 +309,19 @@ mod tests {
                 v: svd.V().subcols(0, r).to_owned(),
             }
         }
-        fn project(&self, y: &[f64]) -> Vec<f64> {
-            let c: Vec<f64> = (0..self.s.len())
+        fn ut(&self, y: &[f64]) -> Vec<f64> {
+            (0..self.s.len())
                 .map(|j| self.u.col(j).iter().zip(y).map(|(a, b)| a * b).sum())
-                .collect();
+                .collect()
+        }
+        fn project(&self, y: &[f64]) -> Vec<f64> {
+            let c = self.ut(y);
             (0..y.len())
                 .map(|i| (0..self.s.len()).map(|j| self.u[(i, j)] * c[j]).sum())
                 .collect()
         }
         fn solve(&self, y: &[f64]) -> Vec<f64> {
-            let c: Vec<f64> = (0..self.s.len())
-                .map(|j| self.u.col(j).iter().zip(y).map(|(a, b)| a * b).sum())
-                .collect();
+            let c = self.ut(y);
             (0..self.v.nrows())
                 .map(|i| {
                     (0..self.s.len())

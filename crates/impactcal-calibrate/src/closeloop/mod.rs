@@ -74,7 +74,7 @@ use impactcal_core::noise::{JitterOptions, SimulationNoise, jitter_points};
 use impactcal_core::{Cfc, ChannelMap, Enrichable, Histories, Model};
 
 use crate::error::{CalibrateError, Result};
-use crate::memory::{self, Guard};
+use crate::memory::Guard;
 use crate::metrics::{CurveMetrics, Iso18571};
 use crate::study::TestData;
 use crate::study::channels::test_on_model;
@@ -234,11 +234,7 @@ pub fn run_loop_on<M: Enrichable>(
         guard: Guard::new(options.max_memory),
     };
     plan.check_all()?;
-    observer.step(&memory::plan_line(
-        "the loop",
-        plan.shapes.peak_bytes(),
-        options.max_memory,
-    ));
+    observer.step(&plan.line());
     let runner = Journaled {
         plan: Some(&plan),
         ..runner
@@ -563,7 +559,14 @@ fn model_spread<M: Model>(
         Some(c) => nominal.filtered(c)?,
         None => nominal,
     };
-    let draws = ModelNoise::new(runs, used, shifts, nominal.clone(), labels.to_vec(), cfc);
+    let draws = ModelNoise {
+        runs,
+        used,
+        shifts,
+        nominal: nominal.clone(),
+        labels: labels.to_vec(),
+        cfc,
+    };
     let noise = SimulationNoise::from_run_reader(&nominal, draws.len(), &mut |j| draws.run(j))?;
     Ok((noise.spread.concat(), draws))
 }

@@ -41,41 +41,20 @@ use crate::study::execute::Outcomes;
 #[derive(Debug, Clone)]
 pub(crate) struct ModelNoise {
     /// The ensemble's runs.
-    runs: Outcomes,
+    pub runs: Outcomes,
     /// The runs that succeeded, in order: draw `j` is run `used[j]`.
-    used: Vec<usize>,
+    pub used: Vec<usize>,
     /// Each draw's parameter change from the nominal point (declared space).
-    shifts: Vec<Vec<f64>>,
+    pub shifts: Vec<Vec<f64>>,
     /// The nominal run on the loop's channels, filtered like the test, `S x T`.
-    nominal: Histories,
+    pub nominal: Histories,
     /// The loop's channels.
-    labels: Vec<String>,
+    pub labels: Vec<String>,
     /// The loop's filter.
-    cfc: Option<Cfc>,
+    pub cfc: Option<Cfc>,
 }
 
 impl ModelNoise {
-    /// The draws of the ensemble `runs` (those of `used` that succeeded, with the parameter
-    /// changes `shifts` they were given) about `nominal` (already on `labels`, filtered
-    /// with `cfc`).
-    pub fn new(
-        runs: Outcomes,
-        used: Vec<usize>,
-        shifts: Vec<Vec<f64>>,
-        nominal: Histories,
-        labels: Vec<String>,
-        cfc: Option<Cfc>,
-    ) -> Self {
-        ModelNoise {
-            runs,
-            used,
-            shifts,
-            nominal,
-            labels,
-            cfc,
-        }
-    }
-
     /// Number of draws.
     pub fn len(&self) -> usize {
         self.used.len()

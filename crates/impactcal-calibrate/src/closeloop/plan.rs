@@ -32,8 +32,7 @@
 //! The loop's peak is what the process holds when the plan is made, plus the held part,
 //! plus the largest stage; [`estimated_peak`] gives it for given shapes.
 
-use crate::error::Result;
-use crate::memory::{F64, Guard, Need, human};
+use crate::memory::Stages;
 
 /// The shapes a loop's memory depends on (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,29 +61,24 @@ impl LoopShapes {
     fn read(&self) -> u64 {
         6 * self.run_values as u64
     }
+}
 
-    fn runs(&self) -> u64 {
-        self.threads as u64 * 6 * self.run_values as u64
-    }
+impl Stages for LoopShapes {
+    const WHO: &'static str = "the loop";
 
-    /// Values held through the loop (beside what the process holds when it is planned).
-    pub fn held(&self) -> u64 {
+    fn held(&self) -> u64 {
         self.run_values as u64 + (8 + 4 * (self.dense as u64 + 4)) * self.n()
     }
 
-    /// Each kind of stage with the values it adds at its peak, in the loop's order.
-    pub fn stages(&self) -> Vec<(&'static str, u64)> {
+    fn stages(&self) -> Vec<(&'static str, u64)> {
         let (n, q, k) = (self.n(), self.dense as u64, self.candidates as u64);
         let draws = self.read() + 6 * n;
         vec![
-            ("the model's runs", self.runs()),
+            (RUNS, self.threads as u64 * self.read()),
             ("a pass over the jitter ensemble", draws),
+            (JACOBIAN, ((3 * q + 8) * n).max((q + 1) * n + self.read())),
             (
-                "a Gauss-Newton Jacobian",
-                ((3 * q + 8) * n).max((q + 1) * n + self.read()),
-            ),
-            (
-                "an attribution",
+                ATTRIBUTION,
                 (k + 1) * n + 5 * n + self.read().max(draws) + 8 * k * self.channels as u64,
             ),
             (
@@ -94,97 +88,50 @@ impl LoopShapes {
         ]
     }
 
-    /// The bytes the loop adds at its peak to what the process holds when it is planned:
-    /// the held part and the largest stage.
-    pub fn peak_bytes(&self) -> u64 {
-        let stage = self.stages().iter().map(|s| s.1).max().unwrap_or(0);
-        F64 * (self.held() + stage)
-    }
-
-    /// What to change when a stage does not fit.
-    fn advice(&self, stage: &str) -> String {
-        let base = format!(
-            "it grows with the channels compared times their samples ({} x {} = {} values)",
-            self.channels,
-            self.samples,
-            self.n()
-        );
-        let what = match stage {
-            "the model's runs" | "a pass over the jitter ensemble" => format!(
+    fn advice(&self, kind: &str) -> String {
+        let what = if kind == RUNS || kind == "a pass over the jitter ensemble" {
+            format!(
                 "it grows with the values each run writes ({}) and the runs at a time ({})",
                 self.run_values, self.threads
-            ),
-            "an attribution" => format!("{base} and the candidates ({})", self.candidates),
-            _ => base,
+            )
+        } else {
+            format!(
+                "it grows with the channels compared times their samples ({} x {} = {} \
+                 values){}",
+                self.channels,
+                self.samples,
+                self.n(),
+                if kind == ATTRIBUTION {
+                    format!(" and the candidates ({})", self.candidates)
+                } else {
+                    String::new()
+                }
+            )
+        };
+        let more = match kind {
+            ATTRIBUTION => ", narrow [loop] candidates",
+            RUNS => ", run fewer at a time (--threads)",
+            _ => "",
         };
         format!(
-            "{what}: compare fewer channels, a shorter window or a coarser output interval{}, \
-             or give more memory (--max-memory)",
-            if stage == "an attribution" {
-                ", narrow [loop] candidates"
-            } else if stage == "the model's runs" {
-                ", run fewer at a time (--threads)"
-            } else {
-                ""
-            }
+            "{what}: compare fewer channels, a shorter window or a coarser output interval\
+             {more}, or give more memory (--max-memory)"
         )
     }
-
-    /// The need of stage `kind` (one of [`stages`](Self::stages)) as checked before it
-    /// allocates, named `stage` (a journal stage, or the step).
-    pub(crate) fn need(&self, kind: &str, stage: &str) -> Need {
-        let values = self
-            .stages()
-            .into_iter()
-            .find(|s| s.0 == kind)
-            .map_or(0, |s| s.1);
-        Need {
-            stage: stage.to_string(),
-            bytes: F64 * values,
-            advice: self.advice(kind),
-        }
-    }
 }
+
+/// The stage kind of a stage of model runs.
+pub(crate) const RUNS: &str = "the model's runs";
+/// The stage kind of a Gauss-Newton Jacobian.
+pub(crate) const JACOBIAN: &str = "a Gauss-Newton Jacobian";
+/// The stage kind of an attribution.
+pub(crate) const ATTRIBUTION: &str = "an attribution";
 
 /// The bytes a loop of `shapes` adds at its peak to what the process holds when it starts
 /// (its nominal run aside): the plan the memory guard checks (see the module docs).
 pub fn estimated_peak(shapes: &LoopShapes) -> u64 {
-    shapes.peak_bytes()
+    shapes.peak()
 }
 
-/// The plan of one loop: its shapes and the guard that checks them.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Plan {
-    pub shapes: LoopShapes,
-    pub guard: Guard,
-}
-
-impl Plan {
-    /// Checks the whole loop before its first stage: for each stage, what the process
-    /// holds, the loop's held part and the stage together.
-    ///
-    /// # Errors
-    /// [`crate::CalibrateError::Memory`] naming the first stage that would not fit.
-    pub fn check_all(&self) -> Result<()> {
-        let held = F64 * self.shapes.held();
-        for (kind, values) in self.shapes.stages() {
-            let mut need = self.shapes.need(kind, kind);
-            need.bytes = held + F64 * values;
-            need.advice = format!(
-                "{} (the loop holds about {} throughout)",
-                need.advice,
-                human(held)
-            );
-            self.guard.check(&need)?;
-        }
-        Ok(())
-    }
-
-    /// Checks stage `kind` named `stage` against what the process holds now.
-    ///
-    /// # Errors
-    /// [`crate::CalibrateError::Memory`] when it would not fit.
-    pub fn check(&self, kind: &str, stage: &str) -> Result<()> {
-        self.guard.check(&self.shapes.need(kind, stage))
-    }
-}
+/// The plan of one loop.
+pub(crate) type Plan = crate::memory::Plan<LoopShapes>;

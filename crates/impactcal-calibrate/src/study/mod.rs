@@ -46,13 +46,13 @@ use impactcal_core::sampling::sample;
 use impactcal_core::{Cfc, ChannelMap, Histories, Model, SamplingMethod};
 
 use crate::error::{CalibrateError, Result};
-use crate::memory::{self, Guard};
+use crate::memory::Guard;
 use crate::metrics::{CurveMetrics, Iso18571};
 
 pub use execute::{Executor, InProcess, Observer, RunOutcome, Runner, Silent, Worker};
 pub use m1::{M1, Verdict};
 pub use options::{StudyOptions, ValidStudyOptions};
-pub use plan::StudyShapes;
+pub use plan::{StudyShapes, estimated_peak};
 pub use result::StudyResult;
 pub use subspace::Subspace;
 
@@ -171,11 +171,7 @@ pub fn run(
         guard: Guard::new(options.max_memory),
     };
     plan.check_all()?;
-    observer.step(&memory::plan_line(
-        "the study",
-        plan.shapes.peak_bytes(),
-        options.max_memory,
-    ));
+    observer.step(&plan.line());
     let jitter = JitterOptions::new(options.noise_runs, options.noise_eps, options.seed);
     let jitter_pts = jitter_points(&space, &nominal_point, &jitter)?;
     let noise_runs = runs.stage("noise", &jitter_pts)?;
@@ -343,7 +339,7 @@ pub fn run(
     // 4. Sensors and 5. M2 of the baseline.
     plan.shapes.channels = objective.len();
     plan.shapes.runs = ok.len();
-    plan.check("sensor placement on the ensemble's impact shapes")?;
+    plan.check(plan::PLACEMENT, plan::PLACEMENT)?;
     observer.step("sensor placement");
     let sensors = sensors::place_sensors(
         &ensemble_run,
@@ -361,7 +357,7 @@ pub fn run(
     let m2_baseline = m2::m2(&base_obj, &test_obj, &objective, options.shapes)?;
 
     // 6. Surrogates and 7. sensitivity.
-    plan.check("the surrogates")?;
+    plan.check(plan::SURROGATES, plan::SURROGATES)?;
     observer.step("surrogates");
     let x = Mat::from_fn(ok_points.len(), space.dim(), |i, j| ok_points[i][j]);
     let q_mat = Mat::from_fn(q_runs.len(), time.len(), |i, k| q_runs[i][k]);
@@ -377,7 +373,7 @@ pub fn run(
         q: q_choice,
         sensors: s_choice,
     });
-    plan.check("the Sobol' indices over time")?;
+    plan.check(plan::SENSITIVITY, plan::SENSITIVITY)?;
     observer.step("sensitivity");
     result.sensitivity = Some(sensitivity::sensitivity(
         &space,

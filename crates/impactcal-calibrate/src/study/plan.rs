@@ -19,8 +19,7 @@
 //!   histories and the fit's tables, `4 N K T`;
 //! - the Sobol' indices over time: `2 B (d + 2) T` surrogate values.
 
-use crate::error::Result;
-use crate::memory::{F64, Guard, Need, human};
+use crate::memory::Stages;
 
 /// The shapes a study's memory depends on (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,14 +44,14 @@ pub struct StudyShapes {
     pub threads: usize,
 }
 
-impl StudyShapes {
-    /// Values held through the study (beside what the process holds when it is planned).
-    pub fn held(&self) -> u64 {
+impl Stages for StudyShapes {
+    const WHO: &'static str = "the study";
+
+    fn held(&self) -> u64 {
         (4 * self.run_values + 2 * self.channels * self.samples + self.runs * self.samples) as u64
     }
 
-    /// Each stage with the values it adds at its peak, in the study's order.
-    pub fn stages(&self) -> Vec<(&'static str, u64)> {
+    fn stages(&self) -> Vec<(&'static str, u64)> {
         let (r, t, c, n) = (
             self.run_values as u64,
             self.samples as u64,
@@ -69,38 +68,29 @@ impl StudyShapes {
         vec![
             ("the model's runs", 6 * r * (self.threads as u64).max(1)),
             ("the spread of the jitter ensemble", 8 * r),
+            (PLACEMENT, placement + 6 * r),
+            (SURROGATES, 4 * n * self.sensors as u64 * t + 6 * r),
             (
-                "sensor placement on the ensemble's impact shapes",
-                placement + 6 * r,
-            ),
-            ("the surrogates", 4 * n * self.sensors as u64 * t + 6 * r),
-            (
-                "the Sobol' indices over time",
+                SENSITIVITY,
                 2 * (self.sobol_rows * (self.parameters + 2)) as u64 * t,
             ),
         ]
     }
 
-    /// The bytes the study adds at its peak to what the process holds when it is planned.
-    pub fn peak_bytes(&self) -> u64 {
-        let stage = self.stages().iter().map(|s| s.1).max().unwrap_or(0);
-        F64 * (self.held() + stage)
-    }
-
-    fn advice(&self, stage: &str) -> String {
-        let what = match stage {
-            "sensor placement on the ensemble's impact shapes" => format!(
+    fn advice(&self, kind: &str) -> String {
+        let what = match kind {
+            PLACEMENT => format!(
                 "it grows with the objective channels times the ensemble's runs times the \
                  samples ({} x {} x {}): fewer channels, fewer runs ([study] ensemble), a \
                  shorter window or a coarser output interval",
                 self.channels, self.runs, self.samples
             ),
-            "the surrogates" => format!(
+            SURROGATES => format!(
                 "it grows with the runs times the sensors times the samples ({} x {} x {}): \
                  fewer sensors or runs, a shorter window or a coarser output interval",
                 self.runs, self.sensors, self.samples
             ),
-            "the Sobol' indices over time" => format!(
+            SENSITIVITY => format!(
                 "it grows with the design's rows times the samples ({} x {} x {}): fewer \
                  [study] sensitivity_samples, a shorter window or a coarser output interval",
                 self.sobol_rows,
@@ -116,54 +106,20 @@ impl StudyShapes {
         };
         format!("{what}, or give more memory (--max-memory)")
     }
-
-    fn need(&self, kind: &str, stage: &str) -> Need {
-        let values = self
-            .stages()
-            .into_iter()
-            .find(|s| s.0 == kind)
-            .map_or(0, |s| s.1);
-        Need {
-            stage: stage.to_string(),
-            bytes: F64 * values,
-            advice: self.advice(kind),
-        }
-    }
 }
 
-/// The plan of one study: its shapes and the guard that checks them.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Plan {
-    pub shapes: StudyShapes,
-    pub guard: Guard,
+/// The stage kind of the sensor placement.
+pub(crate) const PLACEMENT: &str = "sensor placement on the ensemble's impact shapes";
+/// The stage kind of the surrogates.
+pub(crate) const SURROGATES: &str = "the surrogates";
+/// The stage kind of the Sobol' indices.
+pub(crate) const SENSITIVITY: &str = "the Sobol' indices over time";
+
+/// The bytes a study of `shapes` adds at its peak to what the process holds when it is
+/// planned (its nominal run aside).
+pub fn estimated_peak(shapes: &StudyShapes) -> u64 {
+    shapes.peak()
 }
 
-impl Plan {
-    /// Checks every stage before the first: what the process holds, the study's held part
-    /// and the stage together.
-    ///
-    /// # Errors
-    /// [`crate::CalibrateError::Memory`] naming the first stage that would not fit.
-    pub fn check_all(&self) -> Result<()> {
-        let held = F64 * self.shapes.held();
-        for (kind, values) in self.shapes.stages() {
-            let mut need = self.shapes.need(kind, kind);
-            need.bytes = held + F64 * values;
-            need.advice = format!(
-                "{} (the study holds about {} throughout)",
-                need.advice,
-                human(held)
-            );
-            self.guard.check(&need)?;
-        }
-        Ok(())
-    }
-
-    /// Checks stage `kind` against what the process holds now.
-    ///
-    /// # Errors
-    /// [`crate::CalibrateError::Memory`] when it would not fit.
-    pub fn check(&self, kind: &str) -> Result<()> {
-        self.guard.check(&self.shapes.need(kind, kind))
-    }
-}
+/// The plan of one study.
+pub(crate) type Plan = crate::memory::Plan<StudyShapes>;
