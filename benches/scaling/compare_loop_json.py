@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Compares two loop.json files (a closed loop's result) number by number.
 
-    compare_loop_json.py BEFORE.json AFTER.json [--tol 1e-9]
+    compare_loop_json.py BEFORE.json AFTER.json [--tol 1e-9] [--runs BEFORE_DIR AFTER_DIR]
 
 Walks both documents together and prints, for every key path whose numbers differ (list
 indices and channel labels folded into `[]` and `<label>`), the largest difference over
@@ -10,10 +10,16 @@ difference (a key or list entry on one side only, text that differs), counted.
 The M1 exceedances come from a Monte Carlo ensemble of predictive draws: they are listed
 apart, with the binomial standard error of an exceedance fraction over the samples.
 Exit status 0 when every other number agrees within --tol and nothing structural
-differs, 1 otherwise. Standard library only.
+differs, 1 otherwise. With --runs, the points of every stage of runs the two loops made
+(OUT/runs/<stage>/<i>/params.json), in the order the first loop made them, up to the first
+stage where they differ and the one after: on a model whose response changes by its own
+noise under a change in the last bits of a parameter (a crash model), two loops whose
+arithmetic differs only in round-off agree up to the first step that depends on it, and
+then follow different trajectories of the same noise. Standard library only.
 """
 import json
 import math
+import os
 import sys
 from collections import defaultdict
 
@@ -50,8 +56,57 @@ def walk(a, b, path, diffs, structure):
         structure.append(f"{path}: {a!r} before, {b!r} after")
 
 
+def stage_points(out):
+    """{stage: (start time, [point per run])} of a loop's output folder."""
+    stages = {}
+    root = os.path.join(out, "runs")
+    for stage in os.listdir(root):
+        d = os.path.join(root, stage)
+        if not os.path.isdir(d):
+            continue
+        runs = sorted((int(i) for i in os.listdir(d) if i.isdigit()))
+        points, start = [], math.inf
+        for i in runs:
+            with open(os.path.join(d, str(i), "params.json")) as f:
+                r = json.load(f)
+            points.append(r["values"])
+            start = min(start, r["prepared_at"])
+        stages[stage] = (start, points)
+    return stages
+
+
+def compare_runs(before, after):
+    a, b = stage_points(before), stage_points(after)
+    differing = 0
+    for stage in sorted(a, key=lambda k: a[k][0]):
+        if stage not in b:
+            print(f"  runs {stage}: only before")
+            differing += 1
+        else:
+            pa, pb = a[stage][1], b[stage][1]
+            worst = 0.0
+            for x, y in zip(pa, pb):
+                for u, v in zip(x, y):
+                    scale = max(abs(u), abs(v))
+                    if scale > 0:
+                        worst = max(worst, abs(u - v) / scale)
+            same = "identical" if worst == 0.0 and len(pa) == len(pb) else \
+                f"largest relative difference {worst:.3e} ({len(pa)} and {len(pb)} runs)"
+            print(f"  runs {stage}: {same}")
+            if same != "identical":
+                differing += 1
+        if differing >= 2:
+            print("  (later stages follow from these)")
+            break
+
+
 def main():
     args = sys.argv[1:]
+    runs = None
+    if "--runs" in args:
+        i = args.index("--runs")
+        runs = args[i + 1 : i + 3]
+        del args[i : i + 3]
     tol = 1e-9
     if "--tol" in args:
         i = args.index("--tol")
@@ -88,6 +143,8 @@ def main():
         counted[s] += 1
     for s, c in counted.items():
         print(f"  structure ({c}x): {s}")
+    if runs:
+        compare_runs(*runs)
     ok = worst <= tol and not structure
     print("same numbers" if ok else "DIFFERENT")
     return 0 if ok else 1
