@@ -13,6 +13,7 @@
 # per run (the loop's or study's own work, benches/scaling/run_times.py), the verdict.
 #
 #   benches/scaling/run.sh [OUT_DIR] [CASES...]      CASES like 1215:0.05 (default: all six)
+#   WHAT=study benches/scaling/run.sh ...            only the studies (or WHAT=loop)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 OUT=${1:-/tmp/impactcal-scaling}
@@ -40,7 +41,7 @@ for c in $CASES; do
   mkdir -p "$D"
   [ -f "$D/test.csv" ] || "$GEN" "$D" "$S" "$E" 2> "$D/data.log"
   T=$(( $(wc -l < "$D/test.csv") - 1 ))
-  for what in loop study; do
+  for what in ${WHAT:-loop study}; do
     rm -rf "$D/$what-out"
     if [ $what = loop ]; then
       cmd=(close-loop --config "$D/loop.toml" --out "$D/$what-out")
