@@ -10,7 +10,9 @@
 # machine. Prints one Markdown row per case: values compared, runs, wall time, peak
 # resident memory (/usr/bin/time) beside the memory plan the guard checked, the runs' own
 # time per run and the rest of the wall time
-# per run (the loop's or study's own work, benches/scaling/run_times.py), the verdict.
+# per run (the loop's or study's own work, benches/scaling/run_times.py), the verdict. The
+# runs' result files are deleted once a case is measured (a loop at 1,215 channels x 501
+# samples writes 4 GB of them).
 #
 #   benches/scaling/run.sh [OUT_DIR] [CASES...]      CASES like 1215:0.05 (default: all six)
 #   WHAT=study benches/scaling/run.sh ...            only the studies (or WHAT=loop)
@@ -61,6 +63,9 @@ for c in $CASES; do
 print(r['m1']['verdict'], 'reduction', round(r['errors']['reduction'], 3))" 2>/dev/null || true)
     fi
     [ $status -eq 0 ] || verdict="exit $status: $(grep -m1 error "$D/$what.log" | cut -c1-120)"
+    # The runs' histories are not kept (4 GB for a loop at 1,215 channels x 501 samples);
+    # params.json of each run stays for run_times.py.
+    find "$D/$what-out/runs" -name result.csv -delete 2>/dev/null || true
     echo "| $what | $S x $T | $((S * T)) | $(field runs) | $W | $(peak "$D/$what.log") | $(plan "$D/$what.log") | $(field run_s_per_run) | $(field own_work_s_per_run) | $verdict |"
   done
 done
