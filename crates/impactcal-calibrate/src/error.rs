@@ -95,6 +95,29 @@ pub enum CalibrateError {
     /// From the runner that executes a study's runs (its journal, its executor).
     #[error(transparent)]
     Runner(#[from] impactcal_runner::RunnerError),
+    /// A stage whose memory estimate, beside what the process holds, exceeds the limit (the
+    /// user's, or what the machine can still give): stopped before it allocates.
+    #[error(
+        "stage `{stage}` needs about {} beside the {} this process holds, more than \
+         {limit_from} ({}); {advice}",
+        crate::memory::human(*estimate),
+        crate::memory::human(*held),
+        crate::memory::human(*limit)
+    )]
+    Memory {
+        /// The stage.
+        stage: String,
+        /// Its estimate in bytes.
+        estimate: u64,
+        /// What the process held when it was checked, in bytes.
+        held: u64,
+        /// The limit in bytes.
+        limit: u64,
+        /// Where the limit comes from.
+        limit_from: String,
+        /// What the stage's size grows with, and what to change.
+        advice: String,
+    },
 }
 
 /// `Result` with [`CalibrateError`].
@@ -129,7 +152,8 @@ impl CalibrateError {
     /// What kind of fault this is: the kind of a wrapped [`CoreError`];
     /// [`ErrorKind::Numerical`] for a figure the plotting library failed to draw; otherwise
     /// [`ErrorKind::BadInput`] (a curve on which a metric is undefined, lengths that do not
-    /// fit, or a report document that cannot be drawn, are the input's fault).
+    /// fit, a report document that cannot be drawn, or a stage too large for the memory
+    /// allowed, are the input's fault: the user can change them).
     pub fn kind(&self) -> ErrorKind {
         match self {
             CalibrateError::Core(e) => e.kind(),
@@ -137,7 +161,8 @@ impl CalibrateError {
             | CalibrateError::Length { .. }
             | CalibrateError::Report { .. }
             | CalibrateError::Study { .. }
-            | CalibrateError::ForeignJournal { .. } => ErrorKind::BadInput,
+            | CalibrateError::ForeignJournal { .. }
+            | CalibrateError::Memory { .. } => ErrorKind::BadInput,
             CalibrateError::Render { .. } => ErrorKind::Numerical,
             CalibrateError::Shapes(e) => e.kind(),
             CalibrateError::Sensors(e) => e.kind(),

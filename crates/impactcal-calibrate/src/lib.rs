@@ -26,6 +26,7 @@
 
 pub mod closeloop;
 pub mod error;
+pub mod memory;
 pub mod metrics;
 pub mod report;
 pub mod study;

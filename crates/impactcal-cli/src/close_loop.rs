@@ -77,6 +77,12 @@ pub struct Args {
     /// Number of threads (runs go in parallel; results do not depend on it).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Memory the loop may use (`2G`, `512M`, bytes; K/M/G/T are powers of 1024); default:
+    /// what the machine has available. A stage whose estimate does not fit stops the loop
+    /// before it allocates (exit 2), naming the stage and what to change; the journal keeps
+    /// every finished run.
+    #[arg(long, value_parser = crate::size::parse_bytes)]
+    pub max_memory: Option<u64>,
 }
 
 /// The loop file.
@@ -207,6 +213,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     options.recalibrate = b.recalibrate.unwrap_or(options.recalibrate);
     options.seed = b.seed.unwrap_or(options.seed);
     options.sigma = config.test.sigma.or(options.sigma);
+    options.max_memory = args.max_memory;
     let model = build_model(&config, base, &name)?;
     let test = read_test(&resolve(base, &config.test.data))?;
     let map = config

@@ -22,6 +22,7 @@ mod sample;
 mod samples;
 mod shapes;
 mod simulate;
+mod size;
 mod sobol;
 mod study;
 mod surrogate;

@@ -81,6 +81,11 @@ pub struct Args {
     /// Number of threads (runs go in parallel; results do not depend on it).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Memory the study may use (`2G`, `512M`, bytes; K/M/G/T are powers of 1024);
+    /// default: what the machine has available. A stage whose estimate does not fit stops
+    /// the study before it allocates (exit 2), naming the stage and what to change.
+    #[arg(long, value_parser = crate::size::parse_bytes)]
+    pub max_memory: Option<u64>,
 }
 
 /// The study file.
@@ -176,11 +181,12 @@ pub struct Setup {
 pub fn run(args: Args) -> Result<(), CliError> {
     let (config, name) = read_config(&args.config)?;
     let base = args.config.parent().unwrap_or(Path::new("."));
-    let options = config
-        .study
-        .clone()
-        .check()
-        .map_err(|e| CliError::from(e).context(&name))?;
+    let options = StudyOptions {
+        max_memory: args.max_memory,
+        ..config.study.clone()
+    }
+    .check()
+    .map_err(|e| CliError::from(e).context(&name))?;
     let mut setup = setup(&config, base).map_err(|e| e.context(&name))?;
     setup.runner = runner(&config, &args.config, base, &setup).map_err(|e| e.context(&name))?;
     if let Some(r) = &setup.runner {

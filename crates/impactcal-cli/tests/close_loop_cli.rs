@@ -149,6 +149,50 @@ fn bad_input_exits_2_with_one_line() {
     assert!(err.contains("belt"), "{err}");
 }
 
+/// `--max-memory` below what the loop plans: stopped after its nominal run, before any
+/// other stage, with the guard's line (stage, estimate, held, limit, what to change); the
+/// same loop with room resumes from its journal.
+#[test]
+fn a_memory_limit_below_the_plan_stops_the_loop_before_its_stages() {
+    let dir = tempfile::tempdir().unwrap();
+    write_tests(dir.path());
+    let cfg = config(dir.path(), GOOD);
+    let out = dir.path().join("small");
+    let run = |limit: &str| {
+        impactcal(&[
+            "close-loop",
+            "--config",
+            &cfg,
+            "--out",
+            out.to_str().unwrap(),
+            "--max-memory",
+            limit,
+        ])
+    };
+    let o = run("1M");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let last = err.lines().last().unwrap_or_default();
+    for needle in [
+        "stage `",
+        "needs about",
+        "this process holds",
+        "1.0 MB",
+        "--max-memory",
+    ] {
+        assert!(last.contains(needle), "{needle}: {err}");
+    }
+    assert!(out.join("runs/nominal").exists() && !out.join("runs/noise").exists());
+    let o = run("4G");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("memory: the loop plans about"), "{err}");
+    assert!(
+        err.contains("nominal: 1 runs (1 from the journal)"),
+        "{err}"
+    );
+}
+
 /// The loop on a keyword deck, configured as a study file configures it: the strip drop
 /// declares its thickness; the test was measured on the deck itself at another thickness
 /// (0.0021), with a trigger offset and noise, and the holdout at another drop speed. Nothing

@@ -43,13 +43,20 @@ fn strip_study(dir: &Path, study: &str) -> PathBuf {
 }
 
 fn study(config: &Path, out: &Path) -> std::process::Output {
-    impactcal(&[
+    study_with(config, out, &[])
+}
+
+/// `impactcal study` with `extra` arguments.
+fn study_with(config: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
         "study",
         "--config",
         config.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-    ])
+    ];
+    args.extend_from_slice(extra);
+    impactcal(&args)
 }
 
 /// The results a runner journal records (complete lines only).
@@ -60,6 +67,9 @@ fn results_in(journal: &Path) -> usize {
             .count()
     })
 }
+
+/// A study of four runs without reconciliation.
+const SMALL: &str = "ensemble = 4\nsensors = 2\nshapes = 1\nreconcile_runs = 0\nnoise_runs = 2";
 
 const STRIP: &str = "ensemble = 160\nsensors = 3\nshapes = 2\nsensitivity_samples = 64\n\
                      reconcile_runs = 6\nnoise_runs = 3";
@@ -203,10 +213,7 @@ fn refused(config: &Path, out: &Path, what: &str) {
 fn bad_input_exits_with_code_two_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let config = strip_study(
-        d,
-        "ensemble = 4\nsensors = 2\nshapes = 1\nreconcile_runs = 0\nnoise_runs = 2",
-    );
+    let config = strip_study(d, SMALL);
     let text = std::fs::read_to_string(&config).unwrap();
     let variant = |name: &str, from: &str, to: &str| -> PathBuf {
         let p = d.join(name);
@@ -249,6 +256,36 @@ fn bad_input_exits_with_code_two_and_writes_nothing() {
     let c = variant("seed.toml", "ensemble = 4", "ensemble = 4\nseed = 9");
     refused(&c, &out, "another study");
     assert_eq!(std::fs::read(out.join("study.json")).unwrap(), before);
+}
+
+/// `--max-memory` below what the study plans: stopped after its nominal run, before any
+/// other stage, with the guard's line (stage, estimate, what to change); a size that does
+/// not parse is refused before anything runs.
+#[test]
+fn a_memory_limit_below_the_plan_stops_the_study_before_its_stages() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let config = strip_study(d, SMALL);
+    let out = d.join("small");
+    let args = |limit: &str| study_with(&config, &out, &["--max-memory", limit]);
+    let o = args("1M");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let last = err.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("impactcal: error:")
+            && last.contains("needs about")
+            && last.contains("--max-memory"),
+        "{err}"
+    );
+    assert!(out.join("runs/nominal").exists() && !out.join("runs/noise").exists());
+    let o = args("lots");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("not a size"), "{err}");
+    // With room, the same study in the same folder resumes from its nominal run.
+    let o = args("4G");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
 /// Spawns `impactcal study`, SIGKILLs it once `journal` records `after` results, and

@@ -222,27 +222,45 @@ impl SimulationNoise {
         Self::from_runs_filtered(nominal, runs, None)
     }
 
+    /// [`from_runs`](Self::from_runs) over `count` runs read one at a time: `read(j)` gives
+    /// run `j` (and may fail with the caller's error). Each run is read twice, once for the
+    /// mean and once for the spread about it, so that only the nominal run, two
+    /// channels x samples accumulators and one run are held whatever `count` is. The result
+    /// is the same, bit for bit, as `from_runs` on the same runs.
+    ///
+    /// # Errors
+    /// [`CoreError::Invalid`] (converted) for `count < 2` or a run that does not match the
+    /// nominal; whatever `read` returns.
+    pub fn from_run_reader<E: From<CoreError>>(
+        nominal: &Histories,
+        count: usize,
+        read: &mut dyn FnMut(usize) -> std::result::Result<Histories, E>,
+    ) -> std::result::Result<Self, E> {
+        Self::accumulate(nominal, count, None, read)
+    }
+
     fn from_runs_filtered(
         nominal: &Histories,
         runs: &[Histories],
         cfc: Option<Cfc>,
     ) -> Result<Self> {
-        if runs.len() < 2 {
+        Self::accumulate(nominal, runs.len(), cfc, &mut |j| Ok(runs[j].clone()))
+    }
+
+    /// The spread of `count` runs given by `read` about `nominal`, each channel filtered
+    /// with `cfc` when given: two passes over the runs (the mean, then the sum of squares
+    /// about it), each summing over the runs in order.
+    fn accumulate<E: From<CoreError>>(
+        nominal: &Histories,
+        count: usize,
+        cfc: Option<Cfc>,
+        read: &mut dyn FnMut(usize) -> std::result::Result<Histories, E>,
+    ) -> std::result::Result<Self, E> {
+        if count < 2 {
             return Err(CoreError::Invalid(format!(
-                "the spread needs at least 2 runs, got {}",
-                runs.len()
-            )));
-        }
-        for (j, r) in runs.iter().enumerate() {
-            let same = r.labels() == nominal.labels()
-                && r.samples() == nominal.samples()
-                && (r.dt() - nominal.dt()).abs() <= 1e-9 * nominal.dt()
-                && (r.start() - nominal.start()).abs() <= 1e-9 * nominal.dt();
-            if !same {
-                return Err(CoreError::Invalid(format!(
-                    "run {j} does not match the nominal run (labels, samples, step or start)"
-                )));
-            }
+                "the spread needs at least 2 runs, got {count}"
+            ))
+            .into());
         }
         let channels = |h: &Histories| -> Result<Vec<Vec<f64>>> {
             (0..h.channels())
@@ -252,21 +270,42 @@ impl SimulationNoise {
                 })
                 .collect()
         };
+        let mut run = |j: usize| -> std::result::Result<Vec<Vec<f64>>, E> {
+            let r = read(j)?;
+            let same = r.labels() == nominal.labels()
+                && r.samples() == nominal.samples()
+                && (r.dt() - nominal.dt()).abs() <= 1e-9 * nominal.dt()
+                && (r.start() - nominal.start()).abs() <= 1e-9 * nominal.dt();
+            if !same {
+                return Err(CoreError::Invalid(format!(
+                    "run {j} does not match the nominal run (labels, samples, step or start)"
+                ))
+                .into());
+            }
+            Ok(channels(&r)?)
+        };
         let nom = channels(nominal)?;
-        let all: Vec<Vec<Vec<f64>>> = runs.iter().map(channels).collect::<Result<_>>()?;
         let n = nominal.samples();
-        let jf = runs.len() as f64;
-        let spread = (0..nom.len())
-            .map(|c| {
-                (0..n)
-                    .map(|k| {
-                        let mean = all.iter().map(|r| r[c][k]).sum::<f64>() / jf;
-                        let ss: f64 = all.iter().map(|r| (r[c][k] - mean).powi(2)).sum();
-                        (ss / (jf - 1.0)).sqrt()
-                    })
-                    .collect()
-            })
-            .collect();
+        let jf = count as f64;
+        let mut mean: Vec<Vec<f64>> = vec![vec![0.0; n]; nom.len()];
+        for j in 0..count {
+            for (acc, ch) in mean.iter_mut().zip(run(j)?) {
+                acc.iter_mut().zip(ch).for_each(|(a, v)| *a += v);
+            }
+        }
+        mean.iter_mut()
+            .for_each(|ch| ch.iter_mut().for_each(|a| *a /= jf));
+        let mut spread: Vec<Vec<f64>> = vec![vec![0.0; n]; nom.len()];
+        for j in 0..count {
+            for ((acc, m), ch) in spread.iter_mut().zip(&mean).zip(run(j)?) {
+                for ((a, mk), v) in acc.iter_mut().zip(m).zip(ch) {
+                    *a += (v - mk).powi(2);
+                }
+            }
+        }
+        spread
+            .iter_mut()
+            .for_each(|ch| ch.iter_mut().for_each(|a| *a = (*a / (jf - 1.0)).sqrt()));
         let scale = nom
             .iter()
             .map(|y| (y.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt())
@@ -275,7 +314,7 @@ impl SimulationNoise {
             parameters: Vec::new(),
             point: Vec::new(),
             options: JitterOptions {
-                runs: runs.len(),
+                runs: count,
                 eps: 0.0,
                 seed: 0,
                 cfc,
@@ -576,5 +615,33 @@ mod tests {
             SimulationNoise::measure(&m, &[1.0, 10.0], &o),
             Err(CoreError::FilterClass { .. })
         ));
+    }
+
+    /// Runs read one at a time give the spread of the same runs held together, bit for
+    /// bit, each run read twice; a failed read is the caller's error.
+    #[test]
+    fn runs_read_one_at_a_time_give_the_same_spread() {
+        let m = model();
+        let o = JitterOptions::new(7, 1e-3, 5);
+        let pts = jitter_points(m.space(), &[1.0, 10.0], &o).unwrap();
+        let runs: Vec<Histories> = pts.iter().map(|p| m.simulate(p).unwrap()).collect();
+        let nominal = m.simulate(&[1.0, 10.0]).unwrap();
+        let held = SimulationNoise::from_runs(&nominal, &runs).unwrap();
+        let mut reads = vec![0; runs.len()];
+        let streamed = SimulationNoise::from_run_reader(&nominal, runs.len(), &mut |j| {
+            reads[j] += 1;
+            Ok::<_, CoreError>(runs[j].clone())
+        })
+        .unwrap();
+        assert_eq!(streamed, held);
+        assert!(reads.iter().all(|&r| r == 2), "{reads:?}");
+        let failed = SimulationNoise::from_run_reader(&nominal, 3, &mut |j| {
+            if j == 2 {
+                Err(CoreError::Invalid("run 2 is gone".into()))
+            } else {
+                Ok(runs[j].clone())
+            }
+        });
+        assert!(failed.unwrap_err().to_string().contains("run 2 is gone"));
     }
 }

@@ -11,8 +11,9 @@
 //!
 //! where `w` are the loop's whitening weights (`1 / sqrt(sigma_s^2 + spread_s(t)^2)`: the
 //! measurement noise and the model's own simulation noise), `g` the channel gains, `c` the
-//! noise's inflation for lag-one correlation, and `U` (rank `r`) the left singular vectors of
-//! the whitened Jacobian of a fit (parameters and nuisance terms). `J delta` with `delta`
+//! noise's inflation for lag-one correlation, and `U` (rank `r`) an orthonormal basis of the
+//! column space of the whitened Jacobian of a fit (parameters and nuisance terms; the
+//! factored form's basis, `closeloop::jacobian`). `J delta` with `delta`
 //! drawn from the linearised posterior `N(0, c (J^T J)^+)` is exactly `sqrt(c) U z`, so the
 //! first term is the parameters' uncertainty propagated to first order, the second the noise
 //! a repeated test would carry. A model with no fit at that point (the nominal model; any
@@ -33,7 +34,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use super::linalg::Lsq;
+use super::jacobian::Jacobian;
 use super::nuisance::{self, Frame, Terms};
 use crate::error::Result;
 use crate::study::{m1, m2};
@@ -41,10 +42,10 @@ use crate::study::{m1, m2};
 /// Impact shapes compared a side by the loop's M2 (the study's default).
 pub const M2_SHAPES: usize = 10;
 
-/// A fit's linearised posterior: its whitened Jacobian columns (parameters and nuisance
-/// terms) and the noise's inflation `c`.
+/// A fit's linearised posterior: its whitened Jacobian (parameters and nuisance terms) and
+/// the noise's inflation `c`.
 pub(crate) struct Posterior<'a> {
-    pub jac: &'a [Vec<f64>],
+    pub jac: &'a Jacobian,
     pub inflation: f64,
 }
 
@@ -53,7 +54,7 @@ pub(crate) struct Posterior<'a> {
 /// the module docs. Deterministic for a given `seed`.
 ///
 /// # Errors
-/// [`crate::CalibrateError::Study`] when the posterior's SVD fails or `members` is zero.
+/// [`crate::CalibrateError::Study`] when `members` is zero.
 pub(crate) fn m1_exceedance(
     frame: &Frame,
     y: &[f64],
@@ -63,8 +64,7 @@ pub(crate) fn m1_exceedance(
     seed: u64,
 ) -> Result<f64> {
     let t = frame.samples;
-    let lsq = posterior.map(|p| Lsq::new(p.jac).map(|l| (l, p.inflation.sqrt())));
-    let lsq = lsq.transpose()?;
+    let lsq = posterior.map(|p| (p.jac, p.inflation.sqrt()));
     let scale: Vec<f64> = frame
         .weights
         .iter()

@@ -29,6 +29,10 @@
 //!   sensors cannot tell apart;
 //! - a sensor pattern per candidate: its share of `<g~_k, r>` on each channel.
 //!
+//! A drift is zero outside its channel; it is held as its channel's values and projected
+//! in the factored form (`closeloop::jacobian`: `T + r_a` numbers per drift instead of a
+//! vector over the whole test), and its sensor pattern is its share on its own channel.
+//!
 //! Beside the candidates, signature directions that need no run: the time scaling
 //! `t' y'(t)` about the impact (a stiffness-mass scaling) and a drift `t'` per channel. They
 //! are scored the same way and reported; they name no physical parameter and are never added.
@@ -40,10 +44,10 @@ use serde::{Deserialize, Serialize};
 
 use super::detection::chi2_quantile;
 use super::fit::{Ctx, Fit};
+use super::jacobian::Jacobian;
 use super::linalg::dot;
 use super::nuisance;
 use crate::error::Result;
-use crate::study::execute::histories_of;
 
 /// Confounding ratio above which a candidate is not identifiable.
 pub const KAPPA_MAX: f64 = 0.9;
@@ -102,7 +106,7 @@ pub struct Score {
     /// sign`, `not significant`, `within the model's noise`, `explains too little`,
     /// `signature`.
     pub status: String,
-    /// Share of `<g~, r>` per channel.
+    /// Share of `<g~, r>` per channel (a drift's: on its own channel only).
     pub sensor_pattern: BTreeMap<String, f64>,
 }
 
@@ -137,15 +141,86 @@ impl Attribution {
     }
 }
 
+/// A whitened direction before the fitted span is taken out: a vector over the whole test,
+/// or the `T` values of a direction that is zero outside one channel (a drift).
+enum Shape {
+    Dense(Vec<f64>),
+    Channel(usize, Vec<f64>),
+}
+
+/// A direction with the fitted span taken out, `g~ = (I - P_J) g`: a whole vector, or for a
+/// direction `g` on channel `s` alone the pair `l = (I - P_Bs) g_s` (channel `s`'s rows)
+/// and `c = U_a^T g`, with `g~ = l - U_a c` (`closeloop::jacobian`; `U_a` is orthogonal to
+/// the channels' nuisance columns, so `U_a^T l = c`). The pair is `T + r_a` numbers where
+/// the vector would be `S T`.
+enum Unfitted {
+    Dense(Vec<f64>),
+    Channel { s: usize, l: Vec<f64>, c: Vec<f64> },
+}
+
+impl Unfitted {
+    /// `g~ = (I - P_J) g` of the direction `g`, with `||g||^2` and `||P_J g||^2`.
+    fn of(shape: Shape, jac: &Jacobian) -> (f64, f64, Self) {
+        match shape {
+            Shape::Dense(g) => {
+                let pg = jac.project(&g);
+                let gg = dot(&g, &g);
+                let pgg = dot(&pg, &pg);
+                let gt: Vec<f64> = g.iter().zip(&pg).map(|(a, b)| a - b).collect();
+                (gg, pgg, Unfitted::Dense(gt))
+            }
+            Shape::Channel(s, g) => {
+                let l = jac.channel_unfitted(s, &g);
+                let c = jac.coefficients_channel(s, &g);
+                let pb: f64 = g.iter().zip(&l).map(|(a, b)| (a - b).powi(2)).sum();
+                (dot(&g, &g), pb + dot(&c, &c), Unfitted::Channel { s, l, c })
+            }
+        }
+    }
+
+    /// `<g~, y>`, given `y` and its coefficients `U_a^T y`.
+    fn dot(&self, y: &[f64], uty: &[f64], t: usize) -> f64 {
+        match self {
+            Unfitted::Dense(g) => dot(g, y),
+            Unfitted::Channel { s, l, c } => dot(l, &y[s * t..(s + 1) * t]) - dot(c, uty),
+        }
+    }
+
+    /// `<g~_a, g~_b>` (`uty_dense` holds `U_a^T g~` of a dense one: zero to round-off).
+    fn inner(a: (&Self, &[f64]), b: (&Self, &[f64]), t: usize) -> f64 {
+        match (a.0, b.0) {
+            (Unfitted::Dense(x), Unfitted::Dense(y)) => dot(x, y),
+            (Unfitted::Dense(x), Unfitted::Channel { s, l, c })
+            | (Unfitted::Channel { s, l, c }, Unfitted::Dense(x)) => {
+                let ux = if matches!(a.0, Unfitted::Dense(_)) {
+                    a.1
+                } else {
+                    b.1
+                };
+                dot(&x[s * t..(s + 1) * t], l) - dot(c, ux)
+            }
+            (
+                Unfitted::Channel {
+                    s: si,
+                    l: li,
+                    c: ci,
+                },
+                Unfitted::Channel {
+                    s: sj,
+                    l: lj,
+                    c: cj,
+                },
+            ) => {
+                let same = if si == sj { dot(li, lj) } else { 0.0 };
+                same - dot(ci, cj)
+            }
+        }
+    }
+}
+
 /// A direction to score: name, kind, group, whitened direction, and for a candidate its
 /// held value, admissible range and finite step.
-type Direction = (
-    String,
-    String,
-    String,
-    Vec<f64>,
-    Option<(f64, f64, f64, f64)>,
-);
+type Direction = (String, String, String, Shape, Option<(f64, f64, f64, f64)>);
 
 /// Scores the candidates of `model` (and the signature directions) against the residual of
 /// `fit` (see the module docs). `step` is the finite step as a fraction of each range.
@@ -170,7 +245,12 @@ pub(crate) fn attribute<M: Enrichable>(
         .into_iter()
         .filter(|c| allowed(c.name()))
         .collect();
+    if let Some(plan) = ctx.runner.plan {
+        plan.check(super::plan::ATTRIBUTION, &format!("{prefix}-candidates"))?;
+    }
     let frame = &ctx.frame;
+    let jac = &fit.jac;
+    let t = frame.samples;
     let base = nuisance::apply(&fit.y, frame, &fit.terms);
     let mut dirs: Vec<Direction> = Vec::new();
     if !cands.is_empty() {
@@ -195,11 +275,8 @@ pub(crate) fn attribute<M: Enrichable>(
         let outs = ctx
             .runner
             .stage(&full, &format!("{prefix}-candidates"), &points)?;
-        for (k, o) in outs.iter().enumerate() {
-            let yk = ctx.y_of(&histories_of(
-                o,
-                &format!("candidate `{}`", params[k].name),
-            )?)?;
+        for (k, p) in params.iter().enumerate() {
+            let yk = ctx.y_of(&outs.histories(k, &format!("candidate `{}`", p.name))?)?;
             let mk = nuisance::apply(&yk, frame, &fit.terms);
             let g: Vec<f64> = mk
                 .iter()
@@ -207,18 +284,16 @@ pub(crate) fn attribute<M: Enrichable>(
                 .zip(&frame.weights)
                 .map(|((a, b), w)| w * (a - b) / steps[k])
                 .collect();
-            let p = &params[k];
             dirs.push((
                 p.name.clone(),
                 "candidate".into(),
                 cands[k].group.clone(),
-                g,
+                Shape::Dense(g),
                 Some((p.nominal, p.lower, p.upper, steps[k])),
             ));
         }
     }
     // Signature directions.
-    let t = frame.samples;
     let ys = nuisance::shifted(&fit.y, frame, fit.terms.tau);
     let t0 = onset as f64 + fit.terms.tau / frame.dt;
     let mut scale = vec![0.0; ys.len()];
@@ -230,54 +305,74 @@ pub(crate) fn attribute<M: Enrichable>(
             scale[s * t + k] = frame.weights[s * t + k] * fit.terms.gains[s] * tt * dy;
         }
     }
+    drop(ys);
     dirs.push((
         "time_scale".into(),
         "signature".into(),
         "signature".into(),
-        scale,
+        Shape::Dense(scale),
         None,
     ));
     for (s, l) in frame.labels.iter().enumerate() {
-        let mut g = vec![0.0; ys.len()];
-        for k in 0..t {
-            g[s * t + k] = frame.weights[s * t + k] * (k as f64 - t0).max(0.0);
-        }
+        let g: Vec<f64> = (0..t)
+            .map(|k| frame.weights[s * t + k] * (k as f64 - t0).max(0.0))
+            .collect();
         dirs.push((
             format!("drift:{l}"),
             "signature".into(),
             "signature".into(),
-            g,
+            Shape::Channel(s, g),
             None,
         ));
     }
 
-    let draws = ctx.model_noise.draws(fit, frame)?;
-    let lsq = draws.lsq();
+    // Each direction without its fitted part: its size, confounding ratio and `g~`.
+    let mut unfitted = Vec::with_capacity(dirs.len());
+    let mut kappas = Vec::with_capacity(dirs.len());
+    let mut described = Vec::with_capacity(dirs.len());
+    for (name, kind, group, shape, range) in dirs {
+        let (gg, pgg, u) = Unfitted::of(shape, jac);
+        kappas.push(if gg > 0.0 { (pgg / gg).sqrt() } else { 1.0 });
+        unfitted.push(u);
+        described.push((name, kind, group, range));
+    }
+    let uty: Vec<Vec<f64>> = unfitted
+        .iter()
+        .map(|u| match u {
+            Unfitted::Dense(g) => jac.coefficients(g),
+            Unfitted::Channel { .. } => Vec::new(),
+        })
+        .collect();
+    let norms: Vec<f64> = unfitted
+        .iter()
+        .zip(&uty)
+        .map(|(u, c)| Unfitted::inner((u, c), (u, c), t).max(0.0))
+        .collect();
+
+    // One pass over the model's noise draws: each direction's inner products with them.
+    let products = |d: &[f64], utd: &[f64]| -> Vec<f64> {
+        unfitted.iter().map(|u| u.dot(d, utd, t)).collect()
+    };
+    let draws = ctx.model_noise.stats(fit, frame, None, Some(&products))?;
     let draws_energy = draws.unfitted_energy();
     let r = &fit.residual;
+    let utr = jac.coefficients(r);
     let rr = dot(r, r);
-    let crit = chi2_quantile(1.0, alpha / dirs.len() as f64)?;
+    let crit = chi2_quantile(1.0, alpha / described.len() as f64)?;
     let mut scores = Vec::new();
-    let mut tilde: Vec<(usize, Vec<f64>)> = Vec::new();
-    for (i, (name, kind, group, g, range)) in dirs.iter().enumerate() {
-        let gg = dot(g, g);
-        let pg = lsq.project(g);
-        let kappa = if gg > 0.0 {
-            (dot(&pg, &pg) / gg).sqrt()
-        } else {
-            1.0
-        };
-        let gt: Vec<f64> = g.iter().zip(&pg).map(|(a, b)| a - b).collect();
-        let gtt = dot(&gt, &gt);
+    let mut tilde: Vec<usize> = Vec::new();
+    for (i, (name, kind, group, range)) in described.into_iter().enumerate() {
+        let kappa = kappas[i];
+        let gtt = norms[i];
         let identifiable = kappa <= KAPPA_MAX && gtt > 0.0;
-        let gr = dot(&gt, r);
+        let gr = unfitted[i].dot(r, &utr, t);
         let (explained, lm) = if identifiable && rr > 0.0 {
             (gr * gr / (gtt * rr), gr * gr / (gtt * inflation))
         } else {
             (0.0, 0.0)
         };
         let noise_var = if identifiable {
-            draws.amplitude_variance(&gt)
+            draws.amplitude_variance(i, gtt)
         } else {
             0.0
         };
@@ -297,13 +392,23 @@ pub(crate) fn attribute<M: Enrichable>(
             }
         });
         let admissible = match (&amplitude, range) {
-            (Some(a), Some((_, lo, hi, _))) => a.upper >= *lo && a.lower <= *hi,
+            (Some(a), Some((_, lo, hi, _))) => a.upper >= lo && a.lower <= hi,
             _ => true,
         };
+        let share = |part: f64| if gr != 0.0 { part / gr } else { 0.0 };
         let mut pattern = BTreeMap::new();
-        for (s, l) in frame.labels.iter().enumerate() {
-            let part: f64 = (s * t..(s + 1) * t).map(|j| gt[j] * r[j]).sum();
-            pattern.insert(l.clone(), if gr != 0.0 { part / gr } else { 0.0 });
+        match &unfitted[i] {
+            Unfitted::Dense(gt) => {
+                for (s, l) in frame.labels.iter().enumerate() {
+                    let part: f64 = (s * t..(s + 1) * t).map(|j| gt[j] * r[j]).sum();
+                    pattern.insert(l.clone(), share(part));
+                }
+            }
+            Unfitted::Channel { s, l, c } => {
+                let rs = &r[s * t..(s + 1) * t];
+                let part = dot(l, rs) - dot(c, &jac.coefficients_channel(*s, rs));
+                pattern.insert(frame.labels[*s].clone(), share(part));
+            }
         }
         let significant = lm > crit;
         let above_model_noise = identifiable && (gr / gtt).powi(2) / total_var > crit;
@@ -323,12 +428,12 @@ pub(crate) fn attribute<M: Enrichable>(
             "eligible"
         };
         if identifiable {
-            tilde.push((i, gt));
+            tilde.push(i);
         }
         scores.push(Score {
-            name: name.clone(),
-            kind: kind.clone(),
-            group: group.clone(),
+            name,
+            kind,
+            group,
             kappa,
             identifiable,
             explained_fraction: explained,
@@ -348,11 +453,12 @@ pub(crate) fn attribute<M: Enrichable>(
         });
     }
     let mut indistinguishable = Vec::new();
-    for (a, (i, gi)) in tilde.iter().enumerate() {
-        for (j, gj) in &tilde[a + 1..] {
-            let mu = dot(gi, gj).abs() / (dot(gi, gi) * dot(gj, gj)).sqrt();
+    for (a, &i) in tilde.iter().enumerate() {
+        for &j in &tilde[a + 1..] {
+            let gij = Unfitted::inner((&unfitted[i], &uty[i]), (&unfitted[j], &uty[j]), t);
+            let mu = gij.abs() / (norms[i] * norms[j]).sqrt();
             if mu > COHERENCE_MAX {
-                indistinguishable.push((scores[*i].name.clone(), scores[*j].name.clone(), mu));
+                indistinguishable.push((scores[i].name.clone(), scores[j].name.clone(), mu));
             }
         }
     }
@@ -372,4 +478,83 @@ pub(crate) fn attribute<M: Enrichable>(
         ranked: scores,
         indistinguishable,
     })
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// A Jacobian of 4 channels of 30 samples: two dense columns, a bias and a gain per
+    /// channel.
+    fn jacobian() -> (Jacobian, usize, usize) {
+        let (channels, t) = (4, 30);
+        let n = channels * t;
+        let w: Vec<f64> = (0..n).map(|i| 1.0 + 0.3 * (i as f64 * 0.7).sin()).collect();
+        let gain: Vec<f64> = (0..n)
+            .map(|i| w[i] * ((i % t) as f64 * 0.2 + (i / t) as f64).cos())
+            .collect();
+        let dense = vec![
+            (0..n).map(|i| w[i] * (i as f64 * 0.05).sin()).collect(),
+            (0..n)
+                .map(|i| w[i] * ((i % t) as f64 / t as f64).powi(2))
+                .collect(),
+        ];
+        (Jacobian::new(t, dense, &[&w, &gain]).unwrap(), channels, t)
+    }
+
+    fn scatter(s: usize, g: &[f64], channels: usize, t: usize) -> Vec<f64> {
+        let mut v = vec![0.0; channels * t];
+        v[s * t..(s + 1) * t].copy_from_slice(g);
+        v
+    }
+
+    /// A drift held as its channel's values gives the numbers of the same direction held
+    /// over the whole test: size, confounding ratio, `<g~, y>`, `<g~_a, g~_b>` with another
+    /// drift and with a dense direction.
+    #[test]
+    fn a_direction_on_one_channel_gives_the_whole_vector_numbers() {
+        let (jac, channels, t) = jacobian();
+        let n = channels * t;
+        let drift =
+            |s: usize| -> Vec<f64> { (0..t).map(|k| (k as f64 + s as f64) * 0.1).collect() };
+        let y: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
+        let dense: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).sin().powi(3)).collect();
+        let (_, _, hd) = Unfitted::of(Shape::Dense(dense.clone()), &jac);
+        let hd_ut = match &hd {
+            Unfitted::Dense(g) => jac.coefficients(g),
+            Unfitted::Channel { .. } => unreachable!(),
+        };
+        let mut local = Vec::new();
+        for s in [1, 3] {
+            let g = drift(s);
+            let whole = scatter(s, &g, channels, t);
+            let (gg, pgg, u) = Unfitted::of(Shape::Channel(s, g), &jac);
+            let (gg_w, pgg_w, u_w) = Unfitted::of(Shape::Dense(whole.clone()), &jac);
+            assert!((gg - gg_w).abs() <= 1e-12 * gg_w);
+            assert!((pgg - pgg_w).abs() <= 1e-10 * gg_w, "{pgg} vs {pgg_w}");
+            let gt = match &u_w {
+                Unfitted::Dense(g) => g.clone(),
+                Unfitted::Channel { .. } => unreachable!(),
+            };
+            let norm = Unfitted::inner((&u, &[]), (&u, &[]), t);
+            assert!((norm - dot(&gt, &gt)).abs() <= 1e-10 * gg_w);
+            let a = u.dot(&y, &jac.coefficients(&y), t);
+            assert!((a - dot(&gt, &y)).abs() <= 1e-10 * (gg_w * dot(&y, &y)).sqrt());
+            let hd_dot = Unfitted::inner((&hd, &hd_ut), (&u, &[]), t);
+            let expect = match &hd {
+                Unfitted::Dense(h) => dot(h, &gt),
+                Unfitted::Channel { .. } => unreachable!(),
+            };
+            assert!((hd_dot - expect).abs() <= 1e-10 * (gg_w * dot(&dense, &dense)).sqrt());
+            local.push((u, gt));
+        }
+        let cross = Unfitted::inner((&local[0].0, &[]), (&local[1].0, &[]), t);
+        let expect = dot(&local[0].1, &local[1].1);
+        assert!(
+            expect.abs() > 1e-6,
+            "the two drifts must share something for the test"
+        );
+        assert!((cross - expect).abs() <= 1e-10 * expect.abs().max(1.0));
+    }
 }

@@ -120,6 +120,19 @@ fn autocorrelation(e: &[f64], samples: usize, k: usize) -> f64 {
     if den > 0.0 { num / den } else { 0.0 }
 }
 
+/// The reduced chi-square of the whitened residual `e` (`S x T`, `T = samples`) with `p`
+/// fitted quantities (see the module docs), with the effective samples `n_eff`, the pooled
+/// lag-one autocorrelation and the degrees of freedom `nu` it used:
+/// `(chi2_red, n_eff, lag1, nu)`.
+pub(crate) fn chi2_red(e: &[f64], samples: usize, p: usize) -> (f64, f64, f64, f64) {
+    let n = e.len();
+    let rss: f64 = e.iter().map(|v| v * v).sum();
+    let lag1 = autocorrelation(e, samples, 1).clamp(0.0, 0.999);
+    let n_eff = n as f64 * (1.0 - lag1) / (1.0 + lag1);
+    let nu = (n_eff - p as f64).max(1.0);
+    (rss * n_eff / n as f64 / nu, n_eff, lag1, nu)
+}
+
 /// The detection statistics (see the module docs) of the whitened residual `e` (`S x T`),
 /// with `p` fitted quantities, noise lag-one correlation `noise_lag1` and level `alpha`.
 ///
@@ -141,11 +154,7 @@ pub fn detect(
             "empty or mis-shaped residual",
         ));
     }
-    let rss: f64 = e.iter().map(|v| v * v).sum();
-    let lag1 = autocorrelation(e, samples, 1).clamp(0.0, 0.999);
-    let n_eff = n as f64 * (1.0 - lag1) / (1.0 + lag1);
-    let nu = (n_eff - p as f64).max(1.0);
-    let chi2_red = rss * n_eff / n as f64 / nu;
+    let (chi2_red, n_eff, lag1, nu) = chi2_red(e, samples, p);
     let threshold = chi2_quantile(nu, alpha)? / nu;
     let mut q = 0.0;
     let h = WHITENESS_LAGS.min(samples.saturating_sub(2)).max(1);

@@ -8,21 +8,25 @@
 //! (`h_i = 1e-3 (upper_i - lower_i)`, stepping inwards at an upper bound) gives the
 //! whitened columns `w (N(y(theta + h_i e_i)) - N(y(theta))) / h_i` under the current
 //! nuisance terms `N`; with the nuisance columns (`tau`, gains, biases) beside them, the
-//! minimum-norm least-squares step of the linearised problem moves `theta` (clipped to the
-//! bounds). The step is tried at full, quarter and sixteenth length and kept when the
+//! least-squares step of the linearised problem moves `theta` (clipped to the bounds). The
+//! Jacobian is held factored (`closeloop::jacobian`): the per-channel gain and bias columns
+//! are eliminated channel by channel, never formed as columns of the whole test. The step is tried at full, quarter and sixteenth length and kept when the
 //! profiled residual falls; the polish stops when no step helps, when the predicted fall is
 //! below `1e-3` (in units of the noise variance), or after its iteration budget.
 
 use std::cell::Cell;
 use std::path::Path;
+use std::sync::Arc;
 
 use impactcal_core::{Cfc, Histories, Model, ParameterSpace};
 
-use super::linalg::{Lsq, dot};
+use super::jacobian::Jacobian;
+use super::linalg::dot;
 use super::model_noise::ModelNoise;
 use super::nuisance::{self, Frame, Terms};
+use super::plan::Plan;
 use crate::error::{CalibrateError, Result};
-use crate::study::execute::{Dispatch, Observer, RunOutcome, Runs, Worker, histories_of};
+use crate::study::execute::{Dispatch, Observer, Outcomes, Runs, Worker};
 use crate::study::reconcile;
 
 /// The journaled runner of one loop (its output folder and fingerprint), counting the runs
@@ -37,6 +41,8 @@ pub(crate) struct Journaled<'a> {
     pub used: &'a Cell<usize>,
     pub worker: Option<&'a Worker>,
     pub condition: &'a [(String, f64)],
+    /// The loop's memory plan, once the nominal run has given its shapes.
+    pub plan: Option<&'a Plan>,
 }
 
 impl<'a> Journaled<'a> {
@@ -59,7 +65,10 @@ impl<'a> Journaled<'a> {
         stage: &str,
         first: usize,
         points: &[Vec<f64>],
-    ) -> Result<Vec<RunOutcome>> {
+    ) -> Result<Outcomes> {
+        if let Some(plan) = self.plan {
+            plan.check(super::plan::RUNS, stage)?;
+        }
         let exec = Dispatch {
             model,
             worker: self.worker,
@@ -78,12 +87,7 @@ impl<'a> Journaled<'a> {
     ///
     /// # Errors
     /// Journal errors.
-    pub fn stage<M: Model>(
-        &self,
-        model: &M,
-        stage: &str,
-        points: &[Vec<f64>],
-    ) -> Result<Vec<RunOutcome>> {
+    pub fn stage<M: Model>(&self, model: &M, stage: &str, points: &[Vec<f64>]) -> Result<Outcomes> {
         self.stage_from(model, stage, 0, points)
     }
 }
@@ -114,8 +118,9 @@ pub(crate) struct Fit {
     pub residual: Vec<f64>,
     /// `sum residual^2`.
     pub rss: f64,
-    /// Whitened Jacobian columns: the parameters', then the nuisance terms'.
-    pub jac: Vec<Vec<f64>>,
+    /// The whitened Jacobian of the parameters and the nuisance terms, factored (its dense
+    /// columns: the parameters, then `tau`).
+    pub jac: Arc<Jacobian>,
     /// Standard errors of the parameters for unit white noise.
     pub se: Vec<f64>,
     /// Runs this fit used.
@@ -152,8 +157,7 @@ impl Ctx<'_> {
         let o = self
             .runner
             .stage(model, stage, std::slice::from_ref(&point.to_vec()))?;
-        let h = histories_of(&o[0], stage)?;
-        self.y_of(&h)
+        self.y_of(&o.histories(0, stage)?)
     }
 }
 
@@ -178,17 +182,24 @@ pub(crate) fn calibrate<M: Model>(
         .first()
         .cloned()
         .ok_or_else(|| CalibrateError::study(prefix, "no starting point"))?;
-    let mut y = ctx.y_of(&histories_of(&outcomes[0], "the starting point")?)?;
+    let mut y = ctx.y_of(&outcomes.histories(0, "the starting point")?)?;
     if budget > 0 {
-        let warm: Vec<(Vec<f64>, RunOutcome)> = start.iter().cloned().zip(outcomes).collect();
         let n = ctx.frame.test.len() as f64;
         let error = |h: &Histories| -> Result<f64> { Ok(ctx.profile(&ctx.y_of(h)?).1 / n) };
         let stage = format!("{prefix}-cors");
-        let mut run = |first: usize, pts: &[Vec<f64>]| -> Result<Vec<RunOutcome>> {
+        let mut run = |first: usize, pts: &[Vec<f64>]| -> Result<Outcomes> {
             ctx.runner.stage_from(model, &stage, first, pts)
         };
-        let best =
-            reconcile::reconcile(space, &warm, budget, ctx.batch, ctx.seed, &mut run, &error)?;
+        let best = reconcile::reconcile(
+            space,
+            start,
+            &|k| outcomes.get(k),
+            budget,
+            ctx.batch,
+            ctx.seed,
+            &mut run,
+            &error,
+        )?;
         point = best.summary.calibrated_point;
         y = ctx.y_of(&best.histories)?;
     }
@@ -237,32 +248,31 @@ fn polish_from<M: Model>(
                 x
             })
             .collect();
-        let outs = ctx
-            .runner
-            .stage(model, &format!("{prefix}-gn{it}-jac"), &pts)?;
+        let stage = format!("{prefix}-gn{it}-jac");
+        if let Some(plan) = ctx.runner.plan {
+            plan.check(super::plan::JACOBIAN, &stage)?;
+        }
+        let outs = ctx.runner.stage(model, &stage, &pts)?;
         let base = nuisance::apply(&y, &ctx.frame, &terms);
-        let mut jac = Vec::with_capacity(p + 1 + 2 * ctx.frame.labels.len());
-        for (i, o) in outs.iter().enumerate() {
-            let yi = ctx.y_of(&histories_of(o, "a finite-difference run")?)?;
+        let mut dense = Vec::with_capacity(p + 1);
+        for (i, hi) in h.iter().enumerate() {
+            let yi = ctx.y_of(&outs.histories(i, "a finite-difference run")?)?;
             let mi = nuisance::apply(&yi, &ctx.frame, &terms);
-            jac.push(
+            dense.push(
                 mi.iter()
                     .zip(&base)
                     .zip(&ctx.frame.weights)
-                    .map(|((a, b), w)| w * (a - b) / h[i])
+                    .map(|((a, b), w)| w * (a - b) / hi)
                     .collect::<Vec<f64>>(),
             );
         }
-        jac.extend(nuisance::columns(
-            &y,
-            &ctx.frame,
-            &terms,
-            ctx.fixed_gains.is_none(),
-        ));
-        let lsq = Lsq::new(&jac)?;
-        let se: Vec<f64> = lsq.variances()[..p].iter().map(|v| v.sqrt()).collect();
-        let step = lsq.solve(&residual);
-        let fitted = lsq.project(&residual);
+        let (tau, local) = nuisance::columns(&y, &ctx.frame, &terms, ctx.fixed_gains.is_none());
+        dense.push(tau);
+        let local: Vec<&[f64]> = local.iter().map(Vec::as_slice).collect();
+        let jac = Jacobian::new(ctx.frame.samples, dense, &local)?;
+        let se: Vec<f64> = jac.variances()[..p].iter().map(|v| v.sqrt()).collect();
+        let step = jac.solve(&residual);
+        let fitted = jac.project(&residual);
         let predicted = dot(&fitted, &fitted);
         let here = Fit {
             point: point.clone(),
@@ -270,7 +280,7 @@ fn polish_from<M: Model>(
             terms,
             residual,
             rss,
-            jac,
+            jac: Arc::new(jac),
             se,
             runs: 0,
         };

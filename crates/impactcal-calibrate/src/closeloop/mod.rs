@@ -57,11 +57,13 @@ pub mod detection;
 pub mod discrepancy;
 pub mod document;
 mod fit;
+mod jacobian;
 mod linalg;
 mod model_noise;
 pub mod noise_floor;
 pub mod nuisance;
 pub mod options;
+pub mod plan;
 pub mod result;
 pub mod selection;
 
@@ -72,10 +74,11 @@ use impactcal_core::noise::{JitterOptions, SimulationNoise, jitter_points};
 use impactcal_core::{Cfc, ChannelMap, Enrichable, Histories, Model};
 
 use crate::error::{CalibrateError, Result};
+use crate::memory::Guard;
 use crate::metrics::{CurveMetrics, Iso18571};
 use crate::study::TestData;
 use crate::study::channels::test_on_model;
-use crate::study::execute::{Observer, Worker, histories_of};
+use crate::study::execute::{Observer, Worker};
 
 pub use attribution::{Amplitude, Attribution, Score};
 pub use detection::Detection;
@@ -83,12 +86,14 @@ pub use discrepancy::Discrepancy;
 pub use noise_floor::NoiseFloor;
 pub use nuisance::Nuisance;
 pub use options::LoopOptions;
+pub use plan::{LoopShapes, estimated_peak};
 pub use result::{Added, ErrorSummary, Errors, LoopResult, ModelScore, Round, Stages, Verdict};
 
 use agreement::Posterior;
 use fit::{Ctx, Journaled};
 use model_noise::ModelNoise;
 use nuisance::{Frame, Terms};
+use plan::Plan;
 
 /// A holdout test: the measured histories and the condition they were taken at, as held
 /// quantities of the model (`("v0", 6.0)`).
@@ -197,19 +202,43 @@ pub fn run_loop_on<M: Enrichable>(
         used: &used,
         worker,
         condition: &[],
+        plan: None,
     };
 
     // Nominal run, the test on the model's channels.
     let nominal = space.nominal();
-    let nominal_raw = histories_of(
-        &runner.stage(model, "nominal", std::slice::from_ref(&nominal))?[0],
-        "the nominal run",
-    )?;
+    let nominal_raw = runner
+        .stage(model, "nominal", std::slice::from_ref(&nominal))?
+        .histories(0, "the nominal run")?;
     check_covered(test.histories, test.map, &nominal_raw, "test")?;
     let test_m = test_on_model(test.histories, test.map, test.cfc, &nominal_raw)?;
     let labels = test_m.labels().to_vec();
     let samples = test_m.samples();
     let dt = test_m.dt();
+
+    // The memory plan, from the shapes the nominal run gives, checked before any stage.
+    let plan = Plan {
+        shapes: LoopShapes {
+            channels: labels.len(),
+            samples,
+            run_values: nominal_raw.channels() * nominal_raw.samples(),
+            dense: d0 + options.max_added + 1,
+            candidates: listed.iter().filter(|c| options.allows(c.name())).count(),
+            threads: if worker.is_some() {
+                0
+            } else {
+                rayon::current_num_threads()
+            },
+            m1_members: options.m1_members,
+        },
+        guard: Guard::new(options.max_memory),
+    };
+    plan.check_all()?;
+    observer.step(&plan.line());
+    let runner = Journaled {
+        plan: Some(&plan),
+        ..runner
+    };
     let prep = |h: &Histories| -> Result<Vec<f64>> {
         let h = match test.cfc {
             Some(c) => h.filtered(c)?,
@@ -321,7 +350,7 @@ pub fn run_loop_on<M: Enrichable>(
     };
     let noise_var = ctx
         .model_noise
-        .draws(fit, &ctx.frame)?
+        .stats(fit, &ctx.frame, None, None)?
         .parameter_variances(fit.point.len());
     let added: Vec<Added> = outcome
         .added
@@ -356,7 +385,7 @@ pub fn run_loop_on<M: Enrichable>(
             &fit0.y,
             &fit0.terms,
             p_of(d0),
-            Some(posterior(&fit0.jac)),
+            Some(posterior(fit0.jac.as_ref())),
             1,
         )?,
         enriched: judge.errors(
@@ -364,7 +393,7 @@ pub fn run_loop_on<M: Enrichable>(
             &fit.y,
             &fit.terms,
             p_of(fit.point.len()),
-            Some(posterior(&fit.jac)),
+            Some(posterior(fit.jac.as_ref())),
             2,
         )?,
     };
@@ -376,32 +405,32 @@ pub fn run_loop_on<M: Enrichable>(
             observer.step("holdout");
             let enriched_model = model.enrich(&outcome.added)?;
             let enriched_at = enriched_model.at_condition(h.set)?;
-            let nominal_h = histories_of(
-                &runner.at(h.set).stage(
+            let nominal_h = runner
+                .at(h.set)
+                .stage(
                     &declared_at,
                     "holdout-nominal",
                     std::slice::from_ref(&nominal),
-                )?[0],
-                "the holdout's nominal run",
-            )?;
+                )?
+                .histories(0, "the holdout's nominal run")?;
             check_covered(h.histories, test.map, &nominal_h, "holdout")?;
             let test_h = test_on_model(h.histories, test.map, test.cfc, &nominal_h)?;
-            let calibrated_h = histories_of(
-                &runner.at(h.set).stage(
+            let calibrated_h = runner
+                .at(h.set)
+                .stage(
                     &declared_at,
                     "holdout-calibrated",
                     std::slice::from_ref(&fit0.point),
-                )?[0],
-                "the holdout's calibrated run",
-            )?;
-            let enriched_h = histories_of(
-                &runner.at(h.set).stage(
+                )?
+                .histories(0, "the holdout's calibrated run")?;
+            let enriched_h = runner
+                .at(h.set)
+                .stage(
                     &enriched_at,
                     "holdout-enriched",
                     std::slice::from_ref(&fit.point),
-                )?[0],
-                "the holdout's enriched run",
-            )?;
+                )?
+                .histories(0, "the holdout's enriched run")?;
             let (spread_h, _) = model_spread(
                 runner.at(h.set),
                 &declared_at,
@@ -513,39 +542,33 @@ fn model_spread<M: Model>(
 ) -> Result<(Vec<f64>, ModelNoise)> {
     let jitter = JitterOptions::new(options.ensemble, options.jitter, options.seed);
     let pts = jitter_points(model.space(), point, &jitter)?;
-    let prep = |h: &Histories| -> Result<Histories> {
-        Ok(match cfc {
-            Some(c) => h.filtered(c)?.select(labels)?,
-            None => h.select(labels)?,
-        })
-    };
-    let mut runs = Vec::new();
-    let mut shifts = Vec::new();
-    for (o, x) in runner.stage(model, name, &pts)?.iter().zip(&pts) {
-        if let Ok(h) = o {
-            runs.push(prep(h)?);
-            shifts.push(x.iter().zip(point).map(|(a, b)| a - b).collect());
-        }
-    }
-    if runs.len() < 2 {
+    let runs = runner.stage(model, name, &pts)?;
+    let used: Vec<usize> = (0..runs.len()).filter(|&i| runs.succeeded(i)).collect();
+    if used.len() < 2 {
         return Err(CalibrateError::study(
             name,
             "fewer than 2 jitter runs succeeded; the model's noise cannot be measured",
         ));
     }
-    let nominal = prep(nominal)?;
-    let noise = SimulationNoise::from_runs(&nominal, &runs)?;
-    let deviations = runs
+    let shifts = used
         .iter()
-        .map(|r| {
-            r.data()
-                .iter()
-                .zip(nominal.data())
-                .map(|(a, b)| a - b)
-                .collect()
-        })
+        .map(|&i| pts[i].iter().zip(point).map(|(a, b)| a - b).collect())
         .collect();
-    Ok((noise.spread.concat(), ModelNoise { deviations, shifts }))
+    let nominal = nominal.select(labels)?;
+    let nominal = match cfc {
+        Some(c) => nominal.filtered(c)?,
+        None => nominal,
+    };
+    let draws = ModelNoise {
+        runs,
+        used,
+        shifts,
+        nominal: nominal.clone(),
+        labels: labels.to_vec(),
+        cfc,
+    };
+    let noise = SimulationNoise::from_run_reader(&nominal, draws.len(), &mut |j| draws.run(j))?;
+    Ok((noise.spread.concat(), draws))
 }
 
 /// The whitened frame of a test and its noise floor.

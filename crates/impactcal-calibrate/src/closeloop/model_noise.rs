@@ -28,143 +28,177 @@
 //! `v_i` and `a_j` vanish and nothing changes; on a crash model they are what keeps the loop
 //! from adding a quantity whose change the model's own noise can produce.
 
-use super::detection::detect;
+use impactcal_core::{Cfc, Histories};
+
+use super::detection::chi2_red;
 use super::fit::Fit;
-use super::linalg::{Lsq, dot};
 use super::nuisance::{self, Frame};
 use crate::error::Result;
+use crate::study::execute::Outcomes;
 
-/// The jitter ensemble's draws of the model's own noise.
-#[derive(Debug, Clone, Default)]
+/// The jitter ensemble's draws of the model's own noise, read from the ensemble's runs one
+/// at a time whenever a statistic of them is asked for (nothing of the `m` runs is held).
+#[derive(Debug, Clone)]
 pub(crate) struct ModelNoise {
-    /// Each jittered run's response minus the nominal run's (the loop's channels, filtered
-    /// like the test), `S x T`.
-    pub deviations: Vec<Vec<f64>>,
-    /// Each jittered run's parameter change from the nominal point (declared space).
+    /// The ensemble's runs.
+    pub runs: Outcomes,
+    /// The runs that succeeded, in order: draw `j` is run `used[j]`.
+    pub used: Vec<usize>,
+    /// Each draw's parameter change from the nominal point (declared space).
     pub shifts: Vec<Vec<f64>>,
+    /// The nominal run on the loop's channels, filtered like the test, `S x T`.
+    pub nominal: Histories,
+    /// The loop's channels.
+    pub labels: Vec<String>,
+    /// The loop's filter.
+    pub cfc: Option<Cfc>,
 }
 
 impl ModelNoise {
-    /// The draws whitened under the nuisance terms of `fit`: `w (N(y + d_j) - N(y))`.
-    pub fn whitened(&self, fit: &Fit, frame: &Frame) -> Vec<Vec<f64>> {
-        let base = nuisance::apply(&fit.y, frame, &fit.terms);
-        self.deviations
-            .iter()
-            .map(|d| {
-                let y: Vec<f64> = fit.y.iter().zip(d).map(|(a, b)| a + b).collect();
-                nuisance::apply(&y, frame, &fit.terms)
-                    .iter()
-                    .zip(&base)
-                    .zip(&frame.weights)
-                    .map(|((a, b), w)| w * (a - b))
-                    .collect()
-            })
-            .collect()
+    /// Number of draws.
+    pub fn len(&self) -> usize {
+        self.used.len()
     }
 
-    /// The draws whitened under the nuisance terms of `fit`, with the least-squares solver
-    /// of its Jacobian that every statistic of them needs: built once per fit.
+    /// Run `j` of the draws on the loop's channels, filtered like the test.
     ///
     /// # Errors
-    /// When the Jacobian's SVD fails.
-    pub fn draws(&self, fit: &Fit, frame: &Frame) -> Result<Draws<'_>> {
-        Ok(Draws {
-            shifts: &self.shifts,
-            lsq: Lsq::new(&fit.jac)?,
-            whitened: self.whitened(fit, frame),
+    /// A result file that no longer reads; filter errors.
+    pub fn run(&self, j: usize) -> Result<Histories> {
+        let h = self
+            .runs
+            .histories(self.used[j], "a jitter run")?
+            .select(&self.labels)?;
+        Ok(match self.cfc {
+            Some(c) => h.filtered(c)?,
+            None => h,
         })
     }
-}
 
-/// The model's noise draws whitened under one fit ([`ModelNoise::draws`]), and that fit's
-/// least-squares solver.
-pub(crate) struct Draws<'a> {
-    shifts: &'a [Vec<f64>],
-    lsq: Lsq,
-    whitened: Vec<Vec<f64>>,
-}
-
-impl Draws<'_> {
-    /// The least-squares solver of the fit's Jacobian.
-    pub fn lsq(&self) -> &Lsq {
-        &self.lsq
+    /// Draw `j` as a response change, `y_j - y_0`, `S x T`.
+    fn deviation(&self, j: usize) -> Result<Vec<f64>> {
+        let r = self.run(j)?;
+        Ok(r.data()
+            .iter()
+            .zip(self.nominal.data())
+            .map(|(a, b)| a - b)
+            .collect())
     }
 
+    /// One pass over the draws, each whitened under the nuisance terms of `fit`,
+    /// `w (N(y + d_j) - N(y))`, regressed on its Jacobian: per draw, the energy outside the
+    /// fitted span, the dense coefficients `J^+ d_j`, with `chi2 = Some(p)` the reduced
+    /// chi-square of the unfitted part taken as a residual with `p` fitted quantities, and
+    /// with `products` the inner products it returns for the whitened draw and its
+    /// coefficients on the Jacobian's dense basis (`U_a^T d_j`).
+    ///
+    /// # Errors
+    /// [`ModelNoise::run`]'s errors.
+    pub fn stats(
+        &self,
+        fit: &Fit,
+        frame: &Frame,
+        chi2: Option<usize>,
+        products: Option<&Products<'_>>,
+    ) -> Result<DrawStats> {
+        let base = nuisance::apply(&fit.y, frame, &fit.terms);
+        let mut out = DrawStats {
+            shifts: self.shifts.clone(),
+            ..DrawStats::default()
+        };
+        for j in 0..self.len() {
+            let d = self.deviation(j)?;
+            let y: Vec<f64> = fit.y.iter().zip(&d).map(|(a, b)| a + b).collect();
+            drop(d);
+            let dw: Vec<f64> = nuisance::apply(&y, frame, &fit.terms)
+                .iter()
+                .zip(&base)
+                .zip(&frame.weights)
+                .map(|((a, b), w)| w * (a - b))
+                .collect();
+            let u = fit.jac.unfitted(&dw);
+            out.unfitted.push(u.iter().map(|v| v * v).sum());
+            out.solved.push(fit.jac.solve(&dw));
+            if let Some(p) = chi2 {
+                out.chi2.push(chi2_red(&u, frame.samples, p).0);
+            }
+            if let Some(f) = products {
+                out.products.push(f(&dw, &fit.jac.coefficients(&dw)));
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The inner products a pass over the draws takes of each whitened draw, given the draw and
+/// its coefficients on the Jacobian's dense basis.
+pub(crate) type Products<'a> = dyn Fn(&[f64], &[f64]) -> Vec<f64> + 'a;
+
+/// What one pass over the draws gives ([`ModelNoise::stats`]); every statistic is 0 without
+/// draws.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct DrawStats {
+    shifts: Vec<Vec<f64>>,
+    /// `||(I - P_J) d_j||^2` per draw.
+    unfitted: Vec<f64>,
+    /// `J^+ d_j` per draw (the dense coefficients).
+    solved: Vec<Vec<f64>>,
+    /// The reduced chi-square of each draw's unfitted part (when asked).
+    chi2: Vec<f64>,
+    /// The inner products asked for, per draw.
+    products: Vec<Vec<f64>>,
+}
+
+impl DrawStats {
     /// The largest whitened draw outside the span of the fit's Jacobian,
     /// `max_j ||(I - P_J) d_j||`: how far the model's response moves by itself under a
-    /// jitter, in a way re-tuning cannot undo; 0 without draws.
+    /// jitter, in a way re-tuning cannot undo.
     pub fn largest(&self) -> f64 {
-        self.whitened
-            .iter()
-            .map(|d| unfitted(&self.lsq, d).sqrt())
-            .fold(0.0, f64::max)
+        self.unfitted.iter().map(|e| e.sqrt()).fold(0.0, f64::max)
     }
 
     /// The variance the model's noise adds to each of the first `p` parameters of the fit
-    /// (`v_i` of the module docs); zeros without draws.
+    /// (`v_i` of the module docs).
     pub fn parameter_variances(&self, p: usize) -> Vec<f64> {
         let mut var = vec![0.0; p];
-        if self.whitened.is_empty() {
+        if self.solved.is_empty() {
             return var;
         }
-        for (d, s) in self.whitened.iter().zip(self.shifts) {
-            let x = self.lsq.solve(d);
+        for (x, s) in self.solved.iter().zip(&self.shifts) {
             for (i, v) in var.iter_mut().enumerate() {
                 let given = s.get(i).copied().unwrap_or(0.0);
                 *v += (x[i] - given).powi(2);
             }
         }
-        let m = self.whitened.len() as f64;
+        let m = self.solved.len() as f64;
         var.into_iter().map(|v| v / m).collect()
     }
 
-    /// The largest reduced chi-square of the draws taken as residuals of the fit: each
-    /// whitened draw with its projection on the fit's Jacobian removed, scored by `detect`
-    /// (the frame's labels and samples, fitted quantities `p`, noise correlation `lag1`,
-    /// level `alpha`); 0 without draws.
-    ///
-    /// # Errors
-    /// When `detect` fails.
-    pub fn largest_chi2(&self, frame: &Frame, p: usize, lag1: f64, alpha: f64) -> Result<f64> {
-        let mut worst: f64 = 0.0;
-        for d in &self.whitened {
-            let fitted = self.lsq.project(d);
-            let r: Vec<f64> = d.iter().zip(&fitted).map(|(a, b)| a - b).collect();
-            let det = detect(&frame.labels, &r, frame.samples, p, lag1, alpha)?;
-            worst = worst.max(det.chi2_red);
-        }
-        Ok(worst)
+    /// The largest reduced chi-square of the draws taken as residuals of the fit (each
+    /// with its projection on the fit's Jacobian removed; `chi2` asked in the pass).
+    pub fn largest_chi2(&self) -> f64 {
+        self.chi2.iter().copied().fold(0.0, f64::max)
     }
 
-    /// The mean of `||(I - P) d_j||^2` over the draws (0 without draws).
+    /// The mean of `||(I - P) d_j||^2` over the draws.
     pub fn unfitted_energy(&self) -> f64 {
-        if self.whitened.is_empty() {
+        if self.unfitted.is_empty() {
             return 0.0;
         }
-        self.whitened
-            .iter()
-            .map(|d| unfitted(&self.lsq, d))
-            .sum::<f64>()
-            / self.whitened.len() as f64
+        self.unfitted.iter().sum::<f64>() / self.unfitted.len() as f64
     }
 
-    /// The variance of the amplitude the draws attribute to the direction `gt` (orthogonal
-    /// to the fitted Jacobian): `sum_j (<gt, d_j> / <gt, gt>)^2 / m`.
-    pub fn amplitude_variance(&self, gt: &[f64]) -> f64 {
-        let gg = dot(gt, gt);
-        if self.whitened.is_empty() || gg <= 0.0 {
+    /// The variance of the amplitude the draws attribute to direction `k` of the products
+    /// asked in the pass, `g~` (orthogonal to the fitted Jacobian, `<g~, g~> = gg`):
+    /// `sum_j (<g~, d_j> / gg)^2 / m`.
+    pub fn amplitude_variance(&self, k: usize, gg: f64) -> f64 {
+        if self.products.is_empty() || gg <= 0.0 {
             return 0.0;
         }
-        self.whitened
+        self.products
             .iter()
-            .map(|d| (dot(gt, d) / gg).powi(2))
+            .map(|p| (p[k] / gg).powi(2))
             .sum::<f64>()
-            / self.whitened.len() as f64
+            / self.products.len() as f64
     }
-}
-
-/// `||(I - P) d||^2` for the projector `P` of `lsq`.
-fn unfitted(lsq: &Lsq, d: &[f64]) -> f64 {
-    let fitted = lsq.project(d);
-    d.iter().zip(&fitted).map(|(a, b)| (a - b).powi(2)).sum()
 }

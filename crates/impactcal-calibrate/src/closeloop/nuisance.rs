@@ -270,10 +270,17 @@ pub(crate) fn residual(y: &[f64], frame: &Frame, terms: &Terms) -> Vec<f64> {
         .collect()
 }
 
-/// The whitened derivative columns of the nuisance terms at `y`: `tau` (`-g_s y'_s(t -
-/// tau)`), then each channel's gain (`y_s(t - tau)` on that channel; left out when `gains`
-/// is false, the gains being known) and bias (1 on that channel).
-pub(crate) fn columns(y: &[f64], frame: &Frame, terms: &Terms, gains: bool) -> Vec<Vec<f64>> {
+/// The whitened derivative columns of the nuisance terms at `y`, in the form
+/// [`Jacobian::new`](super::jacobian::Jacobian::new) takes them: the dense `tau` column
+/// (`-g_s y'_s(t - tau)`), and the per-channel columns, each channel's bias (1 on that
+/// channel) and gain (`y_s(t - tau)` on that channel; left out when `gains` is false, the
+/// gains being known), whitened; every vector `S x T`.
+pub(crate) fn columns(
+    y: &[f64],
+    frame: &Frame,
+    terms: &Terms,
+    gains: bool,
+) -> (Vec<f64>, Vec<Vec<f64>>) {
     let t = frame.samples;
     let n = y.len();
     let ys = shifted(y, frame, terms.tau);
@@ -286,21 +293,11 @@ pub(crate) fn columns(y: &[f64], frame: &Frame, terms: &Terms, gains: bool) -> V
             tau_col[s * t + k] = -terms.gains[s] * dy * frame.weights[s * t + k];
         }
     }
-    let mut cols = vec![tau_col];
-    for s in 0..frame.labels.len() {
-        let mut g = vec![0.0; n];
-        let mut b = vec![0.0; n];
-        for k in 0..t {
-            let i = s * t + k;
-            g[i] = ys[i] * frame.weights[i];
-            b[i] = frame.weights[i];
-        }
-        if gains {
-            cols.push(g);
-        }
-        cols.push(b);
+    let mut local = vec![frame.weights.clone()];
+    if gains {
+        local.push(ys.iter().zip(&frame.weights).map(|(v, w)| v * w).collect());
     }
-    cols
+    (tau_col, local)
 }
 
 #[cfg(test)]

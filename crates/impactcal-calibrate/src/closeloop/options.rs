@@ -50,6 +50,13 @@ pub struct LoopOptions {
     /// Members of each model's predictive ensemble for M1 (default 199; no runs: see
     /// `closeloop::agreement`).
     pub m1_members: usize,
+    /// Memory the loop's process may use, in bytes; `None`: what the machine has available
+    /// (`crate::memory`). A stage whose estimate does not fit stops the loop with a
+    /// [`CalibrateError::Memory`] before it allocates. Not read from a loop file nor part of
+    /// the loop's fingerprint (`impactcal close-loop --max-memory` sets it): a loop resumed
+    /// with another limit reuses its journal.
+    #[serde(skip)]
+    pub max_memory: Option<u64>,
 }
 
 impl Default for LoopOptions {
@@ -73,6 +80,7 @@ impl Default for LoopOptions {
             candidates: None,
             m1_members: 199,
             fit_gains: true,
+            max_memory: None,
         }
     }
 }

@@ -111,12 +111,10 @@ pub(crate) fn forward<M: Enrichable>(
     let detect_fit = |fit: &Fit| -> Result<Detection> {
         let p = fit.point.len() + n_nuisance;
         let d = detect(&labels, &fit.residual, t, p, noise_lag1, options.alpha)?;
-        let floor = ctx.model_noise.draws(fit, &ctx.frame)?.largest_chi2(
-            &ctx.frame,
-            p,
-            noise_lag1,
-            options.alpha,
-        )?;
+        let floor = ctx
+            .model_noise
+            .stats(fit, &ctx.frame, Some(p), None)?
+            .largest_chi2();
         Ok(d.with_model_noise(floor))
     };
     let z2 = chi2_quantile(1.0, options.alpha)?;
@@ -237,7 +235,7 @@ pub(crate) fn forward<M: Enrichable>(
         let realised = 1.0 - fit_n.rss / base_rss;
         let last = fit_n.point.len() - 1;
         let value = fit_n.point[last];
-        let draws = ctx.model_noise.draws(&fit_n, &ctx.frame)?;
+        let draws = ctx.model_noise.stats(&fit_n, &ctx.frame, None, None)?;
         let noise_var = draws.parameter_variances(fit_n.point.len())[last];
         let sd = (fit_n.se[last].powi(2) * inflation + noise_var).sqrt();
         let change = (value - p.nominal).abs() * best.response_per_unit;

@@ -11,14 +11,14 @@
 //! the job array's name and id before and after `sbatch`) and each result after it is read;
 //! the study always works with the histories as read back from `result.csv` (our CSV
 //! writes the shortest text that reads back as the same number), so a resumed study uses
-//! the same bits as an uninterrupted one.
+//! the same bits as an uninterrupted one. A stage's histories are not held in memory: each
+//! stage reads from its runs' result files what it uses, one run at a time ([`Outcomes`]).
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 use impactcal_core::{CoreError, Histories, Model, ParameterSpace};
 use impactcal_runner::{
-    Batch, Cancel, Hooks, OutputSpec, RunnerError, Solver, SolverCommand, run_batch_with,
+    Batch, Cancel, Hooks, OutputSpec, RunResult, RunnerError, Solver, SolverCommand, run_batch_with,
 };
 
 use crate::error::{CalibrateError, Result};
@@ -251,12 +251,13 @@ impl<'a> Runs<'a> {
 
     /// The outcomes of `points` as stage `stage`: runs the journal holds as finished are
     /// read back, the others run through the executor, each journaled before it starts and
-    /// after its result is read. Outcomes in input order.
+    /// after its result is read. Outcomes in input order; each run's histories stay in its
+    /// result file until asked for ([`Outcomes::get`]).
     ///
     /// # Errors
     /// [`CalibrateError::Runner`] when the stage's journal cannot be written or belongs to
     /// another study, the executor cannot run the solver, or the runs were cancelled.
-    pub fn stage(&self, stage: &str, points: &[Vec<f64>]) -> Result<Vec<RunOutcome>> {
+    pub fn stage(&self, stage: &str, points: &[Vec<f64>]) -> Result<Outcomes> {
         self.stage_from(stage, 0, points, true)
     }
 
@@ -272,12 +273,12 @@ impl<'a> Runs<'a> {
         first: usize,
         points: &[Vec<f64>],
         announce: bool,
-    ) -> Result<Vec<RunOutcome>> {
+    ) -> Result<Outcomes> {
         if points.is_empty() {
             if announce {
                 self.observer.stage(stage, 0, 0);
             }
-            return Ok(Vec::new());
+            return Ok(Outcomes { runs: Vec::new() });
         }
         let name = batch_name(stage, first, announce);
         let space = self.executor.space();
@@ -291,17 +292,13 @@ impl<'a> Runs<'a> {
         )?
         .with_retries(self.executor.retries())
         .with_identity(self.fingerprint.clone());
-        let outcomes: Mutex<Vec<Option<RunOutcome>>> = Mutex::new(vec![None; points.len()]);
         let opened = |reused: usize| {
             if announce {
                 self.observer.stage(stage, points.len(), reused);
             }
         };
-        let finished = |i: usize, o: std::result::Result<Histories, &RunnerError>| {
-            let o = o.map_err(failure_message);
-            if let Ok(mut all) = outcomes.lock() {
-                all[i] = Some(o);
-            }
+        // Each run's histories are dropped as it finishes: they stay in its result file.
+        let finished = |_: usize, _: std::result::Result<Histories, &RunnerError>| {
             self.observer.run_finished();
         };
         let hooks = Hooks {
@@ -309,24 +306,67 @@ impl<'a> Runs<'a> {
             opened: Some(&opened),
             finished: Some(&finished),
         };
-        run_batch_with(
+        let report = run_batch_with(
             &batch,
             &self.executor.executor(),
             &self.executor.cancel(),
             hooks,
         )?;
-        let outcomes = outcomes
-            .into_inner()
-            .map_err(|_| CalibrateError::study(stage, "a run panicked"))?;
-        outcomes
-            .into_iter()
-            .enumerate()
-            .map(|(i, o)| {
-                o.ok_or_else(|| {
-                    CalibrateError::study(stage, format!("run {} never finished", first + i))
-                })
-            })
-            .collect()
+        Ok(Outcomes {
+            runs: report
+                .runs
+                .into_iter()
+                .map(|r| r.map_err(|e| failure_message(&e)))
+                .collect(),
+        })
+    }
+}
+
+/// The outcomes of one stage of runs, in input order: where each run's histories are, or
+/// why the run failed. Nothing is held in memory: [`get`](Self::get) reads a run's
+/// histories back from its result file (the same bits the run handed out), so that a stage
+/// of many runs is read one run at a time.
+#[derive(Debug, Clone, Default)]
+pub struct Outcomes {
+    runs: Vec<std::result::Result<RunResult, String>>,
+}
+
+impl Outcomes {
+    /// Number of runs.
+    pub fn len(&self) -> usize {
+        self.runs.len()
+    }
+
+    /// Whether the stage had no run.
+    pub fn is_empty(&self) -> bool {
+        self.runs.is_empty()
+    }
+
+    /// Whether run `index` succeeded (false for an index out of range).
+    pub fn succeeded(&self, index: usize) -> bool {
+        matches!(self.runs.get(index), Some(Ok(_)))
+    }
+
+    /// The outcome of run `index`: its histories read back from its result file, or the
+    /// failure's message. A result file that no longer reads (removed or edited since) and
+    /// an index out of range are failures too, with the reason.
+    pub fn get(&self, index: usize) -> RunOutcome {
+        match self.runs.get(index) {
+            Some(Ok(r)) => r.read().map_err(|e| e.to_string()),
+            Some(Err(m)) => Err(m.clone()),
+            None => Err(format!(
+                "no run {index} (the stage has {})",
+                self.runs.len()
+            )),
+        }
+    }
+
+    /// The histories of run `index`, or its failure as a simulation error naming `what`.
+    ///
+    /// # Errors
+    /// [`CalibrateError::Core`] with the failure's message.
+    pub fn histories(&self, index: usize, what: &str) -> Result<Histories> {
+        histories_of(self.get(index), what)
     }
 }
 
@@ -373,8 +413,6 @@ fn io(path: &Path, e: std::io::Error) -> CalibrateError {
 }
 
 /// The histories of a successful outcome, or the simulation error.
-pub(crate) fn histories_of(outcome: &RunOutcome, what: &str) -> Result<Histories> {
-    outcome
-        .clone()
-        .map_err(|m| CalibrateError::Core(CoreError::Simulation(format!("{what}: {m}").into())))
+pub(crate) fn histories_of(outcome: RunOutcome, what: &str) -> Result<Histories> {
+    outcome.map_err(|m| CalibrateError::Core(CoreError::Simulation(format!("{what}: {m}").into())))
 }

@@ -30,6 +30,7 @@ pub mod execute;
 pub mod m1;
 pub mod m2;
 pub mod options;
+pub mod plan;
 pub mod reconcile;
 pub mod result;
 pub mod sensitivity;
@@ -45,16 +46,19 @@ use impactcal_core::sampling::sample;
 use impactcal_core::{Cfc, ChannelMap, Histories, Model, SamplingMethod};
 
 use crate::error::{CalibrateError, Result};
+use crate::memory::Guard;
 use crate::metrics::{CurveMetrics, Iso18571};
 
 pub use execute::{Executor, InProcess, Observer, RunOutcome, Runner, Silent, Worker};
 pub use m1::{M1, Verdict};
 pub use options::{StudyOptions, ValidStudyOptions};
+pub use plan::{StudyShapes, estimated_peak};
 pub use result::StudyResult;
 pub use subspace::Subspace;
 
 use channels::{indices_of, q_of, relative_error, relative_l2, test_on_model};
-use execute::{Runs, histories_of};
+use execute::Runs;
+use plan::Plan;
 use result::{
     BeforeAfter, ChannelsSummary, Curves, EnsembleSummary, Errors, FailedRun, M2BeforeAfter,
     NoiseSummary, SensorErrors, SurrogateSummary,
@@ -141,27 +145,48 @@ pub fn run(
 
     // 1. Baseline, test on the model's channels, noise, objective channels.
     let nominal_point = space.nominal();
-    let nominal_raw = histories_of(
-        &runs.stage("nominal", std::slice::from_ref(&nominal_point))?[0],
-        "the nominal run",
-    )?;
+    let nominal_raw = runs
+        .stage("nominal", std::slice::from_ref(&nominal_point))?
+        .histories(0, "the nominal run")?;
     let baseline = prep(&nominal_raw)?;
     let test_m = test_on_model(test.histories, test.map, test.cfc, &nominal_raw)?;
+    // The memory plan, from the shapes the nominal run gives (every shared channel taken as
+    // an objective one), checked before any other stage.
+    let mut plan = Plan {
+        shapes: StudyShapes {
+            run_values: nominal_raw.channels() * nominal_raw.samples(),
+            samples: nominal_raw.samples(),
+            channels: test_m.channels(),
+            runs: options.ensemble,
+            shapes: options.shapes,
+            sensors: options.sensors,
+            parameters: space.dim(),
+            sobol_rows: options.sensitivity_samples,
+            threads: if executor.model().is_some() {
+                rayon::current_num_threads()
+            } else {
+                0
+            },
+        },
+        guard: Guard::new(options.max_memory),
+    };
+    plan.check_all()?;
+    observer.step(&plan.line());
     let jitter = JitterOptions::new(options.noise_runs, options.noise_eps, options.seed);
     let jitter_pts = jitter_points(&space, &nominal_point, &jitter)?;
-    let jitter_runs: Vec<Histories> = runs
-        .stage("noise", &jitter_pts)?
-        .iter()
-        .filter_map(|o| o.as_ref().ok())
-        .map(&prep)
-        .collect::<Result<_>>()?;
-    if jitter_runs.len() < 2 {
+    let noise_runs = runs.stage("noise", &jitter_pts)?;
+    let noise_ok: Vec<usize> = (0..noise_runs.len())
+        .filter(|&i| noise_runs.succeeded(i))
+        .collect();
+    if noise_ok.len() < 2 {
         return Err(CalibrateError::study(
             "noise",
             "fewer than 2 jitter runs succeeded; the model's noise cannot be measured",
         ));
     }
-    let noise = SimulationNoise::from_runs(&baseline, &jitter_runs)?;
+    let jitter_run = |j: usize| prep(&noise_runs.histories(noise_ok[j], "a jitter run")?);
+    let noise =
+        SimulationNoise::from_run_reader(&baseline, noise_ok.len(), &mut |j| jitter_run(j))?;
     let window_end = baseline.start() + (baseline.samples() - 1) as f64 * baseline.dt();
     let shared: Vec<String> = test_m.labels().to_vec();
     let predictable: Vec<String> = noise
@@ -199,7 +224,7 @@ pub fn run(
         sensors::check_count(options.sensors, objective.len())?;
     }
     let noise_idx: Vec<usize> = objective.iter().filter_map(|l| noise.index_of(l)).collect();
-    let q_noise = q_spread(&baseline, &jitter_runs, &objective)?;
+    let q_noise = q_spread(&baseline, noise_ok.len(), &jitter_run, &objective)?;
 
     // 2. The ensemble.
     let design = sample(
@@ -213,22 +238,27 @@ pub fn run(
         .collect();
     let outcomes = runs.stage("ensemble", &points)?;
     let mut failed = Vec::new();
-    let mut ok_points = Vec::new();
-    let mut ok_runs = Vec::new();
-    for (i, o) in outcomes.iter().enumerate() {
-        match o {
-            Ok(h) => {
-                ok_points.push(points[i].clone());
-                ok_runs.push(prep(h)?.select(&objective)?);
-            }
+    let mut ok = Vec::new();
+    for (i, point) in points.iter().enumerate() {
+        match outcomes.get(i) {
+            Ok(_) => ok.push(i),
             Err(message) => failed.push(FailedRun {
                 index: i,
-                point: points[i].clone(),
-                message: message.clone(),
+                point: point.clone(),
+                message,
             }),
         }
     }
-    if ok_runs.is_empty() {
+    let ok_points: Vec<Vec<f64>> = ok.iter().map(|&i| points[i].clone()).collect();
+    // The successful runs on the objective channels, filtered like the test, read one at
+    // a time from their result files by each stage that uses them.
+    let ensemble_run = |k: usize| -> Result<Histories> {
+        let h = outcomes
+            .histories(ok[k], "an ensemble run")?
+            .select(&objective)?;
+        prep(&h)
+    };
+    if ok.is_empty() {
         return Err(CalibrateError::study(
             "ensemble",
             format!(
@@ -240,7 +270,7 @@ pub fn run(
     }
     let ensemble = EnsembleSummary {
         requested: points.len(),
-        succeeded: ok_runs.len(),
+        succeeded: ok.len(),
         failed,
         points: points.clone(),
     };
@@ -251,7 +281,9 @@ pub fn run(
     let test_obj = test_m.select(&objective)?;
     let base_obj = baseline.select(&objective)?;
     let all: Vec<usize> = (0..objective.len()).collect();
-    let q_runs: Vec<Vec<f64>> = ok_runs.iter().map(|h| q_of(h, &all)).collect();
+    let q_runs: Vec<Vec<f64>> = (0..ok.len())
+        .map(|k| Ok(q_of(&ensemble_run(k)?, &all)))
+        .collect::<Result<_>>()?;
     let q_test = q_of(&test_obj, &all);
     let q_baseline = q_of(&base_obj, &all);
     let m1 = m1::m1(&time, &q_runs, &q_test)?;
@@ -273,7 +305,7 @@ pub fn run(
             kept_unpredictable: options.keep_unpredictable,
         },
         noise: NoiseSummary {
-            runs: jitter_runs.len(),
+            runs: noise_ok.len(),
             eps: options.noise_eps,
             fraction: options.noise_fraction,
             relative_spread: noise.relative_spread(window_end, &noise_idx),
@@ -305,9 +337,13 @@ pub fn run(
     }
 
     // 4. Sensors and 5. M2 of the baseline.
+    plan.shapes.channels = objective.len();
+    plan.shapes.runs = ok.len();
+    plan.check(plan::PLACEMENT, plan::PLACEMENT)?;
     observer.step("sensor placement");
     let sensors = sensors::place_sensors(
-        &ok_runs,
+        &ensemble_run,
+        ok.len(),
         &objective,
         options.sensors,
         options.shapes,
@@ -321,13 +357,13 @@ pub fn run(
     let m2_baseline = m2::m2(&base_obj, &test_obj, &objective, options.shapes)?;
 
     // 6. Surrogates and 7. sensitivity.
+    plan.check(plan::SURROGATES, plan::SURROGATES)?;
     observer.step("surrogates");
     let x = Mat::from_fn(ok_points.len(), space.dim(), |i, j| ok_points[i][j]);
     let q_mat = Mat::from_fn(q_runs.len(), time.len(), |i, k| q_runs[i][k]);
-    let at_sensors: Vec<Vec<f64>> = ok_runs
-        .iter()
-        .map(|h| h.select(&selected).map(|s| s.data().to_vec()))
-        .collect::<impactcal_core::Result<_>>()?;
+    let at_sensors: Vec<Vec<f64>> = (0..ok.len())
+        .map(|k| Ok(ensemble_run(k)?.select(&selected)?.data().to_vec()))
+        .collect::<Result<_>>()?;
     let width = at_sensors.first().map_or(0, Vec::len);
     let s_mat = Mat::from_fn(at_sensors.len(), width, |i, k| at_sensors[i][k]);
     let (q_choice, q_fit) = surrogates::choose(&space, x.as_ref(), q_mat.as_ref())?;
@@ -337,6 +373,7 @@ pub fn run(
         q: q_choice,
         sensors: s_choice,
     });
+    plan.check(plan::SENSITIVITY, plan::SENSITIVITY)?;
     observer.step("sensitivity");
     result.sensitivity = Some(sensitivity::sensitivity(
         &space,
@@ -376,15 +413,22 @@ pub fn run(
     }
     // The baseline is a run of the model too: the optimiser starts from it and the
     // ensemble, so the calibrated model is never worse than the baseline.
-    let mut start: Vec<(Vec<f64>, RunOutcome)> =
-        vec![(nominal_point.clone(), Ok(nominal_raw.clone()))];
-    start.extend(points.iter().cloned().zip(outcomes));
+    let mut start = vec![nominal_point.clone()];
+    start.extend(points.iter().cloned());
+    let start_outcome = |k: usize| -> RunOutcome {
+        if k == 0 {
+            Ok(nominal_raw.clone())
+        } else {
+            outcomes.get(k - 1)
+        }
+    };
     observer.stage("reconcile", options.reconcile_runs, 0);
     let mut run_batch =
         |first: usize, pts: &[Vec<f64>]| runs.stage_from("reconcile", first, pts, false);
     let best = reconcile::reconcile(
         &space,
         &start,
+        &start_outcome,
         options.reconcile_runs,
         options.reconcile_batch,
         options.seed,
@@ -420,12 +464,20 @@ pub fn run(
 }
 
 /// Relative jitter spread of `Q(t)` over the objective channels: the RMS over time of the
-/// standard deviation of Q over the jitter runs, over the RMS of the nominal Q.
-fn q_spread(nominal: &Histories, jitter: &[Histories], labels: &[String]) -> Result<f64> {
+/// standard deviation of Q over the `count` jitter runs `jitter(j)`, over the RMS of the
+/// nominal Q.
+fn q_spread(
+    nominal: &Histories,
+    count: usize,
+    jitter: &dyn Fn(usize) -> Result<Histories>,
+    labels: &[String],
+) -> Result<f64> {
     let q0 = q_of(nominal, &indices_of(nominal, labels)?);
-    let qs: Vec<Vec<f64>> = jitter
-        .iter()
-        .map(|h| indices_of(h, labels).map(|i| q_of(h, &i)))
+    let qs: Vec<Vec<f64>> = (0..count)
+        .map(|j| {
+            let h = jitter(j)?;
+            indices_of(&h, labels).map(|i| q_of(&h, &i))
+        })
         .collect::<Result<_>>()?;
     let j = qs.len() as f64;
     let (mut num, mut den) = (0.0, 0.0);

@@ -36,6 +36,13 @@ pub struct StudyOptions {
     pub keep_unpredictable: bool,
     /// Stop after M1 (the screening of a first parameter set).
     pub screen_only: bool,
+    /// Memory the study's process may use, in bytes; `None`: what the machine has
+    /// available (`crate::memory`). A stage whose estimate does not fit stops the study
+    /// with a [`crate::CalibrateError::Memory`] before it allocates. Not read from a study
+    /// file nor part of the study's fingerprint or result (`impactcal study --max-memory`
+    /// sets it).
+    #[serde(skip)]
+    pub max_memory: Option<u64>,
 }
 
 impl Default for StudyOptions {
@@ -53,6 +60,7 @@ impl Default for StudyOptions {
             noise_fraction: 0.05,
             keep_unpredictable: false,
             screen_only: false,
+            max_memory: None,
         }
     }
 }

@@ -7,11 +7,11 @@ use impactcal_core::{Histories, ParameterSpace};
 use impactcal_cors::{Cors, CorsOptions, Transform};
 use serde::{Deserialize, Serialize};
 
-use super::execute::RunOutcome;
+use super::execute::{Outcomes, RunOutcome};
 use crate::error::Result;
 
 /// Runs a batch of points as runs `first..first + points.len()` of the reconciliation.
-pub type RunBatch<'a> = dyn FnMut(usize, &[Vec<f64>]) -> Result<Vec<RunOutcome>> + 'a;
+pub type RunBatch<'a> = dyn FnMut(usize, &[Vec<f64>]) -> Result<Outcomes> + 'a;
 
 /// The outcome of the reconciliation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -44,17 +44,19 @@ pub struct Best {
     pub histories: Histories,
 }
 
-/// Runs CORS-RBF: warm start from `start` (the baseline first, then the ensemble: points
-/// with their histories, failures as `Err`), then `budget` new runs in batches of `batch` through `run(first_index, points)`,
-/// each scored by `error` (the relative prediction error, positive); the surrogate fits
-/// `ln(error)`.
+/// Runs CORS-RBF: warm start from the points `start` (the baseline first, then the
+/// ensemble), whose outcomes `start_outcome(i)` reads (histories, or a failure as `Err`),
+/// then `budget` new runs in batches of `batch` through `run(first_index, points)`, each
+/// scored by `error` (the relative prediction error, positive); the surrogate fits
+/// `ln(error)`. One run's histories are held at a time, and the best run's.
 ///
 /// # Errors
 /// CORS errors; whatever `run` or `error` returns.
 #[allow(clippy::too_many_arguments)]
 pub fn reconcile(
     space: &ParameterSpace,
-    start: &[(Vec<f64>, RunOutcome)],
+    start: &[Vec<f64>],
+    start_outcome: &dyn Fn(usize) -> RunOutcome,
     budget: usize,
     batch: usize,
     seed: u64,
@@ -75,25 +77,31 @@ pub fn reconcile(
         ..CorsOptions::with_seed(seed)
     };
     let mut cors = Cors::new(space.clone(), options)?;
-    let mut evaluated: Vec<(Vec<f64>, Option<Histories>, f64, String)> = Vec::new();
-    let mut warm_points = Vec::new();
+    // The best successful run so far: the first of the smallest errors.
+    let mut best: Option<(Vec<f64>, Histories, f64, String)> = None;
+    let mut consider = |point: &[f64], h: Histories, v: f64, from: String| {
+        if v.is_finite() && best.as_ref().is_none_or(|b| v < b.2) {
+            best = Some((point.to_vec(), h, v, from));
+        }
+    };
     let mut warm_values = Vec::new();
-    for (k, (p, o)) in start.iter().enumerate() {
-        let v = match o {
-            Ok(h) => error(h)?,
-            Err(_) => f64::NAN,
-        };
-        let v = positive(v);
-        warm_points.push(p.clone());
-        warm_values.push(v);
+    for (k, p) in start.iter().enumerate() {
         let from = if k == 0 {
             "baseline".to_string()
         } else {
             format!("ensemble run {}", k - 1)
         };
-        evaluated.push((p.clone(), o.clone().ok(), v, from));
+        let v = match start_outcome(k) {
+            Ok(h) => {
+                let v = positive(error(&h)?);
+                consider(p, h, v, from);
+                v
+            }
+            Err(_) => f64::NAN,
+        };
+        warm_values.push(v);
     }
-    cors.warm_start_rows(&warm_points, &warm_values)?;
+    cors.warm_start_rows(start, &warm_values)?;
     let mut errors = Vec::new();
     let mut failed = Vec::new();
     while errors.len() < budget {
@@ -104,25 +112,24 @@ pub fn reconcile(
         }
         let points: Vec<Vec<f64>> = suggestions.iter().map(|s| s.x.clone()).collect();
         let outcomes = run(errors.len(), &points)?;
-        for (s, o) in suggestions.iter().zip(outcomes) {
+        for (i, s) in suggestions.iter().enumerate() {
             let k = errors.len();
-            let v = match &o {
-                Ok(h) => positive(error(h)?),
+            let v = match outcomes.get(i) {
+                Ok(h) => {
+                    let v = positive(error(&h)?);
+                    consider(&s.x, h, v, format!("reconcile run {k}"));
+                    v
+                }
                 Err(m) => {
-                    failed.push((k, m.clone()));
+                    failed.push((k, m));
                     f64::NAN
                 }
             };
             cors.tell(s.id, v)?;
             errors.push(v);
-            evaluated.push((s.x.clone(), o.ok(), v, format!("reconcile run {k}")));
         }
     }
-    let best = evaluated
-        .iter()
-        .filter(|e| e.1.is_some() && e.2.is_finite())
-        .min_by(|a, b| a.2.total_cmp(&b.2));
-    let Some((point, Some(histories), best_error, from)) = best.cloned() else {
+    let Some((point, histories, best_error, from)) = best else {
         return Err(crate::error::CalibrateError::study(
             "reconciliation",
             "no run succeeded",

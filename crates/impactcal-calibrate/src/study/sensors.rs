@@ -1,8 +1,9 @@
 //! Sensor placement on the ensemble's impact shapes, and the test expanded from the sensors
 //! to every channel through the baseline's shapes (the paper's Eq. 4.8).
 
+use faer::Mat;
 use impactcal_core::Histories;
-use impactcal_sensors::{PlacementOptions, place_from_histories};
+use impactcal_sensors::{CandidateShapes, PlacementOptions, place};
 use impactcal_shapes::{Expansion, ImpactShapes, ShapeOptions};
 use serde::{Deserialize, Serialize};
 
@@ -46,14 +47,19 @@ pub fn check_count(count: usize, candidates: usize) -> Result<()> {
     Ok(())
 }
 
-/// Places `count` sensors on the impact shapes (`shapes` of them) of the ensemble `runs`,
-/// restricted to `candidates`, and expands the test at the sensors to the other candidates
-/// through the `baseline` run's shapes.
+/// Places `count` sensors on the impact shapes (`shapes` of them) of an ensemble of `runs`
+/// runs restricted to `candidates`, and expands the test at the sensors to the other
+/// candidates through the `baseline` run's shapes. `read(j)` gives run `j` on the
+/// candidates' channels (in their order): the runs are read one at a time into the one
+/// matrix the shapes need, `candidates x (runs samples)`, run after run in time (the
+/// source paper's concatenated ensemble).
 ///
 /// # Errors
-/// [`CalibrateError::Study`] for more sensors than candidates; placement and shape errors.
+/// [`CalibrateError::Study`] for more sensors than candidates or no run; a run that does not
+/// have the candidates' channels and samples; placement and shape errors; `read`'s errors.
 pub fn place_sensors(
-    runs: &[Histories],
+    read: &dyn Fn(usize) -> Result<Histories>,
+    runs: usize,
     candidates: &[String],
     count: usize,
     shapes: usize,
@@ -61,16 +67,38 @@ pub fn place_sensors(
     test: &Histories,
 ) -> Result<SensorsResult> {
     check_count(count, candidates.len())?;
-    let restricted: Vec<Histories> = runs
-        .iter()
-        .map(|h| h.select(candidates))
-        .collect::<impactcal_core::Result<_>>()?;
-    let placed = place_from_histories(
-        &restricted,
-        &ShapeOptions::count(shapes),
+    if runs == 0 {
+        return Err(CalibrateError::study(
+            "sensor placement",
+            "no run to place on",
+        ));
+    }
+    let samples = baseline.samples();
+    let mut y = Mat::<f64>::zeros(candidates.len(), runs * samples);
+    for j in 0..runs {
+        let h = read(j)?.select(candidates)?;
+        if h.samples() != samples {
+            return Err(CalibrateError::study(
+                "sensor placement",
+                format!(
+                    "run {j} has {} samples, the baseline {samples}",
+                    h.samples()
+                ),
+            ));
+        }
+        for c in 0..candidates.len() {
+            for (k, v) in h.channel(c).iter().enumerate() {
+                y[(c, j * samples + k)] = *v;
+            }
+        }
+    }
+    let ensemble = ImpactShapes::from_matrix(y.as_ref(), &ShapeOptions::count(shapes))?;
+    drop(y);
+    let placement = place(
+        &CandidateShapes::new(candidates.to_vec(), ensemble.shapes())?,
         &PlacementOptions::new(count),
     )?;
-    let selected = placed.placement.selected.clone();
+    let selected = placement.selected.clone();
     let rest: Vec<String> = candidates
         .iter()
         .filter(|c| !selected.contains(c))
@@ -91,10 +119,10 @@ pub fn place_sensors(
     };
     Ok(SensorsResult {
         candidates: candidates.len(),
-        shapes: placed.shapes.len(),
+        shapes: ensemble.len(),
         selected,
-        determinant_ratio: placed.placement.determinant_ratio,
-        condition_number: placed.placement.condition_number,
+        determinant_ratio: placement.determinant_ratio,
+        condition_number: placement.condition_number,
         expansion_rel_error,
         expansion_condition,
     })
