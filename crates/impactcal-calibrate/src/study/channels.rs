@@ -5,7 +5,8 @@ use impactcal_core::{Cfc, ChannelMap, Histories};
 
 use crate::error::{CalibrateError, Result};
 
-/// The test as the study sees it: the channels it shares with the model (by label, or
+/// The test as the study sees it: converted by the map's conversions (bridges,
+/// accelerometers, units), the channels it shares with the model (by label, or
 /// through a channel map, the model channel scaled by the map's gain standing for the test
 /// channel), relabelled with the model's labels, filtered with the study's CFC class on its
 /// own time base, then interpolated onto the model's time points.
@@ -20,9 +21,13 @@ pub fn test_on_model(
     cfc: Option<Cfc>,
     model: &Histories,
 ) -> Result<Histories> {
-    let test = match cfc {
-        Some(c) => test.filtered(c)?,
+    let converted = match map {
+        Some(m) => m.convert(test)?,
         None => test.clone(),
+    };
+    let test = match cfc {
+        Some(c) => converted.filtered(c)?,
+        None => converted,
     };
     // (test label, model label, gain): model * gain ~ test.
     let pairs: Vec<(String, String, f64)> = match map {

@@ -235,8 +235,9 @@ pub fn spikes(x: &[f64], floor: f64) -> Vec<usize> {
 /// The baseline drift an acceleration record implies.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Drift {
-    /// Start of the tail (s) over which the drift is measured: the last quarter of the
-    /// record after the quiet part.
+    /// Start of the tail (s) over which the drift is measured: after the last sample whose
+    /// departure from the offset exceeds 2 % of the largest (the event's end), or the
+    /// last quarter of the record after the quiet part when that leaves under 16 samples.
     pub tail_start: f64,
     /// The velocity change over the tail that the record implies, offset removed: the
     /// least-squares slope of the velocity `v_k = sum_{i<=k} (a_i - offset) dt` over the
@@ -269,7 +270,19 @@ pub fn drift(
     if quiet >= n || (n - quiet) / 4 < 16 {
         return None;
     }
-    let first = n - (n - quiet) / 4;
+    let peak = x[quiet..]
+        .iter()
+        .map(|v| (v - offset).abs())
+        .fold(0.0, f64::max);
+    let end = (quiet..n)
+        .rev()
+        .find(|&k| (x[k] - offset).abs() > 0.02 * peak)
+        .unwrap_or(quiet);
+    let first = if n - end - 1 >= 16 {
+        end + 1
+    } else {
+        n - (n - quiet) / 4
+    };
     let m = n - first;
     let mut v = 0.0;
     let vel: Vec<f64> = x[first..]

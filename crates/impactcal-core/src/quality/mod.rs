@@ -245,8 +245,9 @@ fn channel(
             let lb = ljung_box(part, lags, 0)?;
             q.white = lb.p_value >= ALPHA;
             q.ljung_box = Some(lb);
-            q.noise_model = Some(ArModel::fit(part, ar::DEFAULT_MAX_ORDER)?);
-            q.lines = spectrum::lines(part, h.dt(), ALPHA);
+            let model = ArModel::fit(part, ar::DEFAULT_MAX_ORDER)?;
+            q.lines = spectrum::lines(part, h.dt(), ALPHA, Some(&model));
+            q.noise_model = Some(model);
         }
     } else if x.len() >= 3 {
         let d2: Vec<f64> = x.windows(3).map(|w| w[2] - 2.0 * w[1] + w[0]).collect();

@@ -80,10 +80,14 @@ pub struct Line {
 }
 
 /// Lines in the noise record `x` (sampled at `dt`): periodogram ordinates above
-/// `ln(m / alpha)` times the running median of their 15 neighbours (`m` ordinates tested),
-/// local maxima only, bins 2 and above (the lowest frequencies are the taper's and the
-/// trend's). Needs 64 samples; returns none below.
-pub fn lines(x: &[f64], dt: f64, alpha: f64) -> Vec<Line> {
+/// `ln(m / alpha)` times the background (`m` ordinates tested), local maxima only, bins 2
+/// and above (the lowest frequencies are the taper's and the trend's). The background is the
+/// density of the record's AR noise model `noise` where one is given (a coloured spectrum
+/// falls steeply and a running median would lag it), and the running median of the 32
+/// neighbours otherwise (over `ln 2`, the median of exponential ordinates). A line counts
+/// as mains when the frequency resolution `1 / (n dt)` is at most 12.5 Hz and it lies within
+/// a bin of a multiple of 50 or 60 Hz. Needs 64 samples; returns none below.
+pub fn lines(x: &[f64], dt: f64, alpha: f64, noise: Option<&ArModel>) -> Vec<Line> {
     let p = periodogram(x);
     let n = x.len().min(MAX_SPECTRUM_SAMPLES);
     if n < 64 || p.len() < 16 {
@@ -101,15 +105,20 @@ pub fn lines(x: &[f64], dt: f64, alpha: f64) -> Vec<Line> {
         if p[j] < p[j - 1] || p[j] < p[j + 1] {
             continue;
         }
-        let lo = j.saturating_sub(16);
-        let hi = (j + 16).min(p.len() - 1);
-        let mut nb: Vec<f64> = (lo..=hi)
-            .filter(|&i| i + 1 < j || i > j + 1)
-            .map(|i| p[i])
-            .collect();
-        nb.sort_by(f64::total_cmp);
-        // The median of exponential ordinates is ln 2 times their mean.
-        let background = nb[nb.len() / 2] / std::f64::consts::LN_2;
+        let background = match noise {
+            Some(m) => m.density(2.0 * std::f64::consts::PI * j as f64 / n as f64),
+            None => {
+                let lo = j.saturating_sub(16);
+                let hi = (j + 16).min(p.len() - 1);
+                let mut nb: Vec<f64> = (lo..=hi)
+                    .filter(|&i| i + 1 < j || i > j + 1)
+                    .map(|i| p[i])
+                    .collect();
+                nb.sort_by(f64::total_cmp);
+                // The median of exponential ordinates is ln 2 times their mean.
+                nb[nb.len() / 2] / std::f64::consts::LN_2
+            }
+        };
         if background <= 0.0 {
             continue;
         }
@@ -118,10 +127,11 @@ pub fn lines(x: &[f64], dt: f64, alpha: f64) -> Vec<Line> {
             let f = j as f64 * df;
             // A sinusoid of amplitude A gives a peak of (A sum w / 2)^2 / sum w^2.
             let amplitude = 2.0 * (p[j] * norm_w).sqrt() / sum_w;
-            let mains = [50.0, 60.0].iter().any(|base| {
-                let h = (f / base).round();
-                h >= 1.0 && (f - h * base).abs() <= df
-            });
+            let mains = df <= 12.5
+                && [50.0, 60.0].iter().any(|base| {
+                    let h = (f / base).round();
+                    h >= 1.0 && (f - h * base).abs() <= df
+                });
             out.push(Line {
                 frequency: f,
                 amplitude,
@@ -220,12 +230,16 @@ mod tests {
         let p = periodogram(&x);
         let mean = p[5..].iter().sum::<f64>() / (p.len() - 5) as f64;
         assert!((mean - 0.25).abs() < 0.02, "{mean}");
-        assert!(lines(&x, dt, 0.01).is_empty(), "{:?}", lines(&x, dt, 0.01));
+        assert!(
+            lines(&x, dt, 0.01, None).is_empty(),
+            "{:?}",
+            lines(&x, dt, 0.01, None)
+        );
         // 0.3 amplitude of 50 Hz hum on 0.5 noise: one line, at 50 Hz, amplitude ~0.3.
         for (k, v) in x.iter_mut().enumerate() {
             *v += 0.3 * (2.0 * std::f64::consts::PI * 50.0 * k as f64 * dt).sin();
         }
-        let l = lines(&x, dt, 0.01);
+        let l = lines(&x, dt, 0.01, None);
         assert_eq!(l.len(), 1, "{l:?}");
         assert!((l[0].frequency - 50.0).abs() <= 2.5, "{l:?}");
         assert!((l[0].amplitude - 0.3).abs() < 0.06, "{l:?}");

@@ -10,15 +10,19 @@ const N: usize = 3000;
 const ONSET: usize = 600;
 
 /// A shock record: `offset` plus AR(1) noise (`phi`, `sigma`) throughout, a decaying
-/// 5 kHz oscillation of amplitude `amp` from sample 600.
+/// 5 kHz oscillation of amplitude `amp` from sample 600 (time constant 400 us).
 fn shock(seed: u64, phi: f64, sigma: f64, amp: f64, offset: f64) -> Vec<f64> {
+    shock_decaying(seed, phi, sigma, amp, offset, 4e-4)
+}
+
+fn shock_decaying(seed: u64, phi: f64, sigma: f64, amp: f64, offset: f64, tau: f64) -> Vec<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let e = ArModel::ar1(phi, sigma).generate(N, &mut rng);
     (0..N)
         .map(|k| {
             let s = if k >= ONSET {
                 let t = (k - ONSET) as f64 * DT;
-                amp * (-t / 4e-4).exp() * (2.0 * std::f64::consts::PI * 5e3 * t).sin()
+                amp * (-t / tau).exp() * (2.0 * std::f64::consts::PI * 5e3 * t).sin()
             } else {
                 0.0
             };
@@ -163,7 +167,8 @@ fn no_false_clipping_or_spikes_on_clean_records() {
 
 #[test]
 fn drift_of_an_acceleration_is_found_and_a_clean_one_passes() {
-    let clean = shock(4, 0.5, 0.02, 20.0, 0.1);
+    // An event that is over (time constant 150 us) before the record ends.
+    let clean = shock_decaying(4, 0.5, 0.02, 20.0, 0.1, 1.5e-4);
     let mut shifted = clean.clone();
     // The zero moves by 0.05 (2.5 noise std) after the event.
     for v in shifted.iter_mut().skip(1500) {
