@@ -191,42 +191,72 @@ pub const SPIKE_WINDOW: usize = 16;
 /// Threshold of a spike, in local robust standard deviations.
 pub const SPIKE_THRESHOLD: f64 = 10.0;
 
-/// Isolated one-sample outliers of `x`: the departure `d_k = x_k - (x_{k-1} + x_{k+1}) / 2`
-/// exceeds [`SPIKE_THRESHOLD`] times the local robust scale (`1.4826` times the median
-/// `|d_j|` over the [`SPIKE_WINDOW`] samples either side, `j != k`, floored at the quantum
-/// and at `floor`), and the two neighbours agree with each other better than the sample
-/// agrees with them (`|x_{k+1} - x_{k-1}| < |d_k|`). A fast but real oscillation raises the
-/// local scale with it and is not taken for a spike.
-pub fn spikes(x: &[f64], floor: f64) -> Vec<usize> {
+/// Widest spike, in samples.
+pub const SPIKE_WIDTH: usize = 3;
+
+/// Isolated outliers of `x`, one to [`SPIKE_WIDTH`] samples wide, as inclusive spans: a
+/// block `x_k .. x_{k+w-1}` every sample of which departs on the same side from the
+/// straight line between its neighbours `x_{k-1}` and `x_{k+w}` by more than
+/// [`SPIKE_THRESHOLD`] (one sample) or twice that (two or three) times the local robust
+/// scale (`1.4826` times the median
+/// `|x_{j+1} - 2 x_j + x_{j-1}| / sqrt 6` over the [`SPIKE_WINDOW`] samples either side,
+/// the block and its neighbours left out, floored at the quantum and at `floor`), while the
+/// neighbours agree with each other better than the block departs (`|x_{k+w} - x_{k-1}|`
+/// below the smallest departure). The narrowest block that qualifies is taken. A fast but
+/// real oscillation raises the local scale with it and is not taken for a spike.
+pub fn spikes(x: &[f64], floor: f64) -> Vec<(usize, usize)> {
     let n = x.len();
     if n < 5 {
         return Vec::new();
     }
     let q = quantum(x);
-    let d: Vec<f64> = (0..n)
+    let d2: Vec<f64> = (0..n)
         .map(|k| {
             if k == 0 || k + 1 == n {
                 0.0
             } else {
-                x[k] - 0.5 * (x[k - 1] + x[k + 1])
+                (x[k + 1] - 2.0 * x[k] + x[k - 1]).abs() / 6f64.sqrt()
             }
         })
         .collect();
     let mut out = Vec::new();
-    for k in 1..n - 1 {
-        if d[k].abs() <= (x[k + 1] - x[k - 1]).abs() {
-            continue;
+    let mut k = 1;
+    while k + 1 < n {
+        let mut found = None;
+        for w in 1..=SPIKE_WIDTH {
+            if k + w >= n {
+                break;
+            }
+            let (a, b) = (x[k - 1], x[k + w]);
+            let dep: Vec<f64> = (0..w)
+                .map(|i| x[k + i] - (a + (b - a) * (i + 1) as f64 / (w + 1) as f64))
+                .collect();
+            let same_side = dep.iter().all(|d| *d > 0.0) || dep.iter().all(|d| *d < 0.0);
+            let smallest = dep.iter().map(|d| d.abs()).fold(f64::INFINITY, f64::min);
+            if !same_side || (b - a).abs() >= smallest {
+                continue;
+            }
+            let lo = k.saturating_sub(SPIKE_WINDOW).max(1);
+            let hi = (k + w + SPIKE_WINDOW).min(n - 2);
+            let local: Vec<f64> = (lo..=hi)
+                .filter(|&j| j + 1 < k || j > k + w)
+                .map(|j| d2[j])
+                .collect();
+            let scale = (1.4826 * median(&local)).max(q).max(floor);
+            // A wider block has more ways to stand out by chance in coloured noise and in a
+            // fast response: it must stand out twice as far.
+            let threshold = SPIKE_THRESHOLD * if w == 1 { 1.0 } else { 2.0 };
+            if scale > 0.0 && smallest > threshold * scale {
+                found = Some(w);
+                break;
+            }
         }
-        let lo = k.saturating_sub(SPIKE_WINDOW).max(1);
-        let hi = (k + SPIKE_WINDOW).min(n - 2);
-        // The neighbours' own departures carry the spike: leave them out too.
-        let local: Vec<f64> = (lo..=hi)
-            .filter(|&j| j + 1 < k || j > k + 1)
-            .map(|j| d[j].abs())
-            .collect();
-        let scale = (1.4826 * median(&local)).max(q).max(floor);
-        if scale > 0.0 && d[k].abs() > SPIKE_THRESHOLD * scale {
-            out.push(k);
+        match found {
+            Some(w) => {
+                out.push((k, k + w - 1));
+                k += w + 1;
+            }
+            None => k += 1,
         }
     }
     out

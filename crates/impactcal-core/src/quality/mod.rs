@@ -32,7 +32,7 @@
 //! x[300] += 5.0;
 //! let h = Histories::from_channels(vec!["a".into()], vec![x], 1e-4, 0.0, "")?;
 //! let q = check(&h, &QualityOptions { pre_trigger: Some(0.015), ..Default::default() })?;
-//! assert_eq!(q.channels[0].spike_samples, vec![300]);
+//! assert_eq!(q.channels[0].spike_spans, vec![[300, 300]]);
 //! assert!(q.channels[0].clipped.is_empty());
 //! # Ok::<(), impactcal_core::CoreError>(())
 //! ```
@@ -134,10 +134,10 @@ pub struct ChannelQuality {
     pub clipped: Vec<[f64; 3]>,
     /// Clipped runs by sample, with how much of the signal each cut.
     pub clipped_runs: Vec<ClipRun>,
-    /// Times of the spikes.
+    /// Times of the spikes (their largest sample).
     pub spikes: Vec<f64>,
-    /// Samples of the spikes.
-    pub spike_samples: Vec<usize>,
+    /// Samples of the spikes, `[first, last]` (one to three samples each).
+    pub spike_spans: Vec<[usize; 2]>,
     /// Drift of an acceleration (`None` for other channels or a record too short).
     pub drift: Option<Drift>,
 }
@@ -228,7 +228,7 @@ fn channel(
         clipped: Vec::new(),
         clipped_runs: Vec::new(),
         spikes: Vec::new(),
-        spike_samples: Vec::new(),
+        spike_spans: Vec::new(),
         drift: None,
     };
     if quiet >= faults::MIN_QUIET {
@@ -264,11 +264,22 @@ fn channel(
             .iter()
             .any(|r| (r.first..=r.last).contains(&k))
     };
-    q.spike_samples = faults::spikes(x, q.noise_std)
+    q.spike_spans = faults::spikes(x, q.noise_std)
         .into_iter()
-        .filter(|&k| !clipped_at(k))
+        .filter(|&(a, b)| !(a..=b).any(clipped_at))
+        .map(|(a, b)| [a, b])
         .collect();
-    q.spikes = q.spike_samples.iter().map(|&k| time(k)).collect();
+    let base = q.offset.unwrap_or_else(|| faults::median(x));
+    q.spikes = q
+        .spike_spans
+        .iter()
+        .map(|&[a, b]| {
+            let peak = (a..=b)
+                .max_by(|&i, &j| (x[i] - base).abs().total_cmp(&(x[j] - base).abs()))
+                .unwrap_or(a);
+            time(peak)
+        })
+        .collect();
     if options.accelerations.holds(&label) && q.offset.is_some() {
         let clean = bridged(x, &q.masked_spans());
         q.drift = faults::drift(
@@ -291,7 +302,7 @@ impl ChannelQuality {
             .clipped_runs
             .iter()
             .map(|r| (r.first, r.last))
-            .chain(self.spike_samples.iter().map(|&k| (k, k)))
+            .chain(self.spike_spans.iter().map(|&[a, b]| (a, b)))
             .collect();
         s.sort_unstable();
         s
@@ -341,8 +352,8 @@ impl ChannelQuality {
                 r.cut
             ));
         }
-        for t in &self.spikes {
-            out.push(format!("{l}: spike at {t:.6e} s"));
+        for (t, [a, b]) in self.spikes.iter().zip(&self.spike_spans) {
+            out.push(format!("{l}: spike at {t:.6e} s ({} sample(s))", b - a + 1));
         }
         if let Some(d) = &self.drift {
             out.push(format!(

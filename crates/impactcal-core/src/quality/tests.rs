@@ -95,6 +95,10 @@ fn planted_clipping_spikes_and_mains_are_found_where_planted() {
     }
     x[2000] += 3.0;
     x[250] -= 1.0;
+    // A three-sample glitch.
+    for k in 2500..2503 {
+        x[k] += 2.0;
+    }
     let q = check(&record("a", x), &QualityOptions::default()).unwrap();
     let c = &q.channels[0];
     assert_eq!(c.clipped_runs.len(), 1, "{:?}", c.clipped_runs);
@@ -103,7 +107,7 @@ fn planted_clipping_spikes_and_mains_are_found_where_planted() {
         (cut[0], *cut.last().unwrap())
     );
     assert_eq!(c.clipped[0][2], rail);
-    assert_eq!(c.spike_samples, vec![250, 2000]);
+    assert_eq!(c.spike_spans, vec![[250, 250], [2000, 2000], [2500, 2502]]);
     assert!((c.spikes[1] - 2000.0 * DT).abs() < 1e-12);
     // Masks on the record's own base cover the planted samples and one step either side.
     let m = q.mask_on("a", 0.0, DT, N);
