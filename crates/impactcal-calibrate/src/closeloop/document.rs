@@ -84,6 +84,7 @@ pub fn report(r: &LoopResult) -> Report {
             f(h.enriched)
         ));
     }
+    lead.push(format!("{}.", r.test_preparation.describe()));
     let mut sections = Vec::new();
 
     let n = &r.nuisance;

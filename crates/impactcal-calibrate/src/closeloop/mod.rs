@@ -7,8 +7,10 @@
 //!    per channel, `test_s(t) = g_s y_s(t - tau) + b_s`, profiled out of every comparison
 //!    and never offered as physics; gains near a units factor are flagged.
 //! 2. **Noise floor** ([`noise_floor`]): measurement noise per channel (given, pre-impact
-//!    window, or the band above the model's bandwidth) and the model's own simulation noise
-//!    from a jitter ensemble, combined in quadrature into the whitening weights.
+//!    window, or the frequencies where the model has no content) and the model's own
+//!    simulation noise from a jitter ensemble, combined in quadrature into the whitening
+//!    weights; the masks of `core::quality` (clipped runs, spikes) give zero weight and the
+//!    test's offsets are removed first (`study::channels::prepared_test`).
 //! 3. **Calibration**: CORS-RBF then a Gauss-Newton polish to a least-squares
 //!    optimum.
 //! 4. **Detection** ([`detection`]): reduced chi-square in effective samples, whiteness,
@@ -74,7 +76,7 @@ use impactcal_core::{Cfc, ChannelMap, Enrichable, Histories, Model};
 use crate::error::{CalibrateError, Result};
 use crate::metrics::{CurveMetrics, Iso18571};
 use crate::study::TestData;
-use crate::study::channels::test_on_model;
+use crate::study::channels::prepared_test;
 use crate::study::execute::{Observer, Worker, histories_of};
 
 pub use attribution::{Amplitude, Attribution, Score};
@@ -206,7 +208,9 @@ pub fn run_loop_on<M: Enrichable>(
         "the nominal run",
     )?;
     check_covered(test.histories, test.map, &nominal_raw, "test")?;
-    let test_m = test_on_model(test.histories, test.map, test.cfc, &nominal_raw)?;
+    let pre = noise_floor::onset(nominal_raw.data(), nominal_raw.samples()).saturating_sub(3);
+    let (test_m, masks, preparation) =
+        prepared_test(test.histories, test.map, test.cfc, &nominal_raw, pre)?;
     let labels = test_m.labels().to_vec();
     let samples = test_m.samples();
     let dt = test_m.dt();
@@ -235,7 +239,7 @@ pub fn run_loop_on<M: Enrichable>(
         "noise",
     )?;
     let y_nominal = prep(&nominal_raw)?;
-    let (frame, floor) = frame_of(
+    let (mut frame, floor) = frame_of(
         &labels,
         test_m.data(),
         samples,
@@ -247,6 +251,7 @@ pub fn run_loop_on<M: Enrichable>(
         band,
         unit_gains.as_deref(),
     )?;
+    masked_out(&mut frame, &masks);
     let ctx = Ctx {
         frame,
         cfc: test.cfc,
@@ -385,7 +390,9 @@ pub fn run_loop_on<M: Enrichable>(
                 "the holdout's nominal run",
             )?;
             check_covered(h.histories, test.map, &nominal_h, "holdout")?;
-            let test_h = test_on_model(h.histories, test.map, test.cfc, &nominal_h)?;
+            let pre_h = noise_floor::onset(nominal_h.data(), nominal_h.samples()).saturating_sub(3);
+            let (test_h, masks_h, _) =
+                prepared_test(h.histories, test.map, test.cfc, &nominal_h, pre_h)?;
             let calibrated_h = histories_of(
                 &runner.at(h.set).stage(
                     &declared_at,
@@ -414,7 +421,7 @@ pub fn run_loop_on<M: Enrichable>(
             )?;
             let y_nom_h = prep(&nominal_h)?;
             let gains: Vec<f64> = fit.terms.gains.clone();
-            let (frame_h, floor_h) = frame_of(
+            let (mut frame_h, floor_h) = frame_of(
                 &labels,
                 test_h.data(),
                 test_h.samples(),
@@ -426,6 +433,7 @@ pub fn run_loop_on<M: Enrichable>(
                 band,
                 Some(&gains),
             )?;
+            masked_out(&mut frame_h, &masks_h);
             let profile = |y: &[f64]| nuisance::profile(y, &frame_h, max_shift, Some(&gains)).0;
             let ys = [y_nom_h, prep(&calibrated_h)?, prep(&enriched_h)?];
             let judge = Judge {
@@ -461,6 +469,7 @@ pub fn run_loop_on<M: Enrichable>(
         detection: det0,
         nuisance: fit.terms.report(&labels, options.units_tolerance),
         noise_floor: floor,
+        test_preparation: preparation,
         candidates: outcome.rounds[0]
             .attribution
             .as_ref()
@@ -575,6 +584,7 @@ fn frame_of(
     let floor = noise_floor::estimate(
         labels,
         test,
+        y_nominal,
         samples,
         dt,
         pre.min(samples),
@@ -584,6 +594,19 @@ fn frame_of(
     )?;
     frame.weights = noise_floor::weights(&floor, spread, samples);
     Ok((frame, floor))
+}
+
+/// Zero weight for the masked samples of `core::quality` (clipped runs and spikes), per
+/// channel in frame order: they leave every residual.
+fn masked_out(frame: &mut Frame, masks: &[Vec<bool>]) {
+    let t = frame.samples;
+    for (s, m) in masks.iter().enumerate() {
+        for (k, &out) in m.iter().enumerate().take(t) {
+            if out {
+                frame.weights[s * t + k] = 0.0;
+            }
+        }
+    }
 }
 
 /// What judges a model's response against a test: the noise's lag-one correlation and the

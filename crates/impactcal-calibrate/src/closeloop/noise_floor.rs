@@ -6,14 +6,19 @@
 //! which wins when given), from the pre-impact window of the test (the samples before the
 //! model's response departs from its initial value, moved by the trigger offset; at least
 //! [`MIN_PRE_IMPACT`] samples; a straight line is fitted and removed, the residual's
-//! standard deviation and lag-one autocorrelation kept), or from the band above the model's
-//! bandwidth: the test minus its CFC-filtered self, whose variance is the part of white
-//! noise above the filter, `sigma^2 = var(test - cfc(test)) / f` with `f` the fraction of a
-//! white sequence's variance the same filter removes (measured on a seeded white sequence of
-//! the same length). `spread_sk` is the standard deviation of a jitter ensemble of the model
+//! standard deviation and lag-one autocorrelation kept), or from the frequencies where the
+//! nominal model has no content (its periodogram below 5 % of the test's): an AR(1)
+//! density fitted there by the Whittle likelihood gives the noise's variance and lag-one
+//! correlation (`impactcal_core::quality::noise_from_band`). Only when the model leaves
+//! too few frequencies empty does the band above the model's bandwidth serve: the test
+//! minus its CFC-filtered self, whose variance is the part of white noise above the filter,
+//! `sigma^2 = var(test - cfc(test)) / f` with `f` the fraction of a white sequence's
+//! variance the same filter removes (measured on a seeded white sequence of the same
+//! length); it counts whatever the model does above the filter as noise. `spread_sk` is the standard deviation of a jitter ensemble of the model
 //! (`impactcal_core::noise`): what the model does on its own under a tiny change of its
 //! parameters, which no calibration may call model-form error.
 
+use impactcal_core::quality::noise_from_band;
 use impactcal_core::{Cfc, Histories};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -32,8 +37,12 @@ pub enum NoiseSource {
     User,
     /// The pre-impact window of the test.
     PreImpact,
-    /// The band above the model's bandwidth (the residual of a CFC filter).
+    /// The band above the model's bandwidth (the residual of a CFC filter): the last
+    /// resort, when the model leaves too few frequencies empty.
     HighBand,
+    /// The frequencies where the nominal model has no content: an AR(1) fitted there
+    /// (`impactcal_core::quality::noise_from_band`).
+    ModelFreeBand,
 }
 
 /// The noise floor of one channel.
@@ -90,8 +99,9 @@ pub(crate) fn onset(model: &[f64], samples: usize) -> usize {
 }
 
 /// Estimates the noise floor (see the module docs). `test` is `S x T` on the model's time
-/// base, `pre_impact` the number of leading samples free of the impact, `spread` the jitter
-/// spread (`S x T`), `cfc` the filter of the high band.
+/// base, `model` the nominal response on the same channels and samples, `pre_impact` the
+/// number of leading samples free of the impact, `spread` the jitter spread (`S x T`),
+/// `cfc` the filter of the high band.
 ///
 /// # Errors
 /// [`CalibrateError::Study`] when no source gives a positive noise level for a channel
@@ -100,6 +110,7 @@ pub(crate) fn onset(model: &[f64], samples: usize) -> usize {
 pub(crate) fn estimate(
     labels: &[String],
     test: &[f64],
+    model: &[f64],
     samples: usize,
     dt: f64,
     pre_impact: usize,
@@ -111,7 +122,7 @@ pub(crate) fn estimate(
     let fraction = if use_pre || user_sigma.is_some() {
         1.0
     } else {
-        removed_fraction(samples, dt, cfc)?
+        removed_fraction(samples, dt, cfc).unwrap_or(f64::NAN)
     };
     let mut channels = Vec::new();
     for (s, label) in labels.iter().enumerate() {
@@ -123,7 +134,12 @@ pub(crate) fn estimate(
         } else if use_pre {
             let (sd, r) = detrended(&ch[..pre_impact]);
             (sd, NoiseSource::PreImpact, r)
+        } else if let Some(b) = noise_from_band(ch, &model[s * samples..(s + 1) * samples]) {
+            (b.model.sigma(), NoiseSource::ModelFreeBand, b.model.lag1())
         } else {
+            if !fraction.is_finite() {
+                removed_fraction(samples, dt, cfc)?;
+            }
             let h = Histories::from_channels(vec![label.clone()], vec![ch.to_vec()], dt, 0.0, "")?;
             let f = h.filtered(cfc)?;
             let e: Vec<f64> = ch.iter().zip(f.channel(0)).map(|(a, b)| a - b).collect();
@@ -229,7 +245,7 @@ mod tests {
         let zeros = vec![0.0; t];
         let cfc = Cfc::from_class(180).unwrap();
         let labels = vec!["a".to_string()];
-        let pre = estimate(&labels, &test, t, 1e-4, 1000, &zeros, None, cfc).unwrap();
+        let pre = estimate(&labels, &test, &zeros, t, 1e-4, 1000, &zeros, None, cfc).unwrap();
         assert_eq!(pre.channels[0].source, NoiseSource::PreImpact);
         assert!(
             (pre.channels[0].sigma - 0.3).abs() < 0.02,
@@ -237,15 +253,33 @@ mod tests {
             pre.channels[0].sigma
         );
         assert!(pre.channels[0].lag1.abs() < 0.1);
-        let band = estimate(&labels, &test, t, 1e-4, 5, &zeros, None, cfc).unwrap();
+        let signal: Vec<f64> = (0..t)
+            .map(|k| {
+                if k < 1000 {
+                    0.0
+                } else {
+                    (k as f64 * 1e-4 * 20.0).sin()
+                }
+            })
+            .collect();
+        let free = estimate(&labels, &test, &signal, t, 1e-4, 5, &zeros, None, cfc).unwrap();
+        assert_eq!(free.channels[0].source, NoiseSource::ModelFreeBand);
+        assert!(
+            (free.channels[0].sigma - 0.3).abs() < 0.03,
+            "{}",
+            free.channels[0].sigma
+        );
+        assert!(free.channels[0].lag1.abs() < 0.1);
+        // A model with content at every frequency (the test itself) leaves no band.
+        let band = estimate(&labels, &test, &test, t, 1e-4, 5, &zeros, None, cfc).unwrap();
         assert_eq!(band.channels[0].source, NoiseSource::HighBand);
         assert!(
             (band.channels[0].sigma - 0.3).abs() < 0.03,
             "{}",
             band.channels[0].sigma
         );
-        let user = estimate(&labels, &test, t, 1e-4, 5, &zeros, Some(0.5), cfc).unwrap();
+        let user = estimate(&labels, &test, &zeros, t, 1e-4, 5, &zeros, Some(0.5), cfc).unwrap();
         assert!((user.channels[0].sigma - 0.5).abs() < 1e-15);
-        assert!(estimate(&labels, &zeros, t, 1e-4, 1000, &zeros, None, cfc).is_err());
+        assert!(estimate(&labels, &zeros, &zeros, t, 1e-4, 1000, &zeros, None, cfc).is_err());
     }
 }

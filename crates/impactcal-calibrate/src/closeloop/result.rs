@@ -134,6 +134,9 @@ pub struct LoopResult {
     pub nuisance: Nuisance,
     /// The noise floor of the calibration test.
     pub noise_floor: NoiseFloor,
+    /// The masks and offsets applied to the test before any comparison.
+    #[serde(default)]
+    pub test_preparation: crate::study::channels::TestPreparation,
     /// The first attribution's ranking.
     pub candidates: Vec<Score>,
     /// Candidate pairs these sensors cannot tell apart (first attribution).

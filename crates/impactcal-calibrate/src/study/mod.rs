@@ -5,7 +5,12 @@
 //!    the window leave the objective (unless kept on request);
 //! 2. a scrambled-Halton ensemble of `N` runs; failed runs are reported by index and kept out;
 //! 3. M1 ([`m1`]): the envelope of `Q(t) = ||v(t)||_2` over the ensemble against the test's
-//!    `Q_e(t)`, the intervals where it leaves, the verdict with the `1/N` bound of Eq. 4.1;
+//!    `Q_e(t)`, the intervals where it leaves, the observed exceedance against the expected
+//!    one of a draw of the model with the test's measurement noise (measured on the test's
+//!    pre-impact part, else on the band the model leaves empty, or `sigma`), the
+//!    probability and the verdict; the test is used with the masks of `core::quality`
+//!    (clipped samples and spikes bridged) and its offsets removed
+//!    ([`channels::prepared_test`]);
 //! 4. sensors ([`sensors`]): effective-independence placement on the ensemble's impact
 //!    shapes; the test expanded from the sensors to the other channels through the baseline's
 //!    shapes, with its error;
@@ -53,11 +58,12 @@ pub use options::{StudyOptions, ValidStudyOptions};
 pub use result::StudyResult;
 pub use subspace::Subspace;
 
-use channels::{indices_of, q_of, relative_error, relative_l2, test_on_model};
+use channels::{indices_of, prepared_test, q_of, relative_error, relative_l2};
 use execute::{Runs, histories_of};
+use impactcal_core::quality::{ArModel, RecordNoise, RecordNoiseSource, noise_of};
 use result::{
     BeforeAfter, ChannelsSummary, Curves, EnsembleSummary, Errors, FailedRun, M2BeforeAfter,
-    NoiseSummary, SensorErrors, SurrogateSummary,
+    MeasurementNoise, NoiseSummary, SensorErrors, SurrogateSummary,
 };
 
 /// The measured side of a study.
@@ -146,7 +152,10 @@ pub fn run(
         "the nominal run",
     )?;
     let baseline = prep(&nominal_raw)?;
-    let test_m = test_on_model(test.histories, test.map, test.cfc, &nominal_raw)?;
+    let pre =
+        crate::closeloop::noise_floor::onset(baseline.data(), baseline.samples()).saturating_sub(3);
+    let (test_m, _masks, preparation) =
+        prepared_test(test.histories, test.map, test.cfc, &nominal_raw, pre)?;
     let jitter = JitterOptions::new(options.noise_runs, options.noise_eps, options.seed);
     let jitter_pts = jitter_points(&space, &nominal_point, &jitter)?;
     let jitter_runs: Vec<Histories> = runs
@@ -254,7 +263,49 @@ pub fn run(
     let q_runs: Vec<Vec<f64>> = ok_runs.iter().map(|h| q_of(h, &all)).collect();
     let q_test = q_of(&test_obj, &all);
     let q_baseline = q_of(&base_obj, &all);
-    let m1 = m1::m1(&time, &q_runs, &q_test)?;
+    let noise_models: Vec<(String, RecordNoise)> = objective
+        .iter()
+        .map(|l| -> Result<(String, RecordNoise)> {
+            let x = test_obj.channel_by_label(l)?;
+            Ok((
+                match options.sigma {
+                    Some(_) => "user".to_string(),
+                    None => String::new(),
+                },
+                match options.sigma {
+                    Some(s) => RecordNoise {
+                        model: ArModel::white(s),
+                        source: RecordNoiseSource::Differences,
+                    },
+                    None => noise_of(x, Some(base_obj.channel_by_label(l)?), pre),
+                },
+            ))
+        })
+        .collect::<Result<_>>()?;
+    let ar: Vec<ArModel> = noise_models.iter().map(|(_, n)| n.model.clone()).collect();
+    let m1 = if ar.iter().all(|m| m.variance == 0.0) {
+        m1::m1(&time, &q_runs, &q_test)?
+    } else {
+        m1::m1_with_noise(&time, &ok_runs, &test_obj, &ar, options.seed)?
+    };
+    let measurement_noise = objective
+        .iter()
+        .zip(&noise_models)
+        .map(|(l, (user, n))| MeasurementNoise {
+            label: l.clone(),
+            source: if user.is_empty() {
+                serde_json::to_value(n.source)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_string))
+                    .unwrap_or_default()
+            } else {
+                user.clone()
+            },
+            sigma: n.model.sigma(),
+            lag1: n.model.lag1(),
+            order: n.model.order(),
+        })
+        .collect();
     let mut result = StudyResult {
         model: description.to_string(),
         fingerprint: fp.clone(),
@@ -283,6 +334,8 @@ pub fn run(
         },
         ensemble,
         m1,
+        test_preparation: preparation,
+        measurement_noise,
         sensors: None,
         m2: None,
         surrogate: None,

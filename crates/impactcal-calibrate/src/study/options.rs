@@ -36,6 +36,10 @@ pub struct StudyOptions {
     pub keep_unpredictable: bool,
     /// Stop after M1 (the screening of a first parameter set).
     pub screen_only: bool,
+    /// Measurement noise standard deviation of every test channel as compared (after the
+    /// filter), when known (`[test] sigma` of a study file); `None`: measured on the test
+    /// (its pre-impact part, else the band the model leaves empty).
+    pub sigma: Option<f64>,
 }
 
 impl Default for StudyOptions {
@@ -53,6 +57,7 @@ impl Default for StudyOptions {
             noise_fraction: 0.05,
             keep_unpredictable: false,
             screen_only: false,
+            sigma: None,
         }
     }
 }
@@ -123,6 +128,15 @@ impl ParamGuard for StudyOptions {
                 "study.noise_fraction",
                 self.noise_fraction,
                 "must be positive",
+            ));
+        }
+        if let Some(s) = self.sigma
+            && !(s.is_finite() && s >= 0.0)
+        {
+            return Err(CoreError::invalid_option(
+                "test.sigma",
+                s,
+                "must be finite and non-negative",
             ));
         }
         Ok(())

@@ -468,6 +468,56 @@ impl RecordQuality {
     }
 }
 
+/// Where the noise model of [`noise_of`] came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RecordNoiseSource {
+    /// The quiet part before the event (AR model by BIC).
+    Quiet,
+    /// The frequencies where the model has no content (AR(1) by Whittle).
+    ModelFreeBand,
+    /// Second differences of the record (white).
+    Differences,
+}
+
+/// The noise of one channel of a test as compared with a model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecordNoise {
+    /// The noise model.
+    pub model: ArModel,
+    /// Where it came from.
+    pub source: RecordNoiseSource,
+}
+
+/// The noise of test channel `test`, in this order: from its quiet part `test[..quiet]`
+/// when that holds at least [`faults::MIN_QUIET`] samples (a straight line removed, an AR
+/// model of order by BIC); else from the frequencies where `model` (the same channel of a
+/// model run on the same time base) has no content ([`noise_from_band`]); else white, from
+/// second differences (`1.4826 median |d2| / sqrt 6`). A constant quiet part falls through
+/// to the next source.
+pub fn noise_of(test: &[f64], model: Option<&[f64]>, quiet: usize) -> RecordNoise {
+    if quiet >= faults::MIN_QUIET && quiet <= test.len() {
+        let part = spectrum::detrended(&test[..quiet]);
+        if let Ok(m) = ArModel::fit(&part, ar::DEFAULT_MAX_ORDER) {
+            return RecordNoise {
+                model: m,
+                source: RecordNoiseSource::Quiet,
+            };
+        }
+    }
+    if let Some(b) = model.and_then(|m| noise_from_band(test, m)) {
+        return RecordNoise {
+            model: b.model,
+            source: RecordNoiseSource::ModelFreeBand,
+        };
+    }
+    let d2: Vec<f64> = test.windows(3).map(|w| w[2] - 2.0 * w[1] + w[0]).collect();
+    RecordNoise {
+        model: ArModel::white(faults::robust_scale(&d2) / 6f64.sqrt()),
+        source: RecordNoiseSource::Differences,
+    }
+}
+
 /// `x` with the samples of `spans` replaced by the straight line between the unmasked
 /// samples either side (held flat at the record's ends).
 pub fn bridged(x: &[f64], spans: &[(usize, usize)]) -> Vec<f64> {
