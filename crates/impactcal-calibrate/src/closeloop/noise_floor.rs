@@ -270,8 +270,9 @@ mod tests {
             free.channels[0].sigma
         );
         assert!(free.channels[0].lag1.abs() < 0.1);
-        // A model with content at every frequency (the test itself) leaves no band.
-        let band = estimate(&labels, &test, &test, t, 1e-4, 5, &zeros, None, cfc).unwrap();
+        // A model with content at every frequency (ten times the test) leaves no band.
+        let loud: Vec<f64> = test.iter().map(|v| 10.0 * v).collect();
+        let band = estimate(&labels, &test, &loud, t, 1e-4, 5, &zeros, None, cfc).unwrap();
         assert_eq!(band.channels[0].source, NoiseSource::HighBand);
         assert!(
             (band.channels[0].sigma - 0.3).abs() < 0.03,

@@ -81,17 +81,23 @@ pub struct ClipRun {
     pub last: usize,
     /// The level (the channel's maximum or minimum).
     pub level: f64,
-    /// How far above the level (below, for the minimum) a parabola through the two
-    /// samples on each side reaches over the run: the part of the signal the rail cut.
-    pub cut: f64,
+    /// The larger of the steps into and out of the run (the signal's unit): how fast the
+    /// signal met the rail.
+    pub step: f64,
 }
 
 /// Clipped runs of `x`, found without being told the rails: runs of at least two samples
-/// equal (within half a quantum) to the channel's maximum or minimum, away from the
-/// record's ends, over which the least-squares parabola through the two samples on each
-/// side rises above the level (falls below, at the minimum) by more than `4 max(q, noise)`
-/// (`q` the quantum, `noise` the channel's noise standard deviation). A smooth peak that
-/// happens to repeat a sample lies on that parabola; a signal cut by a rail does not.
+/// equal (within half a quantum `q`) to the channel's maximum or minimum, away from the
+/// record's ends, that a smooth peak cannot make (`tol = 4 max(q, noise)`, `noise` the
+/// channel's noise standard deviation; `E_1`, `E_2` the steps into and out of the run,
+/// `D_1`, `D_2` the distances of the samples two before and two after from the level):
+///
+/// - three or more equal samples: a smooth peak is that flat only where its curvature is
+///   below a quantum, so its steps in and out are of a quantum: clipped when
+///   `max(E_1, E_2) > tol`;
+/// - two: a smooth peak sampled either side of its top has `D = 3 E` on each side (a
+///   parabola); a rail stops the signal abruptly: clipped when `D > 2 (3 E + tol)` on
+///   either side.
 pub fn clipped_runs(x: &[f64], noise: f64) -> Vec<ClipRun> {
     let n = x.len();
     if n < 8 {
@@ -105,7 +111,7 @@ pub fn clipped_runs(x: &[f64], noise: f64) -> Vec<ClipRun> {
         return Vec::new();
     }
     let mut out = Vec::new();
-    for (level, sign) in [(hi, 1.0), (lo, -1.0)] {
+    for level in [hi, lo] {
         let at = |k: usize| (x[k] - level).abs() <= 0.5 * q;
         let mut k = 0;
         while k < n {
@@ -122,67 +128,25 @@ pub fn clipped_runs(x: &[f64], noise: f64) -> Vec<ClipRun> {
             if last == first || first < 2 || last + 2 >= n {
                 continue;
             }
-            let pts = [first - 2, first - 1, last + 1, last + 2];
-            let Some(c) = parabola(&pts.map(|i| (i as f64, x[i]))) else {
-                continue;
+            let d = |i: usize| (x[i] - level).abs();
+            let (e1, e2) = (d(first - 1), d(last + 1));
+            let clipped = if last - first >= 2 {
+                e1.max(e2) > tol
+            } else {
+                d(first - 2) > 2.0 * (3.0 * e1 + tol) || d(last + 2) > 2.0 * (3.0 * e2 + tol)
             };
-            let cut = (first..=last)
-                .map(|i| {
-                    let t = i as f64;
-                    sign * (c[0] + c[1] * t + c[2] * t * t - level)
-                })
-                .fold(f64::NEG_INFINITY, f64::max);
-            if cut > tol {
+            if clipped {
                 out.push(ClipRun {
                     first,
                     last,
                     level,
-                    cut,
+                    step: e1.max(e2),
                 });
             }
         }
     }
     out.sort_by_key(|r| r.first);
     out
-}
-
-/// Least-squares `a + b t + c t^2` through the points (`t` shifted by the first point).
-fn parabola(p: &[(f64, f64)]) -> Option<[f64; 3]> {
-    let t0 = p[0].0;
-    let mut m = [[0.0; 3]; 3];
-    let mut r = [0.0; 3];
-    for &(t, y) in p {
-        let b = [1.0, t - t0, (t - t0) * (t - t0)];
-        for i in 0..3 {
-            r[i] += b[i] * y;
-            for j in 0..3 {
-                m[i][j] += b[i] * b[j];
-            }
-        }
-    }
-    let det = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(&m);
-    if d.abs() < 1e-12 {
-        return None;
-    }
-    let mut c = [0.0; 3];
-    for (col, ck) in c.iter_mut().enumerate() {
-        let mut mc = m;
-        for i in 0..3 {
-            mc[i][col] = r[i];
-        }
-        *ck = det(&mc) / d;
-    }
-    // Back to absolute t: a + b (t - t0) + c (t - t0)^2.
-    Some([
-        c[0] - c[1] * t0 + c[2] * t0 * t0,
-        c[1] - 2.0 * c[2] * t0,
-        c[2],
-    ])
 }
 
 /// Half-width of the window of the spikes' local scale.

@@ -343,13 +343,13 @@ impl ChannelQuality {
         }
         for (r, c) in self.clipped_runs.iter().zip(&self.clipped) {
             out.push(format!(
-                "{l}: clipped at {:.6e} from {:.6e} s to {:.6e} s ({} samples; the signal \
-                 would have gone at least {:.3e} further)",
+                "{l}: clipped at {:.6e} from {:.6e} s to {:.6e} s ({} samples; it met the \
+                 level at a step of {:.3e})",
                 c[2],
                 c[0],
                 c[1],
                 r.last - r.first + 1,
-                r.cut
+                r.step
             ));
         }
         for (t, [a, b]) in self.spikes.iter().zip(&self.spike_spans) {
