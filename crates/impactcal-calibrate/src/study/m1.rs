@@ -535,8 +535,8 @@ mod tests {
         // (the drop tower's runs seldom cross, so the count carries few effective samples
         // and only a long exceedance is evidence).
         let mut q = norm_history_of(y.data(), y.samples());
-        for k in 80..240 {
-            q[k] = 1.1 * r.upper[k];
+        for (v, u) in q[80..240].iter_mut().zip(&r.upper[80..240]) {
+            *v = 1.1 * u;
         }
         let r = m1(&time, &q_runs, &q).unwrap();
         assert_eq!(r.verdict, Verdict::CannotExplain, "{}", r.statement);

@@ -272,7 +272,7 @@ pub fn drift(
         .rev()
         .find(|&k| (x[k] - offset).abs() > 0.02 * peak)
         .unwrap_or(quiet);
-    let first = if n - end - 1 >= 16 {
+    let first = if n - end > 16 {
         end + 1
     } else {
         n - (n - quiet) / 4

@@ -96,8 +96,8 @@ fn planted_clipping_spikes_and_mains_are_found_where_planted() {
     x[2000] += 3.0;
     x[250] -= 1.0;
     // A three-sample glitch.
-    for k in 2500..2503 {
-        x[k] += 2.0;
+    for v in &mut x[2500..2503] {
+        *v += 2.0;
     }
     let q = check(&record("a", x), &QualityOptions::default()).unwrap();
     let c = &q.channels[0];

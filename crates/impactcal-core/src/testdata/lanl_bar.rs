@@ -11,6 +11,11 @@ use crate::error::{CoreError, Result};
 use crate::histories::Histories;
 use crate::testdata::conversion::{Bridge, Conversion};
 
+/// A tolerance scale for comparing start times written in text (at least a picosecond).
+fn dt_scale(text: &str) -> f64 {
+    text.parse::<f64>().map_or(1e-12, |v| v.abs().max(1e-12))
+}
+
 /// Which bar of a Kolsky set-up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Bar {
@@ -125,7 +130,7 @@ impl LanlBarRecord {
                 }
                 1 => {
                     start = num(a, ca)?;
-                    if num(b, cb)? != start {
+                    if (num(b, cb)? - start).abs() > 1e-12 * start.abs().max(dt_scale(a)) {
                         return Err(err(
                             line,
                             cb,
@@ -135,7 +140,7 @@ impl LanlBarRecord {
                 }
                 2 => {
                     dt = num(a, ca)?;
-                    if dt <= 0.0 || num(b, cb)? != dt {
+                    if dt <= 0.0 || (num(b, cb)? - dt).abs() > 1e-9 * dt {
                         return Err(err(
                             line,
                             ca,
