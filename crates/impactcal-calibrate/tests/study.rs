@@ -149,6 +149,8 @@ fn envelope_and_verdict_match_the_runs_and_a_pushed_test_gives_its_interval() {
     let dir = tempfile::tempdir().unwrap();
     let mut o = options(12, 0);
     o.screen_only = true;
+    // A noiseless test: the paper's reading (no measurement noise counted).
+    o.sigma = Some(0.0);
     let r = run(&model, &test, o.clone(), dir.path()).unwrap();
     let qs: Vec<Vec<f64>> = points
         .iter()

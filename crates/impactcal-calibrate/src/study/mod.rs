@@ -282,7 +282,18 @@ pub fn run(
             ))
         })
         .collect::<Result<_>>()?;
-    let ar: Vec<ArModel> = noise_models.iter().map(|(_, n)| n.model.clone()).collect();
+    // Second differences measure a smooth record's curvature as much as its noise: where
+    // neither a quiet part nor a model-free band shows the noise, M1 counts none.
+    let ar: Vec<ArModel> = noise_models
+        .iter()
+        .map(|(user, n)| {
+            if user.is_empty() && n.source == RecordNoiseSource::Differences {
+                ArModel::white(0.0)
+            } else {
+                n.model.clone()
+            }
+        })
+        .collect();
     let m1 = if ar.iter().all(|m| m.variance == 0.0) {
         m1::m1(&time, &q_runs, &q_test)?
     } else {
