@@ -9,8 +9,8 @@
 //! 2. **Noise floor** ([`noise_floor`]): measurement noise per channel (given, pre-impact
 //!    window, or the frequencies where the model has no content) and the model's own
 //!    simulation noise from a jitter ensemble, combined in quadrature into the whitening
-//!    weights; the masks of `core::quality` (clipped runs, spikes) give zero weight and the
-//!    test's offsets are removed first (`study::channels::prepared_test`).
+//!    weights; the masks of `core::quality` (clipped runs, spikes) give zero weight
+//!    (`study::channels::prepared_test`); the test's offsets are the biases of step 1.
 //! 3. **Calibration**: CORS-RBF then a Gauss-Newton polish to a least-squares
 //!    optimum.
 //! 4. **Detection** ([`detection`]): reduced chi-square in effective samples, whiteness,
@@ -208,9 +208,9 @@ pub fn run_loop_on<M: Enrichable>(
         "the nominal run",
     )?;
     check_covered(test.histories, test.map, &nominal_raw, "test")?;
-    let pre = noise_floor::onset(nominal_raw.data(), nominal_raw.samples()).saturating_sub(3);
+    // The offsets stay: the nuisance terms fit a bias per channel on every sample.
     let (test_m, masks, preparation) =
-        prepared_test(test.histories, test.map, test.cfc, &nominal_raw, pre)?;
+        prepared_test(test.histories, test.map, test.cfc, &nominal_raw, None)?;
     let labels = test_m.labels().to_vec();
     let samples = test_m.samples();
     let dt = test_m.dt();
@@ -390,9 +390,8 @@ pub fn run_loop_on<M: Enrichable>(
                 "the holdout's nominal run",
             )?;
             check_covered(h.histories, test.map, &nominal_h, "holdout")?;
-            let pre_h = noise_floor::onset(nominal_h.data(), nominal_h.samples()).saturating_sub(3);
             let (test_h, masks_h, _) =
-                prepared_test(h.histories, test.map, test.cfc, &nominal_h, pre_h)?;
+                prepared_test(h.histories, test.map, test.cfc, &nominal_h, None)?;
             let calibrated_h = histories_of(
                 &runner.at(h.set).stage(
                     &declared_at,

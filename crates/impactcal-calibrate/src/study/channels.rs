@@ -149,8 +149,9 @@ pub fn relative_l2(a: &[f64], b: &[f64]) -> f64 {
 
 /// What was done to the test before any comparison: the masks of `core::quality` (clipped
 /// runs and spikes found on the raw record, bridged linearly before filtering and, in the
-/// closed loop, given zero weight) and the offsets removed (each channel's pre-impact mean
-/// less the model's over the same samples).
+/// closed loop, given zero weight) and the offsets: removed (each channel's pre-impact mean
+/// less the model's over the same samples) in the study, fitted with the other nuisance
+/// terms (a bias per channel) in the closed loop.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct TestPreparation {
     /// Clipped runs found on the raw test.
@@ -163,6 +164,10 @@ pub struct TestPreparation {
     pub offsets: BTreeMap<String, f64>,
     /// Pre-impact samples the offsets (and the noise) were measured on.
     pub pre_impact_samples: usize,
+    /// The offsets were left in the test because the comparison fits a bias per channel
+    /// (the closed loop's nuisance terms), which takes them out with every sample.
+    #[serde(default)]
+    pub bias_fitted: bool,
 }
 
 impl TestPreparation {
@@ -174,7 +179,9 @@ impl TestPreparation {
             self.clipped_runs,
             self.spikes,
             self.masked_samples,
-            if self.offsets.is_empty() {
+            if self.bias_fitted {
+                "offsets fitted as a bias per channel with the nuisance terms".to_string()
+            } else if self.offsets.is_empty() {
                 "no offset removed (no pre-impact samples in the window)".to_string()
             } else {
                 format!(
@@ -189,9 +196,11 @@ impl TestPreparation {
 
 /// The test prepared for comparison with `model` (a run on the model's channels and time
 /// base, unfiltered): the raw test checked ([`impactcal_core::quality::check`]) and its
-/// clipped and spiked samples bridged, then as [`test_on_model`]; the offsets removed over
-/// the first `pre` samples (when `pre >= 8`); and, per model channel of the result, the mask
-/// of the samples that lie within a raw step of a masked sample.
+/// clipped and spiked samples bridged, then as [`test_on_model`]; with `pre = Some(p)` the
+/// offsets removed over the first `p` samples (when `p >= 8`; the test's mean there less
+/// the filtered model's), with `None` left in (the caller fits a bias per channel); and,
+/// per model channel of the result, the mask of the samples that lie within a raw step of
+/// a masked sample.
 ///
 /// # Errors
 /// As [`test_on_model`].
@@ -200,7 +209,7 @@ pub fn prepared_test(
     map: Option<&ChannelMap>,
     cfc: Option<Cfc>,
     model: &Histories,
-    pre: usize,
+    pre: Option<usize>,
 ) -> Result<(Histories, Vec<Vec<bool>>, TestPreparation)> {
     let converted = match map {
         Some(m) => m.convert(test)?,
@@ -255,10 +264,11 @@ pub fn prepared_test(
     let mut offsets = BTreeMap::new();
     let t = on_model.samples();
     let mut data = on_model.data().to_vec();
-    if pre >= 8 {
+    let removed = pre.filter(|&p| p >= 8).unwrap_or(0);
+    if removed > 0 {
         for (c, l) in on_model.labels().iter().enumerate() {
             let m = model_f.channel_by_label(l)?;
-            let o = (0..pre).map(|k| data[c * t + k] - m[k]).sum::<f64>() / pre as f64;
+            let o = (0..removed).map(|k| data[c * t + k] - m[k]).sum::<f64>() / removed as f64;
             data[c * t..(c + 1) * t].iter_mut().for_each(|v| *v -= o);
             offsets.insert(l.clone(), o);
         }
@@ -276,7 +286,8 @@ pub fn prepared_test(
         spikes: quality.channels.iter().map(|c| c.spike_spans.len()).sum(),
         masked_samples: quality.masked_count(),
         offsets,
-        pre_impact_samples: if pre >= 8 { pre } else { 0 },
+        pre_impact_samples: removed,
+        bias_fitted: pre.is_none(),
     };
     Ok((prepared, masks, summary))
 }

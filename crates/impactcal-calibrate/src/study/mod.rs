@@ -155,7 +155,7 @@ pub fn run(
     let pre =
         crate::closeloop::noise_floor::onset(baseline.data(), baseline.samples()).saturating_sub(3);
     let (test_m, _masks, preparation) =
-        prepared_test(test.histories, test.map, test.cfc, &nominal_raw, pre)?;
+        prepared_test(test.histories, test.map, test.cfc, &nominal_raw, Some(pre))?;
     let jitter = JitterOptions::new(options.noise_runs, options.noise_eps, options.seed);
     let jitter_pts = jitter_points(&space, &nominal_point, &jitter)?;
     let jitter_runs: Vec<Histories> = runs
