@@ -149,8 +149,6 @@ fn envelope_and_verdict_match_the_runs_and_a_pushed_test_gives_its_interval() {
     let dir = tempfile::tempdir().unwrap();
     let mut o = options(12, 0);
     o.screen_only = true;
-    // A noiseless test: the paper's reading (no measurement noise counted).
-    o.sigma = Some(0.0);
     let r = run(&model, &test, o.clone(), dir.path()).unwrap();
     let qs: Vec<Vec<f64>> = points
         .iter()
@@ -190,7 +188,14 @@ fn envelope_and_verdict_match_the_runs_and_a_pushed_test_gives_its_interval() {
     assert!((r.m1.expected_exceedance - 2.0 / 13.0).abs() < 1e-12);
     assert!(r.m1.exceedance_fraction < r.m1.expected_exceedance);
     assert_eq!(r.m1.verdict, Verdict::CanExplain, "{}", r.m1.statement);
+    // A noiseless test has no quiet part (the drop starts at once) and no band above the
+    // ensemble's bandwidth (it is a member): no noise is counted, the paper's reading.
     assert!(!r.m1.noise_counted);
+    assert!(
+        r.measurement_noise
+            .iter()
+            .all(|n| n.sigma == 0.0 && n.note.as_deref().is_some_and(|t| t.contains("no band")))
+    );
     assert_eq!(r.m1.intervals, vec![[40.0 * DT, 59.0 * DT]]);
     assert!((r.m1.exceedance_fraction - 20.0 / SAMPLES as f64).abs() < 1e-15);
 }

@@ -245,10 +245,11 @@ pub fn run_loop_on<M: Enrichable>(
         samples,
         dt,
         &y_nominal,
+        &model_noise.deviations,
         &spread,
         max_shift,
         options,
-        band,
+        (test.cfc, band),
         unit_gains.as_deref(),
     )?;
     masked_out(&mut frame, &masks);
@@ -408,7 +409,7 @@ pub fn run_loop_on<M: Enrichable>(
                 )?[0],
                 "the holdout's enriched run",
             )?;
-            let (spread_h, _) = model_spread(
+            let (spread_h, model_noise_h) = model_spread(
                 runner.at(h.set),
                 &declared_at,
                 &nominal,
@@ -426,10 +427,11 @@ pub fn run_loop_on<M: Enrichable>(
                 test_h.samples(),
                 dt,
                 &y_nom_h,
+                &model_noise_h.deviations,
                 &spread_h,
                 max_shift,
                 options,
-                band,
+                (test.cfc, band),
                 Some(&gains),
             )?;
             masked_out(&mut frame_h, &masks_h);
@@ -556,7 +558,10 @@ fn model_spread<M: Model>(
     Ok((noise.spread.concat(), ModelNoise { deviations, shifts }))
 }
 
-/// The whitened frame of a test and its noise floor.
+/// The whitened frame of a test and its noise floor. `deviations` are the jitter runs
+/// less the nominal one (`S x T` each): the nominal and the jittered runs are the model
+/// ensemble whose bandwidth bounds the noise's band; `filters` the test's CFC (the one
+/// the test and the runs went through) and the class of the high band.
 #[allow(clippy::too_many_arguments)]
 fn frame_of(
     labels: &[String],
@@ -564,10 +569,11 @@ fn frame_of(
     samples: usize,
     dt: f64,
     y_nominal: &[f64],
+    deviations: &[Vec<f64>],
     spread: &[f64],
     max_shift: f64,
     options: &LoopOptions,
-    band: Cfc,
+    filters: (Option<Cfc>, Cfc),
     fixed_gains: Option<&[f64]>,
 ) -> Result<(Frame, NoiseFloor)> {
     let mut frame = Frame {
@@ -580,16 +586,23 @@ fn frame_of(
     let (terms, _) = nuisance::profile(y_nominal, &frame, max_shift, fixed_gains);
     let onset = noise_floor::onset(y_nominal, samples) as f64 + terms.tau / dt;
     let pre = (onset - 3.0).floor().max(0.0) as usize;
+    let members: Vec<Vec<f64>> = std::iter::once(y_nominal.to_vec())
+        .chain(
+            deviations
+                .iter()
+                .map(|d| d.iter().zip(y_nominal).map(|(a, b)| a + b).collect()),
+        )
+        .collect();
     let floor = noise_floor::estimate(
         labels,
         test,
-        y_nominal,
+        &members,
         samples,
         dt,
         pre.min(samples),
         spread,
         options.sigma,
-        band,
+        filters,
     )?;
     frame.weights = noise_floor::weights(&floor, spread, samples);
     Ok((frame, floor))

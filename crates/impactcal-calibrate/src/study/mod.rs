@@ -34,6 +34,7 @@ pub mod document;
 pub mod execute;
 pub mod m1;
 pub mod m2;
+pub mod measured_noise;
 pub mod options;
 pub mod reconcile;
 pub mod result;
@@ -60,10 +61,9 @@ pub use subspace::Subspace;
 
 use channels::{indices_of, prepared_test, q_of, relative_error, relative_l2};
 use execute::{Runs, histories_of};
-use impactcal_core::quality::{ArModel, RecordNoise, RecordNoiseSource, noise_of};
 use result::{
     BeforeAfter, ChannelsSummary, Curves, EnsembleSummary, Errors, FailedRun, M2BeforeAfter,
-    MeasurementNoise, NoiseSummary, SensorErrors, SurrogateSummary,
+    NoiseSummary, SensorErrors, SurrogateSummary,
 };
 
 /// The measured side of a study.
@@ -263,60 +263,13 @@ pub fn run(
     let q_runs: Vec<Vec<f64>> = ok_runs.iter().map(|h| q_of(h, &all)).collect();
     let q_test = q_of(&test_obj, &all);
     let q_baseline = q_of(&base_obj, &all);
-    let noise_models: Vec<(String, RecordNoise)> = objective
-        .iter()
-        .map(|l| -> Result<(String, RecordNoise)> {
-            let x = test_obj.channel_by_label(l)?;
-            Ok((
-                match options.sigma {
-                    Some(_) => "user".to_string(),
-                    None => String::new(),
-                },
-                match options.sigma {
-                    Some(s) => RecordNoise {
-                        model: ArModel::white(s),
-                        source: RecordNoiseSource::Differences,
-                    },
-                    None => noise_of(x, Some(base_obj.channel_by_label(l)?), pre),
-                },
-            ))
-        })
-        .collect::<Result<_>>()?;
-    // Second differences measure a smooth record's curvature as much as its noise: where
-    // neither a quiet part nor a model-free band shows the noise, M1 counts none.
-    let ar: Vec<ArModel> = noise_models
-        .iter()
-        .map(|(user, n)| {
-            if user.is_empty() && n.source == RecordNoiseSource::Differences {
-                ArModel::white(0.0)
-            } else {
-                n.model.clone()
-            }
-        })
-        .collect();
+    let (ar, measurement_noise) =
+        measured_noise::measured(&test_obj, &base_obj, &ok_runs, pre, test.cfc, options.sigma)?;
     let m1 = if ar.iter().all(|m| m.variance == 0.0) {
         m1::m1(&time, &q_runs, &q_test)?
     } else {
         m1::m1_with_noise(&time, &ok_runs, &test_obj, &ar, options.seed)?
     };
-    let measurement_noise = objective
-        .iter()
-        .zip(&noise_models)
-        .map(|(l, (user, n))| MeasurementNoise {
-            label: l.clone(),
-            source: if user.is_empty() {
-                serde_json::to_value(n.source)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_string))
-                    .unwrap_or_default()
-            } else {
-                user.clone()
-            },
-            sigma: n.model.sigma(),
-            lag1: n.model.lag1(),
-            order: n.model.order(),
-        })
-        .collect();
     let mut result = StudyResult {
         model: description.to_string(),
         fingerprint: fp.clone(),

@@ -51,7 +51,7 @@ use crate::table::{Table, TableOptions};
 
 pub use ar::{ArModel, LjungBox, ljung_box};
 pub use faults::{ClipRun, Drift, TimeFault};
-pub use spectrum::{BandNoise, Line, noise_from_band};
+pub use spectrum::{BandNoise, BandRefusal, Line, filtered_white, noise_from_band};
 
 /// Level of the whiteness test and of the line search.
 pub const ALPHA: f64 = 0.01;
@@ -169,11 +169,14 @@ pub fn check(h: &Histories, options: &QualityOptions) -> Result<RecordQuality> {
     let quiet_given = match options.pre_trigger {
         None => None,
         Some(t) => {
-            let k = if t.is_finite() {
-                ((t - h.start()) / h.dt() - 1e-9).ceil().max(0.0) as usize
-            } else {
-                0
-            };
+            if !t.is_finite() {
+                return Err(CoreError::invalid_option(
+                    "pre-trigger",
+                    t,
+                    "must be a finite time (s)",
+                ));
+            }
+            let k = ((t - h.start()) / h.dt() - 1e-9).ceil().max(0.0) as usize;
             if k < faults::MIN_QUIET || k > n {
                 return Err(CoreError::invalid_option(
                     "pre-trigger",
@@ -474,48 +477,64 @@ impl RecordQuality {
 pub enum RecordNoiseSource {
     /// The quiet part before the event (AR model by BIC).
     Quiet,
-    /// The frequencies where the model has no content (AR(1) by Whittle).
+    /// The band above the model ensemble's bandwidth ([`noise_from_band`]).
     ModelFreeBand,
-    /// Second differences of the record (white).
-    Differences,
+    /// Given by the user.
+    Given,
+    /// Nowhere: the record has no quiet part and no band (the note says why).
+    None,
 }
 
 /// The noise of one channel of a test as compared with a model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RecordNoise {
-    /// The noise model.
-    pub model: ArModel,
+    /// The noise model (`None` when no source shows the noise).
+    pub model: Option<ArModel>,
     /// Where it came from.
     pub source: RecordNoiseSource,
+    /// Why the band was not used, when it was tried and refused.
+    pub refusal: Option<BandRefusal>,
 }
 
-/// The noise of test channel `test`, in this order: from its quiet part `test[..quiet]`
-/// when that holds at least [`faults::MIN_QUIET`] samples (a straight line removed, an AR
-/// model of order by BIC); else from the frequencies where `model` (the same channel of a
-/// model run on the same time base) has no content ([`noise_from_band`]); else white, from
-/// second differences (`1.4826 median |d2| / sqrt 6`). A constant quiet part falls through
-/// to the next source.
-pub fn noise_of(test: &[f64], model: Option<&[f64]>, quiet: usize) -> RecordNoise {
+/// The noise of test channel `test` (as compared: after the filter `cfc`, on the step
+/// `dt`), in this order: from its quiet part `test[..quiet]` when that holds at least
+/// [`faults::MIN_QUIET`] samples and is not constant (a straight line removed, an AR model
+/// of order by BIC); else from the band above the bandwidth of `members` (the same channel
+/// of every run of the model ensemble on the same samples, [`noise_from_band`]); else none,
+/// with the band's refusal. Nothing here reads second differences: on a smooth record they
+/// measure its curvature as much as its noise.
+///
+/// # Errors
+/// As [`noise_from_band`] (a member of another length, a step the filter cannot serve).
+pub fn noise_of(
+    test: &[f64],
+    members: &[&[f64]],
+    quiet: usize,
+    dt: f64,
+    cfc: Option<crate::signal::Cfc>,
+) -> Result<RecordNoise> {
     if quiet >= faults::MIN_QUIET && quiet <= test.len() {
         let part = spectrum::detrended(&test[..quiet]);
         if let Ok(m) = ArModel::fit(&part, ar::DEFAULT_MAX_ORDER) {
-            return RecordNoise {
-                model: m,
+            return Ok(RecordNoise {
+                model: Some(m),
                 source: RecordNoiseSource::Quiet,
-            };
+                refusal: None,
+            });
         }
     }
-    if let Some(b) = model.and_then(|m| noise_from_band(test, m)) {
-        return RecordNoise {
-            model: b.model,
+    Ok(match noise_from_band(test, members, dt, cfc)? {
+        Ok(b) => RecordNoise {
+            model: Some(b.model),
             source: RecordNoiseSource::ModelFreeBand,
-        };
-    }
-    let d2: Vec<f64> = test.windows(3).map(|w| w[2] - 2.0 * w[1] + w[0]).collect();
-    RecordNoise {
-        model: ArModel::white(faults::robust_scale(&d2) / 6f64.sqrt()),
-        source: RecordNoiseSource::Differences,
-    }
+            refusal: None,
+        },
+        Err(r) => RecordNoise {
+            model: None,
+            source: RecordNoiseSource::None,
+            refusal: Some(r),
+        },
+    })
 }
 
 /// `x` with the samples of `spans` replaced by the straight line between the unmasked
@@ -548,7 +567,8 @@ pub fn bridged(x: &[f64], spans: &[(usize, usize)]) -> Vec<f64> {
 ///
 /// # Errors
 /// [`CoreError::Io`] when unreadable; the table's errors (a cell that does not parse, a
-/// short row, a duplicate label); [`CoreError::Empty`] for fewer than two rows left.
+/// short row, a duplicate label); [`CoreError::File`] for fewer than two rows left, or
+/// gaps that miss more samples than the record holds.
 pub fn read_record(path: impl AsRef<Path>) -> Result<(Histories, Vec<TimeFault>)> {
     let (text, name) = crate::table::read_text(path.as_ref())?;
     parse_record(&text, &name)
@@ -569,8 +589,12 @@ pub fn parse_record(text: &str, source_name: &str) -> Result<(Histories, Vec<Tim
         }
     }
     if keep.len() < 2 {
-        return Err(CoreError::Empty {
-            what: format!("{source_name}: a record of fewer than two increasing time stamps"),
+        return Err(CoreError::File {
+            file: source_name.to_string(),
+            message: format!(
+                "{} row(s) with increasing time stamps: a record needs at least two",
+                keep.len()
+            ),
         });
     }
     let t: Vec<f64> = keep.iter().map(|&k| times[k]).collect();
@@ -586,6 +610,32 @@ pub fn parse_record(text: &str, source_name: &str) -> Result<(Histories, Vec<Tim
     let h = if uniform {
         Histories::from_channels(labels, cols, mean, t[0], "")?
     } else {
+        // More samples made up across gaps than measured is no longer the record (and a
+        // stray stamp far beyond the rest would allocate without bound).
+        let missing: usize = faults
+            .iter()
+            .map(|f| match f {
+                TimeFault::Gap { missing, .. } => *missing,
+                _ => 0,
+            })
+            .sum();
+        if missing > n {
+            let (from, to) = faults
+                .iter()
+                .find_map(|f| match f {
+                    TimeFault::Gap { from, to, .. } => Some((*from, *to)),
+                    _ => None,
+                })
+                .unwrap_or((t[0], t[n - 1]));
+            return Err(CoreError::File {
+                file: source_name.to_string(),
+                message: format!(
+                    "the time column's gaps (the first from {from} s to {to} s) leave \
+                     {missing} samples missing at the median step against {n} present: \
+                     resampling would make up most of the record; split it at the gap"
+                ),
+            });
+        }
         let (resampled, r) = crate::signal::resample_uniform(&t, &cols)?;
         Histories::from_channels(labels, resampled, r.dt, t[0], "")?
     };

@@ -12,6 +12,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::ar::ArModel;
+use crate::error::{CoreError, Result};
+use crate::signal::Cfc;
+use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 /// Most samples a periodogram is taken on (the direct transform costs `n^2 / 2`).
 pub const MAX_SPECTRUM_SAMPLES: usize = 8192;
@@ -143,77 +146,289 @@ pub fn lines(x: &[f64], dt: f64, alpha: f64, noise: Option<&ArModel>) -> Vec<Lin
     out
 }
 
-/// The noise of a record measured on the frequencies where a model has no content.
+/// Samples of one segment of the band estimate's averaged periodogram
+/// ([`segment_periodogram`]).
+pub const BAND_SEGMENT: usize = 1024;
+
+/// The mean of the Hann periodograms ([`periodogram`]) of `ceil(n / seg)` segments of
+/// `seg = min(n, BAND_SEGMENT)` samples spread evenly from the first sample to the last
+/// (overlapping where `seg` does not divide `n`), ordinates `j = 0 .. seg/2`; and the
+/// number of segments. One segment (the whole record) for `n <= BAND_SEGMENT`.
+pub fn segment_periodogram(x: &[f64]) -> (Vec<f64>, usize) {
+    let n = x.len();
+    let seg = n.min(BAND_SEGMENT);
+    if seg < 4 {
+        return (Vec::new(), 0);
+    }
+    let k = n.div_ceil(seg);
+    let mut sum = vec![0.0; seg / 2 + 1];
+    for i in 0..k {
+        let first = if k == 1 { 0 } else { i * (n - seg) / (k - 1) };
+        for (s, v) in sum.iter_mut().zip(periodogram(&x[first..first + seg])) {
+            *s += v;
+        }
+    }
+    sum.iter_mut().for_each(|v| *v /= k as f64);
+    (sum, k)
+}
+
+/// The noise of a test measured on the band above a model ensemble's bandwidth.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BandNoise {
-    /// The AR(1) noise model fitted on those frequencies (Whittle likelihood).
+    /// Standard deviation of the flat noise before the filter (the record's unit).
+    pub level: f64,
+    /// The noise as compared (after the filter): an AR model by BIC fitted to white noise
+    /// of standard deviation `level` passed through the filter (white itself without one).
     pub model: ArModel,
-    /// Frequencies used (periodogram ordinates).
+    /// The highest ordinate at which a member of the ensemble has content.
+    pub edge: usize,
+    /// The band's first ordinate.
+    pub first: usize,
+    /// Ordinates in the band.
     pub bins: usize,
-    /// Ordinates of the periodogram in all.
+    /// Ordinates of the periodogram in all (`seg / 2`).
     pub of: usize,
+    /// The flatness statistic `Z` of the band (see [`noise_from_band`]): about standard
+    /// normal for flat noise.
+    pub flatness: f64,
+}
+
+/// Why a record has no band to measure its noise on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "reason", rename_all = "kebab-case")]
+pub enum BandRefusal {
+    /// Too few samples for a spectrum.
+    TooShort {
+        /// Samples of the record.
+        samples: usize,
+    },
+    /// A member of the ensemble has content up to within [`MIN_BAND_BINS`] ordinates of
+    /// the top of the usable spectrum.
+    NoFreeBand {
+        /// The highest ordinate with content of a member.
+        edge: usize,
+        /// Ordinates in all.
+        of: usize,
+    },
+    /// The test's spectrum over the band is not flat: content the ensemble lacks, or
+    /// coloured noise, which the band cannot tell apart.
+    NotFlat {
+        /// The band's first ordinate.
+        first: usize,
+        /// The flatness statistic (beyond `+-` [`FLATNESS_LIMIT`]).
+        flatness: f64,
+    },
+    /// A narrow line stands out of the band (a mode the ensemble lacks, or hum).
+    Line {
+        /// Its ordinate.
+        bin: usize,
+        /// Its ratio to the flat level.
+        ratio: f64,
+    },
+}
+
+impl std::fmt::Display for BandRefusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BandRefusal::TooShort { samples } => {
+                write!(f, "{samples} samples are too few for a spectrum")
+            }
+            BandRefusal::NoFreeBand { edge, of } => write!(
+                f,
+                "the model ensemble has content up to ordinate {edge} of {of}: no band above it"
+            ),
+            BandRefusal::NotFlat { first, flatness } => write!(
+                f,
+                "the test's spectrum above ordinate {first} is not flat (statistic {flatness:.1}): \
+                 content the ensemble lacks or coloured noise"
+            ),
+            BandRefusal::Line { bin, ratio } => write!(
+                f,
+                "a line at ordinate {bin} stands {ratio:.0} times above the band's level"
+            ),
+        }
+    }
 }
 
 /// Fewest periodogram ordinates a band estimate is made from.
 pub const MIN_BAND_BINS: usize = 8;
 
-/// The model has no content at an ordinate where its periodogram is below this fraction of
-/// the test's (smoothed over five ordinates).
+/// A member of the ensemble has content at an ordinate where its periodogram reaches this
+/// fraction of the noise's density there.
 pub const MODEL_FREE_RATIO: f64 = 0.05;
 
-/// The noise of `test` from the frequencies where `model` (the same channel, same time base)
-/// has no content: the ordinates `j >= 1` where the model's periodogram is below
-/// [`MODEL_FREE_RATIO`] times the test's (smoothed over five ordinates, so that a chance
-/// high ordinate of the test does not pick itself), and on those an AR(1) density
-/// `S(omega) = sigma_w^2 / (1 - 2 phi cos omega + phi^2)` fitted by the Whittle likelihood
-/// `sum_j ln S(omega_j) + I_j / S(omega_j)` (`phi` on a grid of 0.005 in `[-0.95, 0.95]`,
-/// `sigma_w^2` in closed form); the noise's variance is `sigma_w^2 / (1 - phi^2)`. With
-/// fewer than [`MIN_BAND_BINS`] such ordinates the record has no usable band: `None`.
+/// The band starts this factor above the ensemble's edge.
+pub const BAND_GUARD: f64 = 1.25;
+
+/// Two-sided 1 % limit of the flatness statistic (standard normal).
+pub const FLATNESS_LIMIT: f64 = 2.576;
+
+/// Variance of the mean of `m` Hann periodogram ordinates of white noise, times `m`:
+/// neighbouring ordinates correlate by `|sum w_k^2 e^{2 pi i k / n}|^2 / (sum w_k^2)^2`,
+/// `(2/3)^2` at one ordinate and `(1/6)^2` at two, so `1 + 2 (4/9 + 1/36)`.
+pub const HANN_VARIANCE_FACTOR: f64 = 1.0 + 2.0 * (4.0 / 9.0 + 1.0 / 36.0);
+
+/// Ordinates where the filter's power response is below this are not used (the filter's
+/// stop band, where leakage of the passband's content dominates).
+const STOP_BAND: f64 = 1e-3;
+
+/// The noise of `test` measured on the band above the bandwidth of a model ensemble, for a
+/// test whose noise is flat (white) before the filter `cfc` that both the test and the
+/// members went through (`None`: no filter); `members` are the same channel of every run
+/// of the ensemble on the test's samples, `dt` the step.
 ///
-/// The AR(1) shape is what the band can support: a few high frequencies fix a level and a
-/// slope, not a higher-order spectrum. `test` and `model` must have equal lengths.
-pub fn noise_from_band(test: &[f64], model: &[f64]) -> Option<BandNoise> {
-    if test.len() != model.len() || test.len() < 16 {
-        return None;
+/// Model-form error lives where the model's physics acts: a missing effect reshapes the
+/// response within the bandwidth the model's parameters reach, so the band must lie above
+/// the content of *every* member (not the nominal run alone), where no parameter set of
+/// the model puts anything, and measurement noise is then all that remains. With `T_j` the
+/// test's periodogram ([`segment_periodogram`]), `P_ij` the members', `G_j` the filter's
+/// power response ([`crate::Cfc::power_response`], 1 without one) and the flat level
+/// `s^2`:
+///
+/// 1. starting from the top quarter of the usable ordinates (`G_j >= 1e-3`), `s^2 =
+///    mean_band T_j / G_j` (the Whittle estimate of a known shape); the ensemble's edge
+///    `e` is the highest ordinate where some member reaches `max_i P_ij >=`
+///    [`MODEL_FREE_RATIO`] `s^2 G_j` (a member below it biases `s^2` by less than 5 %);
+///    the band is `ceil(BAND_GUARD e) + 1 ..` the top (a quarter above the edge: content
+///    moved that far beyond every member's would take a structure 1.56 times stiffer than
+///    the stiffest the parameters allow); repeated until the band stays put;
+/// 2. the band must be flat: the normalised ordinates `u_j = T_j / (s^2 G_j)` (mean 1,
+///    variance 1 for flat noise) must not trend with `c_j = cos omega_j`, the score
+///    statistic of an AR(1) colour `phi` at `phi = 0` (`ln S = -ln(1 - 2 phi cos omega +
+///    phi^2)` has slope `2 cos omega` there):
+///    `Z = sum (c_j - c) u_j / sqrt(HANN_VARIANCE_FACTOR sum (c_j - c)^2 / K)` (`c` the mean
+///    of the `c_j`, `K` segments) within `+-` [`FLATNESS_LIMIT`]. Coloured noise, and
+///    content the ensemble lacks just above its edge, raise the band's low end;
+/// 3. and hold no line: no `u_j` above the `1 - 0.01 / m` quantile of `chi^2_{2K} / 2K`
+///    (the mean of `K` exponential ordinates; `ln(m / 0.01)` for one segment), which the
+///    largest of `m` ordinates of flat noise exceeds with probability about 1 %.
+///
+/// The noise as compared is then white noise of standard deviation `s` through the filter;
+/// its AR model (order by BIC, at most 10) is fitted on 16 384 seeded samples of that.
+///
+/// # Errors
+/// The outer error: [`CoreError::DimensionMismatch`] when a member's length differs from
+/// the test's; the filter's errors for a step it cannot serve. The inner one: why there is
+/// no band ([`BandRefusal`]).
+pub fn noise_from_band(
+    test: &[f64],
+    members: &[&[f64]],
+    dt: f64,
+    cfc: Option<Cfc>,
+) -> Result<std::result::Result<BandNoise, BandRefusal>> {
+    if let Some(m) = members.iter().find(|m| m.len() != test.len()) {
+        return Err(CoreError::DimensionMismatch {
+            what: "samples of a member of the ensemble against the test's".into(),
+            expected: test.len(),
+            found: m.len(),
+        });
     }
-    let pt = periodogram(test);
-    let pm = periodogram(model);
-    let n = test.len().min(MAX_SPECTRUM_SAMPLES);
-    let smooth: Vec<f64> = (0..pt.len())
-        .map(|j| {
-            let lo = j.saturating_sub(2);
-            let hi = (j + 2).min(pt.len() - 1);
-            pt[lo..=hi].iter().sum::<f64>() / (hi - lo + 1) as f64
-        })
-        .collect();
-    let bins: Vec<usize> = (1..pt.len())
-        .filter(|&j| pm[j] < MODEL_FREE_RATIO * smooth[j])
-        .collect();
-    if bins.len() < MIN_BAND_BINS {
-        return None;
+    let (pt, k) = segment_periodogram(test);
+    if pt.len() < 2 * MIN_BAND_BINS {
+        return Ok(Err(BandRefusal::TooShort {
+            samples: test.len(),
+        }));
     }
-    let omega = |j: usize| 2.0 * std::f64::consts::PI * j as f64 / n as f64;
-    let mut best: Option<(f64, f64, f64)> = None;
-    for step in -190..=190 {
-        let phi = step as f64 * 0.005;
-        let g = |j: usize| 1.0 / (1.0 - 2.0 * phi * omega(j).cos() + phi * phi);
-        let s2 = bins.iter().map(|&j| pt[j] / g(j)).sum::<f64>() / bins.len() as f64;
-        if s2 <= 0.0 {
-            return None;
+    let seg = test.len().min(BAND_SEGMENT);
+    let of = pt.len() - 1;
+    let omega = |j: usize| 2.0 * std::f64::consts::PI * j as f64 / seg as f64;
+    let gain: Vec<f64> = match cfc {
+        Some(c) => (0..=of)
+            .map(|j| c.power_response(omega(j), dt))
+            .collect::<Result<_>>()?,
+        None => vec![1.0; of + 1],
+    };
+    // Usable: ordinates 1 .. the last above the stop band.
+    let top = (1..=of).rev().find(|&j| gain[j] >= STOP_BAND).unwrap_or(0);
+    if top < 2 * MIN_BAND_BINS {
+        return Ok(Err(BandRefusal::NoFreeBand { edge: top, of }));
+    }
+    // The largest member's ordinate at every frequency.
+    let mut pm = vec![0.0_f64; of + 1];
+    for m in members {
+        for (a, b) in pm.iter_mut().zip(segment_periodogram(m).0) {
+            *a = a.max(b);
         }
-        let nll = bins.len() as f64 * s2.ln() + bins.iter().map(|&j| g(j).ln()).sum::<f64>();
-        if best.is_none_or(|b| nll < b.0) {
-            best = Some((nll, phi, s2));
-        }
     }
-    let (_, phi, s2) = best?;
-    let mut model = ArModel::ar1(phi, (s2 / (1.0 - phi * phi)).sqrt());
-    model.samples = test.len();
-    Some(BandNoise {
+    let level = |first: usize| {
+        (first..=top).map(|j| pt[j] / gain[j]).sum::<f64>() / (top + 1 - first) as f64
+    };
+    let mut first = top + 1 - (top / 4).max(MIN_BAND_BINS);
+    let mut edge = 0;
+    for _ in 0..20 {
+        let s2 = level(first);
+        edge = (1..=top)
+            .rev()
+            .find(|&j| pm[j] >= MODEL_FREE_RATIO * s2 * gain[j])
+            .unwrap_or(0);
+        let next = ((BAND_GUARD * edge as f64).ceil() as usize + 1).max(1);
+        if next + MIN_BAND_BINS > top + 1 {
+            return Ok(Err(BandRefusal::NoFreeBand { edge, of }));
+        }
+        if next == first {
+            break;
+        }
+        first = next;
+    }
+    let s2 = level(first);
+    if s2 <= 0.0 {
+        return Ok(Err(BandRefusal::NoFreeBand { edge, of }));
+    }
+    let u: Vec<f64> = (first..=top).map(|j| pt[j] / (s2 * gain[j])).collect();
+    let m = u.len();
+    let c: Vec<f64> = (first..=top).map(|j| omega(j).cos()).collect();
+    let cm = c.iter().sum::<f64>() / m as f64;
+    let scc: f64 = c.iter().map(|v| (v - cm).powi(2)).sum();
+    let flatness = c.iter().zip(&u).map(|(a, b)| (a - cm) * b).sum::<f64>()
+        / (HANN_VARIANCE_FACTOR * scc / k as f64).sqrt();
+    if flatness.is_nan() || flatness.abs() > FLATNESS_LIMIT {
+        return Ok(Err(BandRefusal::NotFlat { first, flatness }));
+    }
+    // The mean of K exponential ordinates is chi^2_{2K} / 2K: its 1 - 0.01 / m quantile.
+    let line_limit = ChiSquared::new(2.0 * k as f64)
+        .map(|d| d.inverse_cdf(1.0 - 0.01 / m as f64) / (2.0 * k as f64))
+        .unwrap_or(f64::INFINITY);
+    if let Some((i, &r)) = u
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .filter(|(_, r)| **r > line_limit)
+    {
+        return Ok(Err(BandRefusal::Line {
+            bin: first + i,
+            ratio: r,
+        }));
+    }
+    let model = match cfc {
+        None => ArModel::white(s2.sqrt()),
+        Some(c) => filtered_white(s2.sqrt(), dt, c)?,
+    };
+    Ok(Ok(BandNoise {
+        level: s2.sqrt(),
         model,
-        bins: bins.len(),
-        of: pt.len() - 1,
-    })
+        edge,
+        first,
+        bins: m,
+        of,
+        flatness,
+    }))
+}
+
+/// White noise of standard deviation `sigma` through `cfc` at step `dt`, as an AR model by
+/// BIC (order at most [`super::ar::DEFAULT_MAX_ORDER`]) fitted on 16 384 seeded samples.
+///
+/// # Errors
+/// The filter's errors for a step it cannot serve.
+pub fn filtered_white(sigma: f64, dt: f64, cfc: Cfc) -> Result<ArModel> {
+    use rand::SeedableRng;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x0b5e_55ed);
+    let x = ArModel::white(1.0).generate(16_384, &mut rng);
+    let y = cfc.filter(&x, dt, "white reference sequence")?;
+    let mut m = ArModel::fit(&y, super::ar::DEFAULT_MAX_ORDER)?;
+    let scale = sigma * sigma;
+    m.innovation_variance *= scale;
+    m.variance *= scale;
+    Ok(m)
 }
 
 #[cfg(test)]
@@ -246,25 +461,88 @@ mod tests {
         assert!(l[0].mains);
     }
 
-    #[test]
-    fn the_band_fit_recovers_white_and_coloured_noise_above_a_low_pass_signal() {
-        let n = 1000;
-        let signal: Vec<f64> = (0..n)
-            .map(|k| {
-                let t = k as f64 / n as f64;
-                300.0 - 400.0 * t + 50.0 * (2.0 * std::f64::consts::PI * 3.0 * t).sin()
+    /// A low-pass "model" of three modes below 250 Hz at 10 kHz, at stiffness `k`.
+    fn member(k: f64, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let t = i as f64 * 1e-4;
+                [(60.0, 300.0), (140.0, 80.0), (230.0, 30.0)]
+                    .iter()
+                    .map(|(f, a)| {
+                        let w = 2.0 * std::f64::consts::PI * f * k.sqrt();
+                        a * (-0.05 * w * t).exp() * (w * t).sin()
+                    })
+                    .sum::<f64>()
             })
-            .collect();
-        for (phi, seed) in [(0.0, 1), (0.8, 2), (0.5, 3)] {
+            .collect()
+    }
+
+    #[test]
+    fn the_band_measures_flat_noise_and_refuses_colour_and_what_the_ensemble_lacks() {
+        let n = 1000;
+        let members: Vec<Vec<f64>> = (0..9).map(|i| member(0.8 + 0.05 * i as f64, n)).collect();
+        let refs: Vec<&[f64]> = members.iter().map(Vec::as_slice).collect();
+        let truth = member(1.03, n);
+        let with = |noise: &[f64], extra: &dyn Fn(usize) -> f64| -> Vec<f64> {
+            (0..n).map(|i| truth[i] + noise[i] + extra(i)).collect()
+        };
+        let cfc = Cfc::Cfc1000;
+        for seed in 0..10 {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let noise = ArModel::ar1(phi, 2.0).generate(n, &mut rng);
-            let test: Vec<f64> = signal.iter().zip(&noise).map(|(a, b)| a + b).collect();
-            let b = noise_from_band(&test, &signal).unwrap();
-            assert!((b.model.sigma() - 2.0).abs() < 0.2, "phi {phi}: {b:?}");
+            let e = ArModel::white(2.0).generate(n, &mut rng);
+            // Raw: the flat level is the noise's.
+            let b = noise_from_band(&with(&e, &|_| 0.0), &refs, 1e-4, None)
+                .unwrap()
+                .unwrap();
+            assert!((b.model.sigma() / 2.0 - 1.0).abs() < 0.1, "{b:?}");
+            assert!(b.edge < b.first && b.first < b.of / 2, "{b:?}");
+            // Through CFC 1000 (test and members alike): the noise as compared is the
+            // filtered white noise, its standard deviation and lag-one correlation.
+            let f = |x: &[f64]| cfc.filter(x, 1e-4, "x").unwrap();
+            let fe = f(&e);
+            let fm: Vec<Vec<f64>> = members.iter().map(|m| f(m)).collect();
+            let frefs: Vec<&[f64]> = fm.iter().map(Vec::as_slice).collect();
+            let b = noise_from_band(&f(&with(&e, &|_| 0.0)), &frefs, 1e-4, Some(cfc))
+                .unwrap()
+                .unwrap();
+            let sd = (fe.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
+            assert!((b.model.sigma() / sd - 1.0).abs() < 0.15, "{b:?} {sd}");
+            assert!((b.model.lag1() - super::super::ar::lag1(&fe)).abs() < 0.1);
+            // A mode the ensemble lacks inside its bandwidth (at 180 Hz) changes nothing.
+            let inside =
+                |i: usize| 60.0 * (2.0 * std::f64::consts::PI * 180.0 * i as f64 * 1e-4).sin();
+            let c = noise_from_band(&with(&e, &inside), &refs, 1e-4, None)
+                .unwrap()
+                .unwrap();
+            assert!((c.model.sigma() / 2.0 - 1.0).abs() < 0.1, "{c:?}");
+            // One just above the ensemble's edge (a decaying 1.2 kHz ring the ensemble lacks)
+            // is not noise: refused.
+            let above = |i: usize| {
+                let t = i as f64 * 1e-4;
+                20.0 * (-t / 0.02).exp() * (2.0 * std::f64::consts::PI * 1200.0 * t).sin()
+            };
+            let r = noise_from_band(&with(&e, &above), &refs, 1e-4, None).unwrap();
             assert!(
-                (b.model.coefficients[0] - phi).abs() < 0.1,
-                "phi {phi}: {b:?}"
+                matches!(
+                    r,
+                    Err(BandRefusal::NotFlat { .. } | BandRefusal::Line { .. })
+                ),
+                "{r:?}"
             );
+            // AR(1) noise of lag-one correlation 0.8 is not flat: refused.
+            let red = ArModel::ar1(0.8, 2.0).generate(n, &mut rng);
+            let r = noise_from_band(&with(&red, &|_| 0.0), &refs, 1e-4, None).unwrap();
+            assert!(matches!(r, Err(BandRefusal::NotFlat { .. })), "{r:?}");
         }
+        // A noiseless test from the model: no band (the ensemble has content wherever the
+        // test has).
+        let r = noise_from_band(&truth, &refs, 1e-4, None).unwrap();
+        assert!(matches!(r, Err(BandRefusal::NoFreeBand { .. })), "{r:?}");
+        // Members of another length are an error of the caller.
+        assert!(noise_from_band(&truth, &[&truth[..10]], 1e-4, None).is_err());
+        assert!(matches!(
+            noise_from_band(&truth[..20], &[&truth[..20]], 1e-4, None).unwrap(),
+            Err(BandRefusal::TooShort { .. })
+        ));
     }
 }
