@@ -668,7 +668,7 @@ impl Judge<'_> {
                 k += 1.0;
             }
         }
-        let m1_exceedance = agreement::m1_exceedance(
+        let m1 = agreement::m1_exceedance(
             frame,
             y,
             terms,
@@ -688,7 +688,9 @@ impl Judge<'_> {
             chi2_red: det.chi2_red,
             sprague_geers_c: if k > 0.0 { sg / k } else { f64::NAN },
             iso18571_r: if k > 0.0 { r / k } else { f64::NAN },
-            m1_exceedance,
+            m1_exceedance: m1.exceedance_fraction,
+            m1_expected: m1.expected_exceedance,
+            m1_probability: m1.probability,
             m2_above_0_9: m2.map(|m| m.0),
             m2_shapes: m2.map_or(0, |m| m.1),
         })
