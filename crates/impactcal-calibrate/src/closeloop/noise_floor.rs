@@ -199,20 +199,7 @@ pub(crate) fn weights(floor: &NoiseFloor, spread: &[f64], samples: usize) -> Vec
 /// Standard deviation and lag-one autocorrelation of `x` after removing a fitted line.
 fn detrended(x: &[f64]) -> (f64, f64) {
     let n = x.len() as f64;
-    let tm = (n - 1.0) / 2.0;
-    let xm = x.iter().sum::<f64>() / n;
-    let (mut stx, mut stt) = (0.0, 0.0);
-    for (k, v) in x.iter().enumerate() {
-        let t = k as f64 - tm;
-        stx += t * (v - xm);
-        stt += t * t;
-    }
-    let slope = if stt > 0.0 { stx / stt } else { 0.0 };
-    let e: Vec<f64> = x
-        .iter()
-        .enumerate()
-        .map(|(k, v)| v - xm - slope * (k as f64 - tm))
-        .collect();
+    let e = impactcal_core::quality::spectrum::detrended(x);
     let var = e.iter().map(|v| v * v).sum::<f64>() / (n - 2.0).max(1.0);
     let c1 = e.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / (n - 1.0).max(1.0);
     let r = if var > 0.0 { c1 / var } else { 0.0 };
