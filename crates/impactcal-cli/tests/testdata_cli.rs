@@ -1,6 +1,7 @@
-//! End-to-end tests of `impactcal convert`, `filter`, `metrics` and `check` on the ISO-MME sets written
-//! by pyisomme (the core crate's fixtures) and on small CSV files, including the bad input a
-//! user produces: each gives one line on stderr and exit code 2.
+//! End-to-end tests of `impactcal convert`, `filter`, `metrics` and `check` on the ISO-MME
+//! sets written by pyisomme (the core crate's fixtures), the real-data excerpts and small CSV
+//! files, including the bad input a user produces: each gives one line on stderr and exit
+//! code 2.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
