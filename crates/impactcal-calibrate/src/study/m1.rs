@@ -49,10 +49,10 @@ use crate::error::{CalibrateError, Result};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Verdict {
-    /// `Q_e` leaves the envelope no further than a draw of the model may.
+    /// `Q_e` leaves the envelope no more often than a draw of the model may.
     CanExplain,
-    /// `Q_e` leaves the envelope further than every draw of the model: probability of
-    /// reconciling `1 / (N + 1)`.
+    /// `Q_e` leaves the envelope more often than a draw of the model does with a
+    /// probability of `1 / (N + 1)` (see the module docs).
     CannotExplain,
 }
 
