@@ -213,16 +213,16 @@ pub fn lag1(x: &[f64]) -> f64 {
 
 /// Autocorrelations `rho_0 .. rho_h` of the AR process with coefficients `phi`.
 fn autocorrelations_of(phi: &[f64], h: usize) -> Vec<f64> {
-    // Solve the Yule-Walker system by iterating the recursion on a long simulated
-    // impulse response would be costly; for the lags needed here use the step-down
-    // relation on the truncated system, exact for p <= 1 and accurate for larger p.
+    // From the impulse response psi of the causal filter, truncated where it has decayed
+    // (2000 samples, 200 per order at least: |psi| falls as the largest root's modulus to
+    // that power).
     let p = phi.len();
     if p == 0 {
         let mut r = vec![0.0; h + 1];
         r[0] = 1.0;
         return r;
     }
-    // Impulse response psi_j; rho_k = sum psi_j psi_{j+k} / sum psi_j^2.
+    // rho_k = sum psi_j psi_{j+k} / sum psi_j^2.
     let len = 2000.max(200 * p);
     let mut psi = vec![0.0; len];
     psi[0] = 1.0;
