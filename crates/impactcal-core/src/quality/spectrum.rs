@@ -202,11 +202,14 @@ pub enum BandRefusal {
         /// Samples of the record.
         samples: usize,
     },
-    /// A member of the ensemble has content up to within [`MIN_BAND_BINS`] ordinates of
-    /// the top of the usable spectrum.
+    /// Fewer than [`MIN_BAND_BINS`] ordinates lie between a quarter above the highest
+    /// content of a member and the top of the usable spectrum (the filter's stop band).
     NoFreeBand {
         /// The highest ordinate with content of a member.
         edge: usize,
+        /// The highest usable ordinate (above it the filter's power response is below
+        /// `1e-3`).
+        top: usize,
         /// Ordinates in all.
         of: usize,
     },
@@ -233,9 +236,10 @@ impl std::fmt::Display for BandRefusal {
             BandRefusal::TooShort { samples } => {
                 write!(f, "{samples} samples are too few for a spectrum")
             }
-            BandRefusal::NoFreeBand { edge, of } => write!(
+            BandRefusal::NoFreeBand { edge, top, of } => write!(
                 f,
-                "the model ensemble has content up to ordinate {edge} of {of}: no band above it"
+                "the model ensemble has content above the noise up to ordinate {edge} of {of}, \
+                 and the filter passes up to ordinate {top}: no band between"
             ),
             BandRefusal::NotFlat { first, flatness } => write!(
                 f,
@@ -341,7 +345,7 @@ pub fn noise_from_band(
     // Usable: ordinates 1 .. the last above the stop band.
     let top = (1..=of).rev().find(|&j| gain[j] >= STOP_BAND).unwrap_or(0);
     if top < 2 * MIN_BAND_BINS {
-        return Ok(Err(BandRefusal::NoFreeBand { edge: top, of }));
+        return Ok(Err(BandRefusal::NoFreeBand { edge: top, top, of }));
     }
     // The largest member's ordinate at every frequency.
     let mut pm = vec![0.0_f64; of + 1];
@@ -363,7 +367,7 @@ pub fn noise_from_band(
             .unwrap_or(0);
         let next = ((BAND_GUARD * edge as f64).ceil() as usize + 1).max(1);
         if next + MIN_BAND_BINS > top + 1 {
-            return Ok(Err(BandRefusal::NoFreeBand { edge, of }));
+            return Ok(Err(BandRefusal::NoFreeBand { edge, top, of }));
         }
         if next == first {
             break;
@@ -372,7 +376,7 @@ pub fn noise_from_band(
     }
     let s2 = level(first);
     if s2 <= 0.0 {
-        return Ok(Err(BandRefusal::NoFreeBand { edge, of }));
+        return Ok(Err(BandRefusal::NoFreeBand { edge, top, of }));
     }
     let u: Vec<f64> = (first..=top).map(|j| pt[j] / (s2 * gain[j])).collect();
     let m = u.len();
