@@ -202,6 +202,14 @@ pub enum BandRefusal {
         /// Samples of the record.
         samples: usize,
     },
+    /// The filter passes fewer than twice [`MIN_BAND_BINS`] ordinates: no room for a band
+    /// above any content.
+    Filtered {
+        /// The highest ordinate the filter passes (power response at least `1e-3`).
+        top: usize,
+        /// Ordinates in all.
+        of: usize,
+    },
     /// Fewer than [`MIN_BAND_BINS`] ordinates lie between a quarter above the highest
     /// content of a member and the top of the usable spectrum (the filter's stop band).
     NoFreeBand {
@@ -236,6 +244,10 @@ impl std::fmt::Display for BandRefusal {
             BandRefusal::TooShort { samples } => {
                 write!(f, "{samples} samples are too few for a spectrum")
             }
+            BandRefusal::Filtered { top, of } => write!(
+                f,
+                "the filter passes only ordinates up to {top} of {of}: too few for a band"
+            ),
             BandRefusal::NoFreeBand { edge, top, of } => write!(
                 f,
                 "the model ensemble has content above the noise up to ordinate {edge} of {of}, \
@@ -345,7 +357,7 @@ pub fn noise_from_band(
     // Usable: ordinates 1 .. the last above the stop band.
     let top = (1..=of).rev().find(|&j| gain[j] >= STOP_BAND).unwrap_or(0);
     if top < 2 * MIN_BAND_BINS {
-        return Ok(Err(BandRefusal::NoFreeBand { edge: top, top, of }));
+        return Ok(Err(BandRefusal::Filtered { top, of }));
     }
     // The largest member's ordinate at every frequency.
     let mut pm = vec![0.0_f64; of + 1];
