@@ -314,6 +314,7 @@ fn build_model(config: &Config, base: &Path, name: &str) -> Result<LoopModel, Cl
                     data: config.test.data.clone(),
                     map: config.test.map.clone(),
                     cfc: config.test.cfc,
+                    sigma: config.test.sigma,
                 },
                 study: StudyOptions::default(),
             };

@@ -58,6 +58,46 @@ struct Summary<'a> {
     relative_l2_holdout: Option<[f64; 3]>,
     runs: usize,
     reveal: &'a [Reveal],
+    noise: NoiseReveal,
+}
+
+/// The loop's noise floor against the noise the test hid.
+#[derive(Debug, Serialize)]
+struct NoiseReveal {
+    /// Per channel: the label, the hidden noise's standard deviation after the filter,
+    /// the loop's estimate, its source.
+    channels: Vec<(String, f64, f64, String)>,
+    /// Estimate over hidden: least, median, largest.
+    ratio: [f64; 3],
+    /// The final reduced chi-square of the loop.
+    chi2_red_final: f64,
+}
+
+fn noise_reveal(r: &LoopResult, channels: &[String], hidden: &[f64]) -> NoiseReveal {
+    let per: Vec<(String, f64, f64, String)> = channels
+        .iter()
+        .zip(hidden)
+        .filter_map(|(l, h)| {
+            r.noise_floor
+                .channels
+                .iter()
+                .find(|c| &c.label == l)
+                .map(|c| (l.clone(), *h, c.sigma, format!("{:?}", c.source)))
+        })
+        .collect();
+    let mut q: Vec<f64> = per.iter().map(|(_, h, e, _)| e / h).collect();
+    q.sort_by(f64::total_cmp);
+    let ratio = if q.is_empty() {
+        [f64::NAN; 3]
+    } else {
+        [q[0], q[q.len() / 2], q[q.len() - 1]]
+    };
+    let chi2_red_final = r.detection_final.chi2_red;
+    NoiseReveal {
+        channels: per,
+        ratio,
+        chi2_red_final,
+    }
 }
 
 /// The `count` vertical channels of `h` with the largest standard deviation after filtering,
@@ -111,6 +151,38 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         Ok(measured(&h.select(&channels)?, &m)?)
     };
     let (test, holdout) = (measure(&y, 1)?, measure(&yh, 2)?);
+    // The noise as the loop compares it: the test less its noiseless self, through the
+    // loop's filter; its standard deviation per channel.
+    let noiseless = measured(
+        &y.select(&channels)?,
+        &Measurement {
+            time_shift: TRIGGER_OFFSET,
+            gains: vec![(wrong.clone(), args.gain)],
+            ..Measurement::default()
+        },
+    )?;
+    let hidden = Histories::from_channels(
+        channels.clone(),
+        (0..channels.len())
+            .map(|c| {
+                test.channel(c)
+                    .iter()
+                    .zip(noiseless.channel(c))
+                    .map(|(a, b)| a - b)
+                    .collect()
+            })
+            .collect(),
+        test.dt(),
+        test.start(),
+        test.unit(),
+    )?
+    .filtered(Cfc::from_class(CFC)?)?;
+    let hidden_sd: Vec<f64> = (0..channels.len())
+        .map(|c| {
+            let e = hidden.channel(c);
+            (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt()
+        })
+        .collect();
     test.write_csv(args.out.join("test.csv"))?;
     holdout.write_csv(args.out.join("holdout.csv"))?;
 
@@ -151,7 +223,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         })
         .map_err(|e| e.context("demo --close-loop"))?;
 
-    let reveal = reveal(&result, &wrong, args.gain);
+    let noise = noise_reveal(&result, &channels, &hidden_sd);
+    let reveal = reveal(&result, &wrong, args.gain, &noise);
     let mut doc = report(&result);
     doc.title = "Closed loop on the coarse airframe: a test with hidden damping".into();
     doc.sections.push(reveal_section(&reveal));
@@ -174,6 +247,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             .map(|h| [h.nominal, h.calibrated, h.enriched]),
         runs: result.runs,
         reveal: &reveal,
+        noise,
     };
     let json = serde_json::to_string_pretty(&summary)
         .map_err(|e| CliError::failure(format!("cannot encode the summary: {e}")))?;
@@ -192,7 +266,7 @@ fn verdict(r: &LoopResult) -> &'static str {
 }
 
 /// What was hidden beside what the loop found.
-fn reveal(r: &LoopResult, wrong: &str, gain: f64) -> Vec<Reveal> {
+fn reveal(r: &LoopResult, wrong: &str, gain: f64, noise: &NoiseReveal) -> Vec<Reveal> {
     let damping = r.added.iter().find(|a| a.name == "damping").map_or_else(
         || match r.candidates.iter().position(|c| c.name == "damping") {
             Some(k) => format!(
@@ -205,8 +279,6 @@ fn reveal(r: &LoopResult, wrong: &str, gain: f64) -> Vec<Reveal> {
         },
         |a| format!("{:.4} [{:.4}, {:.4}]", a.value, a.lower, a.upper),
     );
-    let floor: Vec<f64> = r.noise_floor.channels.iter().map(|c| c.sigma).collect();
-    let mean_floor = floor.iter().sum::<f64>() / floor.len().max(1) as f64;
     let mut rows = vec![
         Reveal {
             quantity: "damping (1/s), the model holds 0".into(),
@@ -247,8 +319,16 @@ fn reveal(r: &LoopResult, wrong: &str, gain: f64) -> Vec<Reveal> {
         },
         Reveal {
             quantity: "measurement noise".into(),
-            hidden: format!("white, {SNR_DB} dB (1 % of each channel's RMS)"),
-            found: format!("noise floor sigma, mean over channels {mean_floor:.4}"),
+            hidden: format!("white, {SNR_DB} dB (1 % of each channel's RMS), after CFC {CFC}"),
+            found: format!(
+                "noise floor over the noise hidden: {:.2} to {:.2} (median {:.2}); sources {}; \
+                 final chi2_red {:.3}",
+                noise.ratio[0],
+                noise.ratio[2],
+                noise.ratio[1],
+                sources(r),
+                noise.chi2_red_final
+            ),
         },
     ];
     for (name, v) in &r.calibrated {
@@ -261,6 +341,28 @@ fn reveal(r: &LoopResult, wrong: &str, gain: f64) -> Vec<Reveal> {
         }
     }
     rows
+}
+
+/// The noise floor's sources with how many channels each, and the band's first refusal.
+fn sources(r: &LoopResult) -> String {
+    let mut count = std::collections::BTreeMap::new();
+    for c in &r.noise_floor.channels {
+        *count.entry(format!("{:?}", c.source)).or_insert(0) += 1;
+    }
+    let mut s = count
+        .iter()
+        .map(|(k, n)| format!("{k} x {n}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if let Some(why) = r
+        .noise_floor
+        .channels
+        .iter()
+        .find_map(|c| c.band_refusal.as_ref())
+    {
+        s.push_str(&format!(" (band refused: {why})"));
+    }
+    s
 }
 
 /// Whether `g` is within 5 % of a factor the loop flags as a units error.

@@ -5,6 +5,7 @@
 
 mod airframe;
 mod batch;
+mod check;
 mod close_loop;
 mod compare;
 mod convert;
@@ -69,6 +70,10 @@ enum Command {
     Sobol(sobol::Args),
     /// Measured data (an ISO-MME data set, or CSV on a non-uniform time base) into wide CSV.
     Convert(convert::Args),
+    /// The quality of a measured record: offsets, noise (level, colour, AR model, lines),
+    /// clipped runs, spikes, drift of accelerations, gaps; JSON, one line per finding on
+    /// stderr.
+    Check(check::Args),
     /// SAE J211 / ISO 6487 channel frequency class filter (CFC 60, 180, 600, 1000).
     Filter(filter::Args),
     /// Curve metrics of a model against a test: relative L2, RMS, peak, Sprague-Geers,
@@ -114,6 +119,7 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Sobol(a) => sobol::run(a),
         Command::Airframe(a) => airframe::run(a),
         Command::Convert(a) => convert::run(a),
+        Command::Check(a) => check::run(a),
         Command::Filter(a) => filter::run(a),
         Command::Metrics(a) => metrics::run(a),
         Command::Study(a) => study::run(a),

@@ -18,7 +18,7 @@ pub struct Args {
     /// Analysis (model) histories in wide CSV.
     #[arg(long)]
     pub analysis: PathBuf,
-    /// Channel map `test_label,model_label[,gain]` (default: pair equal labels).
+    /// Channel map `test_label,model_label[,gain[,conversion]]` (default: pair equal labels).
     #[arg(long)]
     pub map: Option<PathBuf>,
     /// Channel frequency class applied to both sides before comparing: 60, 180, 600 or 1000.
@@ -38,10 +38,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some(r) = &record.resampling {
         eprintln!("note: {}: {r}", args.test.display());
     }
-    let test = record.histories;
     let model = Histories::read_csv(&args.analysis)?;
-    let pairs = match &args.map {
-        Some(path) => ChannelPair::from_map(&ChannelMap::read(path)?, &test, &model)?,
+    let map = args.map.as_ref().map(ChannelMap::read).transpose()?;
+    // The map's conversions (bridges, accelerometers, units) turn raw channels into SI.
+    let test = match &map {
+        Some(m) => m.convert(&record.histories)?,
+        None => record.histories,
+    };
+    let pairs = match &map {
+        Some(m) => ChannelPair::from_map(m, &test, &model)?,
         None => ChannelPair::by_label(&test, &model)?,
     };
     let window = args.window.as_deref().map(parse_window).transpose()?;

@@ -16,6 +16,7 @@
 //! data = "test.csv"              # wide CSV, or an ISO-MME data set
 //! map = "map.csv"                # optional
 //! cfc = 60                       # optional
+//! sigma = 0.5                    # optional: measurement noise (else measured)
 //!
 //! [study]
 //! ensemble = 50
@@ -148,6 +149,9 @@ pub struct TestConfig {
     pub map: Option<PathBuf>,
     /// CFC class applied to test and runs.
     pub cfc: Option<u32>,
+    /// Measurement noise standard deviation of every channel (after the filter); default:
+    /// measured on the test.
+    pub sigma: Option<f64>,
 }
 
 /// A model built from a study file, ready to run.
@@ -181,9 +185,13 @@ pub struct Setup {
 pub fn run(args: Args) -> Result<(), CliError> {
     let (config, name) = read_config(&args.config)?;
     let base = args.config.parent().unwrap_or(Path::new("."));
+    let mut study = config.study.clone();
+    if config.test.sigma.is_some() {
+        study.sigma = config.test.sigma;
+    }
     let options = StudyOptions {
         max_memory: args.max_memory,
-        ..config.study.clone()
+        ..study
     }
     .check()
     .map_err(|e| CliError::from(e).context(&name))?;

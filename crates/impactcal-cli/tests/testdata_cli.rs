@@ -1,6 +1,7 @@
-//! End-to-end tests of `impactcal convert`, `filter` and `metrics` on the ISO-MME sets written
-//! by pyisomme (the core crate's fixtures) and on small CSV files, including the bad input a
-//! user produces: each gives one line on stderr and exit code 2.
+//! End-to-end tests of `impactcal convert`, `filter`, `metrics` and `check` on the ISO-MME
+//! sets written by pyisomme (the core crate's fixtures), the real-data excerpts and small CSV
+//! files, including the bad input a user produces: each gives one line on stderr and exit
+//! code 2.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
@@ -331,4 +332,90 @@ fn bad_input_is_one_line_and_exit_2() {
         ],
         "T13.chn: line 3: names `Channel/T13.002`",
     );
+}
+
+/// A file of the repository's real-data excerpts (`tests/data/`).
+fn real(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data")
+        .join(rel)
+}
+
+#[test]
+fn check_reports_a_real_record_in_the_documented_json_and_one_line_per_finding() {
+    let dir = tempfile::tempdir().unwrap();
+    // The drop tower's test 4 excerpt: board 4 clipped at its negative rail for two samples.
+    let path = real("droptower/test4_excerpt.csv");
+    let out = impactcal(&["check", "--test", s(&path), "--pre-trigger", "3.5e-4"]);
+    let q = json(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    let channels = q["channels"].as_array().unwrap();
+    assert_eq!(channels.len(), 6);
+    for c in channels {
+        for key in [
+            "offset",
+            "noise_std",
+            "lag1",
+            "white",
+            "clipped",
+            "spikes",
+            "drift",
+        ] {
+            assert!(c.get(key).is_some(), "{key} missing in {c}");
+        }
+    }
+    let board4 = channels.iter().find(|c| c["label"] == "accel_4").unwrap();
+    let clip = board4["clipped"][0].as_array().unwrap();
+    assert!((clip[2].as_f64().unwrap() + 71.5605456679512).abs() < 1e-9);
+    assert_eq!(board4["white"], false);
+    // One line per finding, each naming the file and the channel.
+    assert!(err.lines().all(|l| l.starts_with(s(&path))), "{err}");
+    assert_eq!(
+        err.lines()
+            .filter(|l| l.contains("accel_4: clipped at -7.156055e1"))
+            .count(),
+        1,
+        "{err}"
+    );
+    // The Los Alamos Kolsky layout, written to a file.
+    let kolsky = real("kolsky/cu_excerpt.raw");
+    let json_path = dir.path().join("q.json");
+    let out = impactcal(&["check", "--test", s(&kolsky), "--out", s(&json_path)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let q: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    assert_eq!(q["channels"][1]["label"], "transmitted");
+}
+
+#[test]
+fn check_refuses_bad_records_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let test = pulses(dir.path(), "t.csv", 0.0, 400, 1.0);
+    bad_input(
+        &["check", "--test", s(&test), "--pre-trigger", "NaN"],
+        "must be a finite time",
+    );
+    bad_input(
+        &["check", "--test", s(&test), "--pre-trigger", "0.001"],
+        "at least 32 are needed",
+    );
+    bad_input(
+        &["check", "--test", s(&test), "--acceleration", "a,z"],
+        "`z` is not a channel",
+    );
+    let far = dir.path().join("far.csv");
+    let mut text = String::from("time,a\n");
+    for k in 0..100 {
+        text.push_str(&format!("{},{}\n", k as f64 * 1e-6, k % 3));
+    }
+    text.push_str("1000,1\n");
+    std::fs::write(&far, text).unwrap();
+    bad_input(&["check", "--test", s(&far)], "split it at the gap");
+    let raw = dir.path().join("bad.raw");
+    std::fs::write(&raw, "a\tb\tc\n").unwrap();
+    bad_input(&["check", "--test", s(&raw)], "row 1, column 4");
 }

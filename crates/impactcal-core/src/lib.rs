@@ -10,6 +10,9 @@
 //!   channel maps from test to model labels.
 //! - [`signal`]: SAE J211 / ISO 6487 CFC filters, interpolation of model histories onto test
 //!   time points, resampling and cropping.
+//! - [`quality`]: checks of measured data before it is used (offsets, coloured noise and its
+//!   AR model, mains lines, clipping, spikes, drift, gaps), the masks that keep faulty
+//!   samples out of every residual, and the noise level from a band a model leaves empty.
 //! - [`Model`]: a parameter vector in, histories out, with parallel batch evaluation.
 //! - [`noise`]: the noise a model produces on its own, measured with a jitter ensemble
 //!   ([`SimulationNoise`]: spread per channel and time, predictability horizons).
@@ -46,6 +49,7 @@ pub mod histories;
 pub mod model;
 pub mod noise;
 pub mod points;
+pub mod quality;
 pub mod samples;
 pub mod sampling;
 pub mod signal;

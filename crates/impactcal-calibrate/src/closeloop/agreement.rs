@@ -49,9 +49,11 @@ pub(crate) struct Posterior<'a> {
     pub inflation: f64,
 }
 
-/// The fraction of samples at which the test (nuisance terms `terms` taken out) leaves the
-/// M1 envelope of `members` predictive draws about the model response `y` (`S x T`); see
-/// the module docs. Deterministic for a given `seed`.
+/// M1 of the test (nuisance terms `terms` taken out) against the envelope of `members`
+/// predictive draws about the model response `y` (`S x T`); see the module docs: the
+/// observed exceedance, the expected one `2 / (N + 1)` (the draws carry the noise), the
+/// probability and the verdict as the study judges them ([`m1::m1`]). Deterministic for a
+/// given `seed`.
 ///
 /// # Errors
 /// [`crate::CalibrateError::Study`] when `members` is zero.
@@ -62,7 +64,7 @@ pub(crate) fn m1_exceedance(
     posterior: Option<Posterior<'_>>,
     members: usize,
     seed: u64,
-) -> Result<f64> {
+) -> Result<m1::M1> {
     let t = frame.samples;
     let lsq = posterior.map(|p| (p.jac, p.inflation.sqrt()));
     let scale: Vec<f64> = frame
@@ -97,7 +99,7 @@ pub(crate) fn m1_exceedance(
         .collect();
     let time: Vec<f64> = (0..t).map(|k| k as f64 * frame.dt).collect();
     let test = nuisance::corrected_test(frame, terms);
-    Ok(m1::m1(&time, &runs, &norm_history_of(&test, t))?.exceedance_fraction)
+    m1::m1(&time, &runs, &norm_history_of(&test, t))
 }
 
 /// M2 of the model response `y` against the test (nuisance terms taken out): the number of
@@ -170,24 +172,31 @@ mod tests {
             })
             .collect();
         let f = frame(test, sigma);
-        let inside = m1_exceedance(&f, &y, &unit_terms(), None, 199, 1).unwrap();
+        let inside = m1_exceedance(&f, &y, &unit_terms(), None, 199, 1)
+            .unwrap()
+            .exceedance_fraction;
         // Expected 2/(N+1) = 1 % of the samples; allow for chance.
         assert!(inside < 0.05, "{inside}");
         // The noiseless model itself: Q_e at the centre, inside wherever the signal is
         // far above the noise (every sample here but where both channels cross zero).
         let own = m1_exceedance(&frame(y.clone(), sigma), &y, &unit_terms(), None, 199, 1);
-        assert!(own.unwrap() < 0.05);
+        assert!(own.unwrap().exceedance_fraction < 0.05);
         // A test 10 % larger than the model leaves the envelope almost everywhere.
         let scaled = frame(y.iter().map(|v| 1.1 * v).collect(), sigma);
         let out = m1_exceedance(&scaled, &y, &unit_terms(), None, 199, 1).unwrap();
-        assert!(out > 0.8, "{out}");
+        assert!(out.exceedance_fraction > 0.8, "{}", out.statement);
+        // Far more often than the 1 % a draw of the ensemble leaves it: cannot-explain.
+        assert!((out.expected_exceedance - 0.01).abs() < 1e-12);
+        assert!(out.probability < 1.0 / 200.0, "{}", out.statement);
+        assert_eq!(out.verdict, m1::Verdict::CannotExplain);
         // With the gain profiled (1.1 on both channels) the same test is back inside.
         let terms = Terms {
             gains: vec![1.1, 1.1],
             ..unit_terms()
         };
         let back = m1_exceedance(&scaled, &y, &terms, None, 199, 1).unwrap();
-        assert!(back < 0.05, "{back}");
+        assert!(back.exceedance_fraction < 0.05, "{}", back.statement);
+        assert_eq!(back.verdict, m1::Verdict::CanExplain);
     }
 
     #[test]

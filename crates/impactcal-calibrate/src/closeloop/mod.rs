@@ -7,8 +7,10 @@
 //!    per channel, `test_s(t) = g_s y_s(t - tau) + b_s`, profiled out of every comparison
 //!    and never offered as physics; gains near a units factor are flagged.
 //! 2. **Noise floor** ([`noise_floor`]): measurement noise per channel (given, pre-impact
-//!    window, or the band above the model's bandwidth) and the model's own simulation noise
-//!    from a jitter ensemble, combined in quadrature into the whitening weights.
+//!    window, or the frequencies where the model has no content) and the model's own
+//!    simulation noise from a jitter ensemble, combined in quadrature into the whitening
+//!    weights; the masks of `core::quality` (clipped runs, spikes) give zero weight
+//!    (`study::channels::prepared_test`); the test's offsets are the biases of step 1.
 //! 3. **Calibration**: CORS-RBF then a Gauss-Newton polish to a least-squares
 //!    optimum.
 //! 4. **Detection** ([`detection`]): reduced chi-square in effective samples, whiteness,
@@ -77,7 +79,7 @@ use crate::error::{CalibrateError, Result};
 use crate::memory::Guard;
 use crate::metrics::{CurveMetrics, Iso18571};
 use crate::study::TestData;
-use crate::study::channels::test_on_model;
+use crate::study::channels::prepared_test;
 use crate::study::execute::{Observer, Worker};
 
 pub use attribution::{Amplitude, Attribution, Score};
@@ -211,7 +213,9 @@ pub fn run_loop_on<M: Enrichable>(
         .stage(model, "nominal", std::slice::from_ref(&nominal))?
         .histories(0, "the nominal run")?;
     check_covered(test.histories, test.map, &nominal_raw, "test")?;
-    let test_m = test_on_model(test.histories, test.map, test.cfc, &nominal_raw)?;
+    // The offsets stay: the nuisance terms fit a bias per channel on every sample.
+    let (test_m, masks, preparation) =
+        prepared_test(test.histories, test.map, test.cfc, &nominal_raw, None)?;
     let labels = test_m.labels().to_vec();
     let samples = test_m.samples();
     let dt = test_m.dt();
@@ -264,18 +268,20 @@ pub fn run_loop_on<M: Enrichable>(
         "noise",
     )?;
     let y_nominal = prep(&nominal_raw)?;
-    let (frame, floor) = frame_of(
+    let (mut frame, floor) = frame_of(
         &labels,
         test_m.data(),
         samples,
         dt,
         &y_nominal,
+        &model_noise,
         &spread,
         max_shift,
         options,
-        band,
+        (test.cfc, band),
         unit_gains.as_deref(),
     )?;
+    masked_out(&mut frame, &masks);
     let ctx = Ctx {
         frame,
         cfc: test.cfc,
@@ -414,7 +420,8 @@ pub fn run_loop_on<M: Enrichable>(
                 )?
                 .histories(0, "the holdout's nominal run")?;
             check_covered(h.histories, test.map, &nominal_h, "holdout")?;
-            let test_h = test_on_model(h.histories, test.map, test.cfc, &nominal_h)?;
+            let (test_h, masks_h, _) =
+                prepared_test(h.histories, test.map, test.cfc, &nominal_h, None)?;
             let calibrated_h = runner
                 .at(h.set)
                 .stage(
@@ -431,7 +438,7 @@ pub fn run_loop_on<M: Enrichable>(
                     std::slice::from_ref(&fit.point),
                 )?
                 .histories(0, "the holdout's enriched run")?;
-            let (spread_h, _) = model_spread(
+            let (spread_h, model_noise_h) = model_spread(
                 runner.at(h.set),
                 &declared_at,
                 &nominal,
@@ -443,18 +450,20 @@ pub fn run_loop_on<M: Enrichable>(
             )?;
             let y_nom_h = prep(&nominal_h)?;
             let gains: Vec<f64> = fit.terms.gains.clone();
-            let (frame_h, floor_h) = frame_of(
+            let (mut frame_h, floor_h) = frame_of(
                 &labels,
                 test_h.data(),
                 test_h.samples(),
                 dt,
                 &y_nom_h,
+                &model_noise_h,
                 &spread_h,
                 max_shift,
                 options,
-                band,
+                (test.cfc, band),
                 Some(&gains),
             )?;
+            masked_out(&mut frame_h, &masks_h);
             let profile = |y: &[f64]| nuisance::profile(y, &frame_h, max_shift, Some(&gains)).0;
             let ys = [y_nom_h, prep(&calibrated_h)?, prep(&enriched_h)?];
             let judge = Judge {
@@ -490,6 +499,7 @@ pub fn run_loop_on<M: Enrichable>(
         detection: det0,
         nuisance: fit.terms.report(&labels, options.units_tolerance),
         noise_floor: floor,
+        test_preparation: preparation,
         candidates: outcome.rounds[0]
             .attribution
             .as_ref()
@@ -571,7 +581,11 @@ fn model_spread<M: Model>(
     Ok((noise.spread.concat(), draws))
 }
 
-/// The whitened frame of a test and its noise floor.
+/// The whitened frame of a test and its noise floor. The nominal run `y_nominal` and the
+/// jitter runs of `model_noise` (read one at a time, only when a channel's noise comes
+/// from the band) are the model ensemble whose bandwidth bounds the noise's band;
+/// `filters` the test's CFC (the one the test and the runs went through) and the class of
+/// the high band.
 #[allow(clippy::too_many_arguments)]
 fn frame_of(
     labels: &[String],
@@ -579,10 +593,11 @@ fn frame_of(
     samples: usize,
     dt: f64,
     y_nominal: &[f64],
+    model_noise: &ModelNoise,
     spread: &[f64],
     max_shift: f64,
     options: &LoopOptions,
-    band: Cfc,
+    filters: (Option<Cfc>, Cfc),
     fixed_gains: Option<&[f64]>,
 ) -> Result<(Frame, NoiseFloor)> {
     let mut frame = Frame {
@@ -595,18 +610,40 @@ fn frame_of(
     let (terms, _) = nuisance::profile(y_nominal, &frame, max_shift, fixed_gains);
     let onset = noise_floor::onset(y_nominal, samples) as f64 + terms.tau / dt;
     let pre = (onset - 3.0).floor().max(0.0) as usize;
+    let members = || {
+        let runs = (0..model_noise.len()).map(|j| Ok(model_noise.run(j)?.data().to_vec()));
+        noise_floor::envelopes_of(
+            std::iter::once(Ok(y_nominal.to_vec())).chain(runs),
+            labels.len(),
+            samples,
+        )
+    };
     let floor = noise_floor::estimate(
         labels,
         test,
+        &members,
         samples,
         dt,
         pre.min(samples),
         spread,
         options.sigma,
-        band,
+        filters,
     )?;
     frame.weights = noise_floor::weights(&floor, spread, samples);
     Ok((frame, floor))
+}
+
+/// Zero weight for the masked samples of `core::quality` (clipped runs and spikes), per
+/// channel in frame order: they leave every residual.
+fn masked_out(frame: &mut Frame, masks: &[Vec<bool>]) {
+    let t = frame.samples;
+    for (s, m) in masks.iter().enumerate() {
+        for (k, &out) in m.iter().enumerate().take(t) {
+            if out {
+                frame.weights[s * t + k] = 0.0;
+            }
+        }
+    }
 }
 
 /// What judges a model's response against a test: the noise's lag-one correlation and the
@@ -656,7 +693,7 @@ impl Judge<'_> {
                 k += 1.0;
             }
         }
-        let m1_exceedance = agreement::m1_exceedance(
+        let m1 = agreement::m1_exceedance(
             frame,
             y,
             terms,
@@ -676,7 +713,9 @@ impl Judge<'_> {
             chi2_red: det.chi2_red,
             sprague_geers_c: if k > 0.0 { sg / k } else { f64::NAN },
             iso18571_r: if k > 0.0 { r / k } else { f64::NAN },
-            m1_exceedance,
+            m1_exceedance: m1.exceedance_fraction,
+            m1_expected: m1.expected_exceedance,
+            m1_probability: m1.probability,
             m2_above_0_9: m2.map(|m| m.0),
             m2_shapes: m2.map_or(0, |m| m.1),
         })

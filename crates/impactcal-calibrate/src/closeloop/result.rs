@@ -79,6 +79,14 @@ pub struct Errors {
     /// its Jacobian, and the noise floor; `closeloop::agreement`). About `2 / (N + 1)` for
     /// a right model with `N` members, towards 1 with model-form error.
     pub m1_exceedance: f64,
+    /// M1: the exceedance a draw of the predictive ensemble has, `2 / (N + 1)`.
+    #[serde(default)]
+    pub m1_expected: f64,
+    /// M1: the probability that a draw of the ensemble leaves the envelope at least as
+    /// often as the test (the study's beta-binomial, `study::m1`); below `1 / (N + 1)`
+    /// the model cannot explain the test.
+    #[serde(default)]
+    pub m1_probability: f64,
     /// M2: paired impact shapes of model and test with `|M2| > 0.9`; `None` when the
     /// shapes cannot be formed (a response without signal on the compared channels).
     pub m2_above_0_9: Option<usize>,
@@ -134,6 +142,9 @@ pub struct LoopResult {
     pub nuisance: Nuisance,
     /// The noise floor of the calibration test.
     pub noise_floor: NoiseFloor,
+    /// The masks and offsets applied to the test before any comparison.
+    #[serde(default)]
+    pub test_preparation: crate::study::channels::TestPreparation,
     /// The first attribution's ranking.
     pub candidates: Vec<Score>,
     /// Candidate pairs these sensors cannot tell apart (first attribution).

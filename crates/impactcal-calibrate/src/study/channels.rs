@@ -1,11 +1,16 @@
 //! The test on the model's channels and time base, and the norm history `Q(t)`.
 
+use std::collections::BTreeMap;
+
+use impactcal_core::quality::{QualityOptions, bridged, check};
 use impactcal_core::signal::interpolate_onto;
 use impactcal_core::{Cfc, ChannelMap, Histories};
+use serde::{Deserialize, Serialize};
 
 use crate::error::{CalibrateError, Result};
 
-/// The test as the study sees it: the channels it shares with the model (by label, or
+/// The test as the study sees it: converted by the map's conversions (bridges,
+/// accelerometers, units), the channels it shares with the model (by label, or
 /// through a channel map, the model channel scaled by the map's gain standing for the test
 /// channel), relabelled with the model's labels, filtered with the study's CFC class on its
 /// own time base, then interpolated onto the model's time points.
@@ -20,9 +25,13 @@ pub fn test_on_model(
     cfc: Option<Cfc>,
     model: &Histories,
 ) -> Result<Histories> {
-    let test = match cfc {
-        Some(c) => test.filtered(c)?,
+    let converted = match map {
+        Some(m) => m.convert(test)?,
         None => test.clone(),
+    };
+    let test = match cfc {
+        Some(c) => converted.filtered(c)?,
+        None => converted,
     };
     // (test label, model label, gain): model * gain ~ test.
     let pairs: Vec<(String, String, f64)> = match map {
@@ -136,4 +145,149 @@ pub fn relative_l2(a: &[f64], b: &[f64]) -> f64 {
     } else {
         f64::NAN
     }
+}
+
+/// What was done to the test before any comparison: the masks of `core::quality` (clipped
+/// runs and spikes found on the raw record, bridged linearly before filtering and, in the
+/// closed loop, given zero weight) and the offsets: removed (each channel's pre-impact mean
+/// less the model's over the same samples) in the study, fitted with the other nuisance
+/// terms (a bias per channel) in the closed loop.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TestPreparation {
+    /// Clipped runs found on the raw test.
+    pub clipped_runs: usize,
+    /// Spikes found on the raw test.
+    pub spikes: usize,
+    /// Raw samples masked (clipped or spiked).
+    pub masked_samples: usize,
+    /// Offsets removed, per model channel (empty when the window has no pre-impact part).
+    pub offsets: BTreeMap<String, f64>,
+    /// Pre-impact samples the offsets (and the noise) were measured on.
+    pub pre_impact_samples: usize,
+    /// The offsets were left in the test because the comparison fits a bias per channel
+    /// (the closed loop's nuisance terms), which takes them out with every sample.
+    #[serde(default)]
+    pub bias_fitted: bool,
+}
+
+impl TestPreparation {
+    /// One line for a report.
+    pub fn describe(&self) -> String {
+        format!(
+            "Test data as used: {} clipped run(s) and {} spike(s) found by the quality check \
+             ({} raw samples) masked out of every comparison; {}",
+            self.clipped_runs,
+            self.spikes,
+            self.masked_samples,
+            if self.bias_fitted {
+                "offsets fitted as a bias per channel with the nuisance terms".to_string()
+            } else if self.offsets.is_empty() {
+                "no offset removed (no pre-impact samples in the window)".to_string()
+            } else {
+                format!(
+                    "offsets removed on {} channel(s), measured on {} pre-impact samples",
+                    self.offsets.len(),
+                    self.pre_impact_samples
+                )
+            }
+        )
+    }
+}
+
+/// The test prepared for comparison with `model` (a run on the model's channels and time
+/// base, unfiltered): the raw test checked ([`impactcal_core::quality::check`]) and its
+/// clipped and spiked samples bridged, then as [`test_on_model`]; with `pre = Some(p)` the
+/// offsets removed over the first `p` samples (when `p >= 8`; the test's mean there less
+/// the filtered model's), with `None` left in (the caller fits a bias per channel); and,
+/// per model channel of the result, the mask of the samples that lie within a raw step of
+/// a masked sample.
+///
+/// # Errors
+/// As [`test_on_model`].
+pub fn prepared_test(
+    test: &Histories,
+    map: Option<&ChannelMap>,
+    cfc: Option<Cfc>,
+    model: &Histories,
+    pre: Option<usize>,
+) -> Result<(Histories, Vec<Vec<bool>>, TestPreparation)> {
+    let converted = match map {
+        Some(m) => m.convert(test)?,
+        None => test.clone(),
+    };
+    let quality = check(&converted, &QualityOptions::default())?;
+    let channels: Vec<Vec<f64>> = quality
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(c, q)| bridged(converted.channel(c), &q.masked_spans()))
+        .collect();
+    let repaired = Histories::from_channels(
+        converted.labels().to_vec(),
+        channels,
+        converted.dt(),
+        converted.start(),
+        converted.unit(),
+    )?;
+    // The map's conversions are applied: map the labels and gains only.
+    let plain = map.map(|m| {
+        let mut m = m.clone();
+        m.entries.iter_mut().for_each(|e| e.conversion = None);
+        m
+    });
+    let on_model = test_on_model(&repaired, plain.as_ref(), cfc, model)?;
+    let test_label = |model_label: &str| -> String {
+        map.and_then(|m| {
+            m.entries
+                .iter()
+                .find(|e| e.model_label == model_label)
+                .map(|e| e.test_label.clone())
+        })
+        .unwrap_or_else(|| model_label.to_string())
+    };
+    let masks: Vec<Vec<bool>> = on_model
+        .labels()
+        .iter()
+        .map(|l| {
+            quality.mask_on(
+                &test_label(l),
+                on_model.start(),
+                on_model.dt(),
+                on_model.samples(),
+            )
+        })
+        .collect();
+    let model_f = match cfc {
+        Some(c) => model.filtered(c)?,
+        None => model.clone(),
+    };
+    let mut offsets = BTreeMap::new();
+    let t = on_model.samples();
+    let mut data = on_model.data().to_vec();
+    let removed = pre.filter(|&p| p >= 8).unwrap_or(0);
+    if removed > 0 {
+        for (c, l) in on_model.labels().iter().enumerate() {
+            let m = model_f.channel_by_label(l)?;
+            let o = (0..removed).map(|k| data[c * t + k] - m[k]).sum::<f64>() / removed as f64;
+            data[c * t..(c + 1) * t].iter_mut().for_each(|v| *v -= o);
+            offsets.insert(l.clone(), o);
+        }
+    }
+    let prepared = Histories::new(
+        on_model.labels().to_vec(),
+        t,
+        on_model.dt(),
+        on_model.start(),
+        on_model.unit(),
+        data,
+    )?;
+    let summary = TestPreparation {
+        clipped_runs: quality.channels.iter().map(|c| c.clipped_runs.len()).sum(),
+        spikes: quality.channels.iter().map(|c| c.spike_spans.len()).sum(),
+        masked_samples: quality.masked_count(),
+        offsets,
+        pre_impact_samples: removed,
+        bias_fitted: pre.is_none(),
+    };
+    Ok((prepared, masks, summary))
 }

@@ -69,11 +69,10 @@ fn pct(v: f64) -> String {
 /// The report of a study. `geometry` (when the model has one) places the sensors on the
 /// structure; without it the sensor figure is left out and the sensors are listed.
 pub fn report(r: &StudyResult, geometry: Option<&Geometry>) -> Report {
-    let mut lead = vec![format!(
-        "M1 verdict: {}. {}.",
-        r.m1.verdict.as_str(),
-        r.m1.statement
-    )];
+    let mut lead = vec![
+        format!("M1 verdict: {}. {}.", r.m1.verdict.as_str(), r.m1.statement),
+        format!("{}.", r.test_preparation.describe()),
+    ];
     if let Some(e) = &r.errors {
         lead.push(before_after_sentence(
             r,

@@ -5,7 +5,12 @@
 //!    the window leave the objective (unless kept on request);
 //! 2. a scrambled-Halton ensemble of `N` runs; failed runs are reported by index and kept out;
 //! 3. M1 ([`m1`]): the envelope of `Q(t) = ||v(t)||_2` over the ensemble against the test's
-//!    `Q_e(t)`, the intervals where it leaves, the verdict with the `1/N` bound of Eq. 4.1;
+//!    `Q_e(t)`, the intervals where it leaves, the observed exceedance against the expected
+//!    one of a draw of the model with the test's measurement noise (measured on the test's
+//!    pre-impact part, else on the band the model leaves empty, or `sigma`), the
+//!    probability and the verdict; the test is used with the masks of `core::quality`
+//!    (clipped samples and spikes bridged) and its offsets removed
+//!    ([`channels::prepared_test`]);
 //! 4. sensors ([`sensors`]): effective-independence placement on the ensemble's impact
 //!    shapes; the test expanded from the sensors to the other channels through the baseline's
 //!    shapes, with its error;
@@ -29,6 +34,7 @@ pub mod document;
 pub mod execute;
 pub mod m1;
 pub mod m2;
+pub mod measured_noise;
 pub mod options;
 pub mod plan;
 pub mod reconcile;
@@ -56,7 +62,7 @@ pub use plan::{StudyShapes, estimated_peak};
 pub use result::StudyResult;
 pub use subspace::Subspace;
 
-use channels::{indices_of, q_of, relative_error, relative_l2, test_on_model};
+use channels::{indices_of, prepared_test, q_of, relative_error, relative_l2};
 use execute::Runs;
 use plan::Plan;
 use result::{
@@ -149,7 +155,10 @@ pub fn run(
         .stage("nominal", std::slice::from_ref(&nominal_point))?
         .histories(0, "the nominal run")?;
     let baseline = prep(&nominal_raw)?;
-    let test_m = test_on_model(test.histories, test.map, test.cfc, &nominal_raw)?;
+    let pre =
+        crate::closeloop::noise_floor::onset(baseline.data(), baseline.samples()).saturating_sub(3);
+    let (test_m, _masks, preparation) =
+        prepared_test(test.histories, test.map, test.cfc, &nominal_raw, Some(pre))?;
     // The memory plan, from the shapes the nominal run gives (every shared channel taken as
     // an objective one), checked before any other stage.
     let mut plan = Plan {
@@ -281,12 +290,31 @@ pub fn run(
     let test_obj = test_m.select(&objective)?;
     let base_obj = baseline.select(&objective)?;
     let all: Vec<usize> = (0..objective.len()).collect();
-    let q_runs: Vec<Vec<f64>> = (0..ok.len())
-        .map(|k| Ok(q_of(&ensemble_run(k)?, &all)))
-        .collect::<Result<_>>()?;
+    // One pass over the runs: their response norms and their spectra's envelope.
+    let mut q_runs: Vec<Vec<f64>> = Vec::with_capacity(ok.len());
+    let envelopes = measured_noise::envelopes(
+        &base_obj,
+        (0..ok.len()).map(|k| {
+            let h = ensemble_run(k)?;
+            q_runs.push(q_of(&h, &all));
+            Ok(h)
+        }),
+    )?;
     let q_test = q_of(&test_obj, &all);
     let q_baseline = q_of(&base_obj, &all);
-    let m1 = m1::m1(&time, &q_runs, &q_test)?;
+    let (ar, measurement_noise) =
+        measured_noise::measured(&test_obj, &envelopes, pre, test.cfc, options.sigma)?;
+    let m1 = if ar.iter().all(|m| m.variance == 0.0) {
+        m1::m1(&time, &q_runs, &q_test)?
+    } else {
+        m1::m1_with_noise(
+            &time,
+            (0..ok.len()).map(&ensemble_run),
+            &test_obj,
+            &ar,
+            options.seed,
+        )?
+    };
     let mut result = StudyResult {
         model: description.to_string(),
         fingerprint: fp.clone(),
@@ -315,6 +343,8 @@ pub fn run(
         },
         ensemble,
         m1,
+        test_preparation: preparation,
+        measurement_noise,
         sensors: None,
         m2: None,
         surrogate: None,

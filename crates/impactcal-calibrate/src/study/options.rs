@@ -43,6 +43,10 @@ pub struct StudyOptions {
     /// sets it).
     #[serde(skip)]
     pub max_memory: Option<u64>,
+    /// Measurement noise standard deviation of every test channel as compared (after the
+    /// filter), when known (`[test] sigma` of a study file); `None`: measured on the test
+    /// (its pre-impact part, else the band the model leaves empty).
+    pub sigma: Option<f64>,
 }
 
 impl Default for StudyOptions {
@@ -61,6 +65,7 @@ impl Default for StudyOptions {
             keep_unpredictable: false,
             screen_only: false,
             max_memory: None,
+            sigma: None,
         }
     }
 }
@@ -131,6 +136,15 @@ impl ParamGuard for StudyOptions {
                 "study.noise_fraction",
                 self.noise_fraction,
                 "must be positive",
+            ));
+        }
+        if let Some(s) = self.sigma
+            && !(s.is_finite() && s >= 0.0)
+        {
+            return Err(CoreError::invalid_option(
+                "test.sigma",
+                s,
+                "must be finite and non-negative",
             ));
         }
         Ok(())

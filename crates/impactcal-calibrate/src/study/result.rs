@@ -1,6 +1,7 @@
 //! The result of a study: every number, serialised as `study.json`.
 
 use impactcal_core::ParameterSpace;
+use impactcal_core::quality::RecordNoiseSource;
 use serde::{Deserialize, Serialize};
 
 use super::m1::M1;
@@ -40,6 +41,13 @@ pub struct StudyResult {
     pub ensemble: EnsembleSummary,
     /// Metric M1.
     pub m1: M1,
+    /// The masks and offsets applied to the test before any comparison.
+    #[serde(default)]
+    pub test_preparation: super::channels::TestPreparation,
+    /// The measurement noise M1 counted, per objective channel: where it came from, its
+    /// standard deviation and lag-one correlation (after the filter).
+    #[serde(default)]
+    pub measurement_noise: Vec<MeasurementNoise>,
     /// The sensors (absent when the study stopped after M1).
     pub sensors: Option<SensorsResult>,
     /// Metric M2 before and after.
@@ -202,4 +210,23 @@ pub struct Curves {
     pub sensor_baseline: Vec<f64>,
     /// Its calibrated history.
     pub sensor_calibrated: Option<Vec<f64>>,
+}
+
+/// The measurement noise of one test channel as M1 counts it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeasurementNoise {
+    /// The channel.
+    pub label: String,
+    /// Where it came from: `given` (`[test] sigma`), `quiet` (the pre-impact part),
+    /// `model-free-band` (the band above the ensemble's bandwidth) or `none`.
+    pub source: RecordNoiseSource,
+    /// Standard deviation (the test's unit, after the filter; 0 for `none`).
+    pub sigma: f64,
+    /// Lag-one correlation.
+    pub lag1: f64,
+    /// AR order.
+    pub order: usize,
+    /// Why no noise was measured (source `none`).
+    #[serde(default)]
+    pub note: Option<String>,
 }

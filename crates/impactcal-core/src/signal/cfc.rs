@@ -151,6 +151,25 @@ impl Cfc {
         Ok(y)
     }
 
+    /// The power response of [`Cfc::filter`] away from the record's ends at normalised
+    /// angular frequency `omega` (radians per sample) for step `dt`: one pass is
+    /// `H(z) = b0 (1 + z^-1)^2 / (1 - a1 z^-1 - a2 z^-2)`, the forward and the backward
+    /// pass together `|H(e^{i omega})|^4` (zero phase). White noise of variance `sigma^2`
+    /// comes out with density `sigma^2 |H|^4`.
+    ///
+    /// # Errors
+    /// As [`Cfc::filter`] for the step.
+    pub fn power_response(self, omega: f64, dt: f64) -> Result<f64> {
+        let (b0, a1, a2) = self.coefficients(dt, "CFC power response")?;
+        // |1 + e^{-i w}|^2 = 2 + 2 cos w.
+        let num = b0 * b0 * (2.0 + 2.0 * omega.cos()).powi(2);
+        let (re, im) = (
+            1.0 - a1 * omega.cos() - a2 * (2.0 * omega).cos(),
+            a1 * omega.sin() + a2 * (2.0 * omega).sin(),
+        );
+        Ok((num / (re * re + im * im)).powi(2))
+    }
+
     /// `(b0, a1, a2)` of the difference equation for step `dt` (`b1 = 2 b0`, `b2 = b0`).
     fn coefficients(self, dt: f64, what: &str) -> Result<(f64, f64, f64)> {
         if !(dt.is_finite() && dt > 0.0) {
@@ -210,6 +229,26 @@ impl Histories {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn the_power_response_is_the_filters_gain_on_sines() {
+        let dt = 1e-4;
+        for cfc in [Cfc::Cfc180, Cfc::Cfc600, Cfc::Cfc1000] {
+            // A sine well inside the record: amplitude ratio squared.
+            for f in [100.0, 1000.0, 2500.0] {
+                let n = 4000;
+                let y = cfc.filter(&sine(f, dt, n), dt, "sine").unwrap();
+                // Mean square over whole periods: half the squared amplitude.
+                let ms = y[n / 4..3 * n / 4].iter().map(|v| v * v).sum::<f64>() / (n / 2) as f64;
+                let r = cfc.power_response(2.0 * PI * f * dt, dt).unwrap();
+                assert!(
+                    (2.0 * ms - r).abs() < 1e-3 * r.max(1e-3),
+                    "{cfc} {f}: {ms} {r}"
+                );
+            }
+        }
+        assert!(Cfc::Cfc1000.power_response(0.1, 1e-3).is_err());
+    }
 
     fn sine(freq: f64, dt: f64, n: usize) -> Vec<f64> {
         (0..n)

@@ -2,11 +2,14 @@
 
 use std::path::Path;
 
+use super::conversion::Conversion;
 use crate::error::{CoreError, Result};
+use crate::histories::Histories;
 use crate::table::{LineIndex, csv_reader};
 
-/// One line of a channel map: the test channel `test_label` is compared with the model channel
-/// `model_label` multiplied by `gain` (the gain converts the model's unit into the test's).
+/// One line of a channel map: the test channel `test_label`, converted by `conversion` when
+/// it has one, is compared with the model channel `model_label` multiplied by `gain` (the
+/// gain converts the model's unit into the test's).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MapEntry {
     /// Label of the test (measured) channel.
@@ -15,12 +18,18 @@ pub struct MapEntry {
     pub model_label: String,
     /// Factor applied to the model channel before comparing (1 when the map omits it).
     pub gain: f64,
+    /// The conversion of the raw test channel into SI (a bridge, an accelerometer's
+    /// sensitivity, a unit), applied before anything else.
+    pub conversion: Option<Conversion>,
     /// 1-based line of the map file.
     pub line: usize,
 }
 
-/// A channel map read from CSV lines `test_label,model_label[,gain]`, optionally under a
-/// header line `test_label,model_label[,gain]`. Blank lines are skipped.
+/// A channel map read from CSV lines `test_label,model_label[,gain[,conversion]]`,
+/// optionally under a header line `test_label,model_label[,gain[,conversion]]`. Blank lines
+/// are skipped. A conversion is written as [`Conversion::parse`] reads it, for example
+/// `HEAD_X,12.x,,accelerometer mv-per-g=0.5` or `SG1,bar.strain,1,quarter-bridge gf=2.06
+/// gain=200 excitation=8`.
 ///
 /// A test label may appear once; a model label may serve several test channels (two sensors
 /// compared with one model node).
@@ -69,12 +78,12 @@ impl ChannelMap {
             if entries.is_empty() && record.get(0) == Some("test_label") {
                 continue;
             }
-            if !(2..=3).contains(&record.len()) {
+            if !(2..=4).contains(&record.len()) {
                 return Err(err(
                     line,
-                    record.len().min(3) + 1,
+                    record.len().min(4) + 1,
                     format!(
-                        "expected `test_label,model_label[,gain]`, found {} fields",
+                        "expected `test_label,model_label[,gain[,conversion]]`, found {} fields",
                         record.len()
                     ),
                 ));
@@ -98,6 +107,10 @@ impl ChannelMap {
                     }
                 },
             };
+            let conversion = match record.get(3) {
+                None | Some("") => None,
+                Some(text) => Some(Conversion::parse(text).map_err(|m| err(line, 4, m))?),
+            };
             if let Some(first) = entries.iter().find(|e| e.test_label == test_label) {
                 return Err(err(
                     line,
@@ -112,6 +125,7 @@ impl ChannelMap {
                 test_label: test_label.to_string(),
                 model_label: model_label.to_string(),
                 gain,
+                conversion,
                 line,
             });
         }
@@ -125,6 +139,48 @@ impl ChannelMap {
             file: source_name.to_string(),
             entries,
         })
+    }
+
+    /// `test` with the conversion of each mapped channel applied (other channels as they
+    /// are).
+    ///
+    /// # Errors
+    /// [`CoreError::NonFinite`] naming the channel and sample where a conversion gives a
+    /// non-finite value (a bridge ratio at its pole).
+    pub fn convert(&self, test: &Histories) -> Result<Histories> {
+        if self.entries.iter().all(|e| e.conversion.is_none()) {
+            return Ok(test.clone());
+        }
+        let mut channels = Vec::with_capacity(test.channels());
+        for (c, label) in test.labels().iter().enumerate() {
+            let conv = self
+                .entries
+                .iter()
+                .find(|e| &e.test_label == label)
+                .and_then(|e| e.conversion);
+            let x = test.channel(c);
+            channels.push(match conv {
+                None => x.to_vec(),
+                Some(cv) => {
+                    let y: Vec<f64> = x.iter().map(|v| cv.apply(*v)).collect();
+                    if let Some(k) = y.iter().position(|v| !v.is_finite()) {
+                        return Err(CoreError::NonFinite {
+                            what: format!("channel `{label}` converted by {}", self.file),
+                            value: y[k],
+                            location: format!("sample {k}"),
+                        });
+                    }
+                    y
+                }
+            });
+        }
+        Histories::from_channels(
+            test.labels().to_vec(),
+            channels,
+            test.dt(),
+            test.start(),
+            test.unit(),
+        )
     }
 
     /// Checks that every test label is among `test_labels` and every model label among
@@ -189,6 +245,34 @@ mod tests {
     }
 
     #[test]
+    fn conversions_apply_to_their_channels_only() {
+        let m = ChannelMap::parse(
+            "SG,bar.strain,,quarter-bridge gf=2 gain=100 excitation=10\nA,1.z,2,unit from=g\nB,2.z\n",
+            "map.csv",
+        )
+        .unwrap();
+        assert_eq!(m.entries[0].gain, 1.0);
+        let h = Histories::from_channels(
+            vec!["SG".into(), "A".into(), "B".into()],
+            vec![vec![0.0, 2.0], vec![1.0, -1.0], vec![3.0, 4.0]],
+            1e-3,
+            0.0,
+            "",
+        )
+        .unwrap();
+        let c = m.convert(&h).unwrap();
+        // V_r = 2 / 1000; strain = 4 V_r / (2 (1 - 2 V_r)).
+        assert!((c.channel(0)[1] - 0.008 / (2.0 * 0.996)).abs() < 1e-15);
+        assert_eq!(c.channel(1), &[9.80665, -9.80665]);
+        assert_eq!(c.channel(2), &[3.0, 4.0]);
+        // A ratio at the quarter bridge's pole (V_r = 1/2) is named.
+        let h = Histories::from_channels(vec!["SG".into()], vec![vec![0.0, 500.0]], 1e-3, 0.0, "")
+            .unwrap();
+        let e = m.convert(&h).unwrap_err().to_string();
+        assert!(e.contains("`SG`") && e.contains("sample 1"), "{e}");
+    }
+
+    #[test]
     fn unknown_labels_name_the_line_and_side() {
         let m = ChannelMap::parse("A,1.x\nB,2.x\n", "map.csv").unwrap();
         match m.check(&["A", "B"], &["1.x"]).unwrap_err() {
@@ -213,7 +297,8 @@ mod tests {
             e => panic!("unexpected {e}"),
         };
         assert_eq!(pos("A,1.x\nB\n"), (2, 2));
-        assert_eq!(pos("A,1.x,2,3\n"), (1, 4));
+        assert_eq!(pos("A,1.x,2,3,4\n"), (1, 5));
+        assert_eq!(pos("A,1.x,2,third-bridge\n"), (1, 4));
         assert_eq!(pos("A,1.x,zero\n"), (1, 3));
         assert_eq!(pos("A,1.x,0\n"), (1, 3));
         assert_eq!(pos("A,1.x\nA,2.x\n"), (2, 1));
