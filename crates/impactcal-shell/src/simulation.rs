@@ -26,6 +26,7 @@ use crate::element::{
     self, ElementFault, ElementOutput, KernelOptions, STATE_HEAD, STATE_PER_POINT,
 };
 use crate::error::{Result, ShellError};
+use crate::contact::{ContactNodes, ContactState};
 use crate::geometry::{dot, sub};
 use crate::model::{Curve, MotionKind, ShellModel, WallMethod};
 use crate::rigid::{RigidState, cross, inverse, mul, rotation};
@@ -149,6 +150,12 @@ pub struct RunResult {
     /// wall's id is its `_ID` card's, else its 1-based position among the walls. `None`
     /// for a model without walls.
     pub walls: Option<Histories>,
+    /// The energies of each contact interface sampled at the output interval (LS-DYNA's
+    /// `sleout`): channels `<id>.energy` (the work its forces took from the structure:
+    /// spring energy stored now plus what damping and friction dissipated) and
+    /// `<id>.friction` (the friction share). An interface's id is its `_ID` card's, else
+    /// its 1-based position among the interfaces. `None` for a model without contact.
+    pub contacts: Option<Histories>,
     /// The energies of each part sampled at the output interval (LS-DYNA's `matsum`):
     /// channels `<part>.internal, <part>.kinetic, <part>.hourglass, <part>.damping`.
     /// Concentrated masses belong to no part.
@@ -255,6 +262,8 @@ pub struct Simulation {
     bodies: Vec<RigidState>,
     /// Per element, the mass and rotary inertia it gives each of its nodes.
     elem_mass: Vec<[f64; 2]>,
+    /// The state of each contact interface.
+    contacts: Vec<ContactState>,
     started: bool,
 }
 
@@ -397,6 +406,11 @@ impl Simulation {
                 .map(|b| RigidState::initial(b, &c.mass, &c.inertia, &c.v0, &c.w0))
                 .collect(),
             elem_mass: element_masses(&c),
+            contacts: c
+                .contacts
+                .iter()
+                .map(|f| ContactState::new(f, &c.x0))
+                .collect(),
             started: false,
             c,
         };
@@ -452,6 +466,32 @@ impl Simulation {
     /// The force of the walls on the structure at the current time (sum over walls).
     pub fn wall_force(&self) -> [f64; 3] {
         self.wall_force
+    }
+
+    /// Each contact interface's id, energy and friction energy now (see
+    /// [`RunResult::contacts`]), in model order.
+    pub fn contact_energies(&self) -> Vec<(u64, f64, f64)> {
+        self.c
+            .contacts
+            .iter()
+            .zip(&self.contacts)
+            .map(|(f, s)| (f.id, s.energy, s.friction))
+            .collect()
+    }
+
+    /// Each contact interface's id, the number of its nodes that penetrated a segment at
+    /// the start and the largest such penetration. These penetrations are kept as a
+    /// reference that only additional penetration acts against (nodes are not moved).
+    pub fn initial_penetrations(&self) -> Vec<(u64, usize, f64)> {
+        self.c
+            .contacts
+            .iter()
+            .zip(&self.contacts)
+            .map(|(f, s)| {
+                let (n, max) = s.initial_penetrations();
+                (f.id, n, max)
+            })
+            .collect()
     }
 
     /// The accumulated internal, hourglass and damping energies of each part, in model
@@ -706,6 +746,23 @@ impl Simulation {
         self.energies.kinetic = ke_t + ke_r;
     }
 
+    /// Segment contact: each interface's forces on the current positions with the mid-step
+    /// velocities added to the accelerations (before walls, rigid bodies and constraints),
+    /// and its work over the step `dt` just taken booked as contact (and friction) energy.
+    fn contact(&mut self, dt: f64) {
+        let nodes = ContactNodes {
+            x: &self.x,
+            v: &self.v,
+            mass: &self.c.mass,
+        };
+        for (st, f) in self.contacts.iter_mut().zip(&self.c.contacts) {
+            let (e0, f0) = (st.energy, st.friction);
+            st.cycle(f, &nodes, self.time, dt, &mut self.a);
+            self.energies.contact += st.energy - e0;
+            self.energies.friction += st.friction - f0;
+        }
+    }
+
     /// Rigid walls: corrects the accelerations of the nodes that would enter a wall in the
     /// next step (kinematic) or that are in it (penalty), books the energy they remove and
     /// the impulse each wall gives.
@@ -957,6 +1014,7 @@ impl Simulation {
             .map(|c| c.dt_min)
             .fold(f64::INFINITY, f64::min);
         self.gather(0.0);
+        self.contact(0.0);
         self.kick(0.0, dt);
         self.energies.initial = self.energies.kinetic;
         self.dt_half = dt;
@@ -987,6 +1045,7 @@ impl Simulation {
             Some(dt) => dt,
             None => self.control.tssfac * min,
         };
+
         if dt.is_infinite() && min.is_infinite() {
             return Err(ShellError::value(
                 "time step",
@@ -1064,6 +1123,7 @@ impl Simulation {
         let g1 = self.body_accel(self.time);
         self.energies.external_work += 0.5 * (g0 + g1) * mdz;
         self.gather(self.time);
+        self.contact(dt);
         self.kick(0.5 * dt, dt_next);
         self.dt_half = dt_next;
         self.dt_min = self.dt_min.min(dt);
@@ -1237,6 +1297,11 @@ impl Simulation {
             "energy",
         )?;
         let walls = self.wall_histories(&samples, 9 * nh + ENERGY_LABELS.len(), interval)?;
+        let contacts = self.contact_histories(
+            &samples,
+            9 * nh + ENERGY_LABELS.len() + 4 * self.c.walls.len(),
+            interval,
+        )?;
         let part_energies = self.part_histories(&part_samples, interval)?;
         let mut wall_peaks = Vec::with_capacity(self.c.walls.len());
         let mut peak_total: f64 = 0.0;
@@ -1259,6 +1324,7 @@ impl Simulation {
         let mut it = nodal.into_iter();
         Ok(RunResult {
             walls,
+            contacts,
             part_energies,
             parts: self.part_energies(),
             displacement: it.next().flatten(),
@@ -1317,6 +1383,9 @@ impl Simulation {
         ]);
         for j in &self.wall_impulse {
             s.extend_from_slice(j);
+        }
+        for c in &self.contacts {
+            s.extend_from_slice(&[c.energy, c.friction]);
         }
         s
     }
@@ -1379,6 +1448,30 @@ impl Simulation {
         }
         Ok(Some(Histories::from_channels(
             labels, chans, dt, 0.0, "force",
+        )?))
+    }
+
+    /// The energies of each contact interface sampled at the output interval, from column
+    /// `at` of the samples: channels `<id>.energy`, `<id>.friction`.
+    fn contact_histories(
+        &self,
+        samples: &[Vec<f64>],
+        at: usize,
+        dt: f64,
+    ) -> Result<Option<Histories>> {
+        if self.c.contacts.is_empty() {
+            return Ok(None);
+        }
+        let mut labels = Vec::new();
+        let mut chans = Vec::new();
+        for (k, f) in self.c.contacts.iter().enumerate() {
+            for (j, name) in ["energy", "friction"].iter().enumerate() {
+                labels.push(format!("{}.{name}", f.id));
+                chans.push(samples.iter().map(|s| s[at + 2 * k + j]).collect());
+            }
+        }
+        Ok(Some(Histories::from_channels(
+            labels, chans, dt, 0.0, "energy",
         )?))
     }
 
