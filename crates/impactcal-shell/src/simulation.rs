@@ -21,12 +21,12 @@
 use impactcal_core::Histories;
 use rayon::prelude::*;
 
+use crate::contact::{ContactNodes, ContactState};
 use crate::element::quad_lanes::{Block, LANES, quad_block};
 use crate::element::{
     self, ElementFault, ElementOutput, KernelOptions, STATE_HEAD, STATE_PER_POINT,
 };
 use crate::error::{Result, ShellError};
-use crate::contact::{ContactNodes, ContactState};
 use crate::geometry::{dot, sub};
 use crate::model::{Curve, MotionKind, ShellModel, WallMethod};
 use crate::rigid::{RigidState, cross, inverse, mul, rotation};

@@ -111,9 +111,18 @@ mod tests {
         let w = closest_on_triangle([0.5, 0.5, 3.0], a, b, c);
         assert!((w[0] - 0.5).abs() < 1e-15 && (w[1] - 0.25).abs() < 1e-15);
         // Beyond each vertex and edge.
-        assert_eq!(closest_on_triangle([-1.0, -1.0, 1.0], a, b, c), [1.0, 0.0, 0.0]);
-        assert_eq!(closest_on_triangle([3.0, -1.0, 0.0], a, b, c), [0.0, 1.0, 0.0]);
-        assert_eq!(closest_on_triangle([-1.0, 3.0, 0.0], a, b, c), [0.0, 0.0, 1.0]);
+        assert_eq!(
+            closest_on_triangle([-1.0, -1.0, 1.0], a, b, c),
+            [1.0, 0.0, 0.0]
+        );
+        assert_eq!(
+            closest_on_triangle([3.0, -1.0, 0.0], a, b, c),
+            [0.0, 1.0, 0.0]
+        );
+        assert_eq!(
+            closest_on_triangle([-1.0, 3.0, 0.0], a, b, c),
+            [0.0, 0.0, 1.0]
+        );
         let w = closest_on_triangle([1.0, -1.0, 0.0], a, b, c);
         assert!((w[1] - 0.5).abs() < 1e-15 && w[2] == 0.0);
         let w = closest_on_triangle([2.0, 2.0, 0.0], a, b, c);

@@ -140,7 +140,10 @@ fn check_settings(c: &Contact, by: &str) -> Result<()> {
     if !(0.0..=100.0).contains(&c.damping) {
         return Err(ShellError::value(
             by,
-            format!("damping VDC must lie in [0, 100] percent of critical, got {}", c.damping),
+            format!(
+                "damping VDC must lie in [0, 100] percent of critical, got {}",
+                c.damping
+            ),
         ));
     }
     for (side, s) in [("slave", c.slave_side), ("master", c.master_side)] {
@@ -160,7 +163,10 @@ fn check_settings(c: &Contact, by: &str) -> Result<()> {
     if !(c.birth.is_finite() && c.death > c.birth) {
         return Err(ShellError::value(
             by,
-            format!("death time {} must come after birth time {}", c.death, c.birth),
+            format!(
+                "death time {} must come after birth time {}",
+                c.death, c.birth
+            ),
         ));
     }
     Ok(())
@@ -302,7 +308,10 @@ fn build(m: &Model<'_>, control: &ContactControl, c: &Contact, id: u64) -> Resul
     }
     defs.sort_by_key(|d| d.elem);
     if defs.is_empty() {
-        return Err(ShellError::value(&by, "has no segments (its surfaces hold no shells)"));
+        return Err(ShellError::value(
+            &by,
+            "has no segments (its surfaces hold no shells)",
+        ));
     }
     // Checked nodes and the sides they are checked against, with thickness and stiffness
     // from the shells of their own surface.

@@ -181,7 +181,6 @@ impl ContactState {
             let refs = self.memory.iter().filter(|m| m.reference > 0.0);
             self.initial = refs.fold((0, 0.0), |(n, x), m| (n + 1, f64::max(x, m.reference)));
         }
-
     }
 
     /// The number of checked nodes in contact in the last cycle.
@@ -329,11 +328,7 @@ fn node_contact(
         work = -dot(ft, slip);
     }
     m.friction = ft;
-    let force = [
-        fn_ * n[0] + ft[0],
-        fn_ * n[1] + ft[1],
-        fn_ * n[2] + ft[2],
-    ];
+    let force = [fn_ * n[0] + ft[0], fn_ * n[1] + ft[1], fn_ * n[2] + ft[2]];
     (
         Some(Hit {
             seg: seg as u32,

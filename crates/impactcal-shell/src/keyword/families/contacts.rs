@@ -23,7 +23,13 @@ pub(crate) fn nodes_to_surface(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()
 
 /// A side of the interface from its id and type: 2 part set, 3 part, 4 node set (slave
 /// side of a nodes-to-surface contact), 5 every shell.
-fn surface(f: &Fields<'_>, k: usize, id_name: &str, ty_name: &str, slave: bool) -> Result<ContactSurface> {
+fn surface(
+    f: &Fields<'_>,
+    k: usize,
+    id_name: &str,
+    ty_name: &str,
+    slave: bool,
+) -> Result<ContactSurface> {
     let id = f.opt_id(k, id_name)?;
     let ty = f.int(k + 2, ty_name, 0)?;
     let need_id = |s: ContactSurface| {
@@ -43,11 +49,19 @@ fn surface(f: &Fields<'_>, k: usize, id_name: &str, ty_name: &str, slave: bool) 
         0 | 1 => Err(f.err(format!(
             "field {ty_name}: {ty} (a segment or shell element set) is not supported: give the \
              parts (2 part set, 3 part{})",
-            if slave { ", 4 node set, 5 all" } else { ", 5 all" }
+            if slave {
+                ", 4 node set, 5 all"
+            } else {
+                ", 5 all"
+            }
         ))),
         _ => Err(f.err(format!(
             "field {ty_name}: {ty} is not supported (2 part set, 3 part{})",
-            if slave { ", 4 node set, 5 all" } else { ", 5 all" }
+            if slave {
+                ", 4 node set, 5 all"
+            } else {
+                ", 5 all"
+            }
         ))),
     }
 }

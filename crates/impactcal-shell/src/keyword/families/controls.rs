@@ -107,14 +107,22 @@ pub(crate) fn contact(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
         )));
     }
     let mut unused: Vec<&str> = Vec::new();
-    for (k, name) in [(2, "ISLCHK"), (3, "SHLTHK"), (5, "THKCHG"), (6, "ORIEN"), (7, "ENMASS")] {
+    for (k, name) in [
+        (2, "ISLCHK"),
+        (3, "SHLTHK"),
+        (5, "THKCHG"),
+        (6, "ORIEN"),
+        (7, "ENMASS"),
+    ] {
         if f.real(k, name, 0.0)? != 0.0 {
             unused.push(name);
         }
     }
     if let Some(c) = kw.next() {
         let g = kw.fields(&c, W10);
-        let names = ["USRSTR", "USRFRC", "NSBCS", "INTERM", "XPENE", "SSTHK", "ECDT", "TIEDPRJ"];
+        let names = [
+            "USRSTR", "USRFRC", "NSBCS", "INTERM", "XPENE", "SSTHK", "ECDT", "TIEDPRJ",
+        ];
         for (k, name) in names.iter().enumerate() {
             if k != 5 && g.real(k, name, 0.0)? != 0.0 {
                 unused.push(name);
@@ -151,7 +159,13 @@ pub(crate) fn contact(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
             v => return Err(g.err(format!("field IGNORE: {v} is not supported (0, 1 or 2)"))),
         }
         g.must_be_zero(6, "SPOTHIN")?;
-        for (k, name) in [(1, "FRCENG"), (2, "SKIPRWG"), (3, "OUTSEG"), (4, "SPOTSTP"), (5, "SPOTDEL")] {
+        for (k, name) in [
+            (1, "FRCENG"),
+            (2, "SKIPRWG"),
+            (3, "OUTSEG"),
+            (4, "SPOTSTP"),
+            (5, "SPOTDEL"),
+        ] {
             if g.real(k, name, 0.0)? != 0.0 {
                 unused.push(name);
             }
