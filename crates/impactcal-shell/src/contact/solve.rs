@@ -183,11 +183,6 @@ impl ContactState {
         }
     }
 
-    /// The number of checked nodes in contact in the last cycle.
-    pub fn in_contact(&self) -> usize {
-        self.hits.iter().filter(|h| h.is_some()).count()
-    }
-
     /// The number of checked nodes that penetrated a segment at the start and the largest
     /// penetration (the references recorded then).
     pub fn initial_penetrations(&self) -> (usize, f64) {
