@@ -129,6 +129,10 @@ pub struct Args {
     /// `<part>.internal|kinetic|hourglass|damping`).
     #[arg(long)]
     pub part_energies: Option<PathBuf>,
+    /// Write the energy of each contact interface here (wide CSV, columns
+    /// `<interface id>.energy|friction`).
+    #[arg(long)]
+    pub contact_energies: Option<PathBuf>,
     /// The nodal quantity written to `--out`.
     #[arg(long, value_enum, default_value_t)]
     pub quantity: QuantityArg,
@@ -176,6 +180,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let started = std::time::Instant::now();
     let result = pool.install(|| -> Result<_, ShellError> {
         let mut sim = Simulation::new(&model)?;
+        for (id, n, deepest) in sim.initial_penetrations() {
+            if n > 0 {
+                eprintln!(
+                    "impactcal: warning: contact interface {id}: {n} nodes start inside a segment \
+                     (deepest {deepest:.4e}); these penetrations are kept as references that only \
+                     further penetration acts against (nodes are not moved)"
+                );
+            }
+        }
         if std::io::stderr().is_terminal() {
             let bar = indicatif::ProgressBar::new(1000);
             bar.set_style(
@@ -223,10 +236,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some(path) = &args.part_energies {
         result.part_energies.write_csv(path)?;
     }
+    if let Some(path) = &args.contact_energies {
+        let c = result.contacts.as_ref().ok_or_else(|| {
+            CliError::input(format!(
+                "{name}: --contact-energies needs a contact interface in the model"
+            ))
+        })?;
+        c.write_csv(path)?;
+    }
     let s = &result.summary;
     eprintln!(
         "impactcal: {} shells, {} cycles to t = {:.4e}; time step {:.3e} (first {:.3e}, max {:.3e}); \
-         energy ratio {:.4}; {}; peak wall force {:.4e}{}; \
+         energy ratio {:.4}; {}; peak wall force {:.4e}{}{}; \
          {:.2} s wall time on {} threads ({:.3} us per element-cycle)",
         s.elements,
         s.cycles,
@@ -238,11 +259,31 @@ pub fn run(args: Args) -> Result<(), CliError> {
         hourglass_message(&s.energies, s.hourglass_share),
         s.peak_wall_force,
         wall_peaks(&s.wall_peaks),
+        contact_message(result.contacts.as_ref()),
         wall,
         pool.current_num_threads(),
         1e6 * wall / (s.cycles.max(1) as f64 * s.elements.max(1) as f64)
     );
     Ok(())
+}
+
+/// Each contact interface's final energy and friction share, when there are interfaces.
+fn contact_message(h: Option<&impactcal::core::Histories>) -> String {
+    let Some(h) = h else {
+        return String::new();
+    };
+    let last = h.samples().saturating_sub(1);
+    let each: Vec<String> = (0..h.channels() / 2)
+        .map(|k| {
+            let id = h.labels()[2 * k].trim_end_matches(".energy");
+            format!(
+                "interface {id} {:.4e} (friction {:.4e})",
+                h.value(2 * k, last),
+                h.value(2 * k + 1, last)
+            )
+        })
+        .collect();
+    format!("; contact energy: {}", each.join(", "))
 }
 
 /// Each wall's sampled peak, when there are several walls.

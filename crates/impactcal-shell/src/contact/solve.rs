@@ -42,6 +42,9 @@ pub(crate) struct ContactState {
     x_sort: Vec<[f64; 3]>,
     memory: Vec<Memory>,
     hits: Vec<Option<Hit>>,
+    /// Each segment's box this cycle, grown by its half thickness and the largest node
+    /// half thickness.
+    boxes: Vec<[f64; 6]>,
     /// Per chunk of checked nodes, the friction work of the cycle.
     chunk_work: Vec<f64>,
     /// Force on each of the interface's nodes, this cycle and the last.
@@ -79,6 +82,7 @@ impl ContactState {
                 n
             ],
             hits: vec![None; n],
+            boxes: vec![[0.0; 6]; f.segs.len()],
             chunk_work: vec![0.0; n.div_ceil(CHUNK)],
             force: vec![[0.0; 3]; f.nodes.len()],
             force_old: vec![[0.0; 3]; f.nodes.len()],
@@ -128,7 +132,12 @@ impl ContactState {
             if !start {
                 self.refresh(f, s.x);
             }
-            let cand = &self.cand;
+            self.boxes
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(4 * CHUNK)
+                .for_each(|(k, b)| *b = segment_box(f, k, s.x, f.seg_half[k] + f.max_half));
+            let (cand, boxes) = (&self.cand, &self.boxes);
             self.memory
                 .par_chunks_mut(CHUNK)
                 .zip(self.hits.par_chunks_mut(CHUNK))
@@ -138,7 +147,7 @@ impl ContactState {
                     let mut w = 0.0;
                     for (k, (m, h)) in mem.iter_mut().zip(hits.iter_mut()).enumerate() {
                         let j = c * CHUNK + k;
-                        let (hit, dw) = node_contact(f, j, cand.of(j), s, m, dt, start);
+                        let (hit, dw) = node_contact(f, j, cand.of(j), boxes, s, m, dt, start);
                         *h = hit;
                         w += dw;
                     }
@@ -201,6 +210,7 @@ fn deepest(
     f: &Interface,
     j: usize,
     cand: &[u32],
+    boxes: &[[f64; 6]],
     x: &[[f64; 3]],
     m: &Memory,
 ) -> Option<(usize, [f64; 4], f64, [f64; 3])> {
@@ -209,10 +219,10 @@ fn deepest(
     let mut best: Option<(usize, [f64; 4], f64, [f64; 3])> = None;
     for &s in cand {
         let s = s as usize;
-        let reach = f.slave_half[j] + f.seg_half[s];
-        if !inside(&segment_box(f, s, x, reach), p) {
+        if !inside(&boxes[s], p) {
             continue;
         }
+        let reach = f.slave_half[j] + f.seg_half[s];
         let xs = corners_at(f, s, x);
         let (w, q, d2) = closest_on_segment(p, &xs, f.seg_tri[s]);
         // A node that was pushed out of this segment in the last cycle and is now on the
@@ -247,16 +257,18 @@ fn deepest(
 }
 
 /// The contact of checked node `j` this cycle and its friction work; updates its memory.
+#[allow(clippy::too_many_arguments)]
 fn node_contact(
     f: &Interface,
     j: usize,
     cand: &[u32],
+    boxes: &[[f64; 6]],
     s: &Nodes<'_>,
     m: &mut Memory,
     dt: f64,
     start: bool,
 ) -> (Option<Hit>, f64) {
-    let Some((seg, w, pen, n)) = deepest(f, j, cand, s.x, m) else {
+    let Some((seg, w, pen, n)) = deepest(f, j, cand, boxes, s.x, m) else {
         *m = Memory {
             seg: u32::MAX,
             ..Memory::default()
