@@ -133,6 +133,12 @@ pub struct Args {
     /// `<interface id>.energy|friction`).
     #[arg(long)]
     pub contact_energies: Option<PathBuf>,
+    /// Write the force of each contact interface here, sampled at the output interval as
+    /// the mean over each interval (wide CSV, columns `<interface id>.fx|fy|fz|fn`: the
+    /// resultant on the slave side, zero for a single-surface contact, and the sum of the
+    /// normal force over its contacts).
+    #[arg(long)]
+    pub contact_forces: Option<PathBuf>,
     /// The nodal quantity written to `--out`.
     #[arg(long, value_enum, default_value_t)]
     pub quantity: QuantityArg,
@@ -240,6 +246,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let c = result.contacts.as_ref().ok_or_else(|| {
             CliError::input(format!(
                 "{name}: --contact-energies needs a contact interface in the model"
+            ))
+        })?;
+        c.write_csv(path)?;
+    }
+    if let Some(path) = &args.contact_forces {
+        let c = result.contact_forces.as_ref().ok_or_else(|| {
+            CliError::input(format!(
+                "{name}: --contact-forces needs a contact interface in the model"
             ))
         })?;
         c.write_csv(path)?;

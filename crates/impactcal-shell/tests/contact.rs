@@ -232,11 +232,9 @@ fn contact_damping_follows_the_damped_oscillator() {
     assert!(rel(out, -v) < 5e-3, "rebound {out} vs {}", -v);
 }
 
-/// Two 4 x 4 plates (2 mm steel) 1 mm apart flying at each other at 5 m/s each, run to
-/// well after they part, with the time-step scale factor `tssfac`: the momentum of the
-/// whole, plate A's momentum after, the largest deviation of the energy ratio from 1, the
-/// final energy ratio, the interface's energy after, and the worst penetration.
-fn plates_meeting(tssfac: f64) -> (f64, f64, f64, f64, f64, f64, f64) {
+/// Two 4 x 4 plates (2 mm steel, parts 1 and 2) 1 mm apart flying at each other at 5 m/s
+/// each, held together by `contact`; `t` is their thickness.
+fn two_plates(contact: Contact) -> (ShellModel, f64) {
     let t = 0.002;
     let mut m = plate(4, 4, 0.1, 0.1, [0.0; 3]);
     let b = plate(4, 4, 0.1, 0.1, [0.008, 0.005, t + 0.001]);
@@ -261,9 +259,17 @@ fn plates_meeting(tssfac: f64) -> (f64, f64, f64, f64, f64, f64, f64) {
         VelocityTarget::Part(2),
         [0.0, 0.0, -5.0],
     ));
-    m.contacts
-        .push(Contact::single_surface(ContactSurface::PartSet(1)));
+    m.contacts.push(contact);
     m.control.end_time = 4e-4;
+    (m, t)
+}
+
+/// The two plates of [`two_plates`] in a single-surface contact, run to well after they
+/// part, with the time-step scale factor `tssfac`: the momentum of the
+/// whole, plate A's momentum after, the largest deviation of the energy ratio from 1, the
+/// final energy ratio, the interface's energy after, and the worst penetration.
+fn plates_meeting(tssfac: f64) -> (f64, f64, f64, f64, f64, f64, f64) {
+    let (mut m, t) = two_plates(Contact::single_surface(ContactSurface::PartSet(1)));
     m.control.tssfac = tssfac;
     let mut sim = Simulation::new(&m).unwrap();
     let momentum = |s: &Simulation, part: Option<bool>| {
@@ -338,6 +344,80 @@ fn two_plates_meeting_at_speed_keep_momentum_and_energy() {
     );
     assert!(fine.4.abs() < 0.01, "interface energy after {}", fine.4);
     assert!(fine.4.abs() < coarse.4.abs() / 4.0);
+}
+
+/// The interface's sampled forces (`RunResult::contact_forces`) against the momentum the
+/// plates exchange. In a surface-to-surface contact the slave side's resultant, integrated
+/// over the run, is the momentum plate A (the slave part) gained, component by component;
+/// at every sample it is no larger than the summed normal force `fn` (no friction here).
+/// In a single-surface contact over both plates every force acts within the one side: the
+/// resultant is zero to round-off while `fn` carries the exchange. The sampled interface
+/// energy ends at the interface's energy.
+#[test]
+fn contact_forces_integrate_to_the_momentum_exchanged() {
+    let s2s = Contact::between(
+        ContactKind::SurfaceToSurface,
+        ContactSurface::Part(1),
+        ContactSurface::Part(2),
+    );
+    for (contact, single) in [
+        (s2s, false),
+        (Contact::single_surface(ContactSurface::PartSet(1)), true),
+    ] {
+        let (m, _) = two_plates(contact);
+        let mut sim = Simulation::new(&m).unwrap();
+        let plate_a = |s: &Simulation| {
+            let mut p = [0.0; 3];
+            for ((v, mass), id) in s.velocities().iter().zip(s.masses()).zip(s.node_ids()) {
+                if *id < 100 {
+                    for d in 0..3 {
+                        p[d] += mass * v[d];
+                    }
+                }
+            }
+            p
+        };
+        let p0 = plate_a(&sim);
+        let r = sim.run().unwrap();
+        let p1 = plate_a(&sim);
+        let f = r.contact_forces.as_ref().unwrap();
+        assert_eq!(f.labels(), ["1.fx", "1.fy", "1.fz", "1.fn"]);
+        let dt = f.dt();
+        let integral: Vec<f64> = (0..4)
+            .map(|c| f.channel(c).iter().sum::<f64>() * dt)
+            .collect();
+        let exchanged = (p1[2] - p0[2]).abs();
+        assert!(exchanged > 0.9 * 2.0 * p0[2].abs(), "{exchanged} vs {p0:?}");
+        for k in 0..f.samples() {
+            let g = [f.value(0, k), f.value(1, k), f.value(2, k)];
+            let size = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+            assert!(
+                size <= f.value(3, k) * (1.0 + 1e-9) + 1e-9,
+                "sample {k}: {g:?}"
+            );
+        }
+        assert!(integral[3] >= exchanged * (1.0 - 1e-9), "{integral:?}");
+        eprintln!(
+            "single surface {single}: integral {integral:?}, plate A gained {:?}",
+            [p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]]
+        );
+        for d in 0..3 {
+            if single {
+                assert!(integral[d].abs() < 1e-9 * exchanged, "{integral:?}");
+            } else {
+                assert!(
+                    (integral[d] - (p1[d] - p0[d])).abs() < 1e-9 * exchanged,
+                    "component {d}: {integral:?} vs {:?}",
+                    [p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]]
+                );
+            }
+        }
+        let e = r.contacts.as_ref().unwrap();
+        assert_eq!(e.labels(), ["1.energy", "1.friction"]);
+        let (_, energy, friction) = sim.contact_energies()[0];
+        assert_eq!(e.value(0, e.samples() - 1), energy);
+        assert_eq!(e.value(1, e.samples() - 1), friction);
+    }
 }
 
 /// A block (one 0.1 m square with 2.5 kg at each corner) launched at 2 m/s along a held

@@ -24,6 +24,10 @@ pub(crate) struct Interface {
     pub nodes: Vec<u32>,
     /// The rigid body of each local node (`usize::MAX`: none).
     pub body: Vec<usize>,
+    /// True for a local node on the slave side (the side whose resultant force is
+    /// reported): a node checked against master segments or a corner of a slave segment;
+    /// every node of a single-surface contact.
+    pub on_slave: Vec<bool>,
     /// The local nodes checked against segments.
     pub slaves: Vec<u32>,
     /// Half the contact thickness of each checked node.
@@ -425,12 +429,26 @@ fn build(m: &Model<'_>, control: &ContactControl, c: &Contact, id: u64) -> Resul
         segs.push(el.nodes.map(|i| local[i as usize]));
         seg_tri.push(el.tri);
     }
+    let mut on_slave: Vec<bool> = nodes
+        .iter()
+        .map(|&i| single || checks[i as usize] & MASTER != 0)
+        .collect();
+    if c.kind == ContactKind::SurfaceToSurface {
+        for (d, seg) in defs.iter().zip(&segs) {
+            if d.side & SLAVE != 0 {
+                for &l in &seg[..if m.elems[d.elem].tri { 3 } else { 4 }] {
+                    on_slave[l as usize] = true;
+                }
+            }
+        }
+    }
     let max_half = slave_half.iter().copied().fold(0.0, f64::max);
     let mean_size = defs.iter().map(|d| d.area.sqrt()).sum::<f64>() / defs.len() as f64;
     let max_seg_half = defs.iter().map(|d| d.half).fold(0.0, f64::max);
     Ok(Interface {
         id,
         body: nodes.iter().map(|&i| m.body_of[i as usize]).collect(),
+        on_slave,
         nodes,
         slaves,
         slave_half,

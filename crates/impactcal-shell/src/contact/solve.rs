@@ -12,12 +12,14 @@ use crate::geometry::{dot, sub};
 const CHUNK: usize = 256;
 
 /// The contact of one checked node in one cycle: the segment, the weights of the closest
-/// point on its corners and the force on the node (the segment's corners take `-w_k f`).
+/// point on its corners, the force on the node (the segment's corners take `-w_k f`) and
+/// its normal part (penalty and damping, >= 0).
 #[derive(Debug, Clone, Copy)]
 struct Hit {
     seg: u32,
     w: [f64; 4],
     f: [f64; 3],
+    normal: f64,
 }
 
 /// What the node remembers between cycles.
@@ -54,6 +56,9 @@ pub(crate) struct ContactState {
     /// friction share of it.
     pub energy: f64,
     pub friction: f64,
+    /// This cycle's resultant force on the slave side `[x, y, z]` and the sum of the
+    /// normal force over the contacts.
+    pub resultant: [f64; 4],
     /// Number of bucket sorts so far.
     pub sorts: u64,
     /// The number of nodes that penetrated at the start and the largest penetration.
@@ -88,6 +93,7 @@ impl ContactState {
             force_old: vec![[0.0; 3]; f.nodes.len()],
             energy: 0.0,
             friction: 0.0,
+            resultant: [0.0; 4],
             sorts: 1,
             initial: (0, 0.0),
         }
@@ -112,12 +118,19 @@ impl ContactState {
             worst = worst.max(dot(d, d));
         }
         if 2.0 * worst.sqrt() > f.margin {
-            self.cand = candidates(f, x, f.margin);
-            for (l, &i) in f.nodes.iter().enumerate() {
-                self.x_sort[l] = x[i as usize];
-            }
-            self.sorts += 1;
+            self.sort(f, x);
         }
+    }
+
+    /// The bucket sort on the positions `x`: new candidate lists and the positions they
+    /// were found on; returns the number of candidate pairs.
+    pub fn sort(&mut self, f: &Interface, x: &[[f64; 3]]) -> usize {
+        self.cand = candidates(f, x, f.margin);
+        for (l, &i) in f.nodes.iter().enumerate() {
+            self.x_sort[l] = x[i as usize];
+        }
+        self.sorts += 1;
+        self.cand.list.len()
     }
 
     /// One cycle at time `t`: contact forces on the positions `x` with the mid-step
@@ -160,8 +173,10 @@ impl ContactState {
         // Forces on the interface's nodes, added in node order.
         std::mem::swap(&mut self.force, &mut self.force_old);
         self.force.iter_mut().for_each(|g| *g = [0.0; 3]);
+        let mut normal = 0.0;
         for (j, h) in self.hits.iter().enumerate() {
             let Some(h) = h else { continue };
+            normal += h.normal;
             let u = f.slaves[j] as usize;
             for d in 0..3 {
                 self.force[u][d] += h.f[d];
@@ -174,9 +189,15 @@ impl ContactState {
             }
         }
         let mut work = 0.0;
+        let mut resultant = [0.0, 0.0, 0.0, normal];
         for (l, &i) in f.nodes.iter().enumerate() {
             let i = i as usize;
             let (g, g0, v) = (self.force[l], self.force_old[l], s.v[i]);
+            if f.on_slave[l] {
+                for d in 0..3 {
+                    resultant[d] += g[d];
+                }
+            }
             work += 0.5 * (dot(g, v) + dot(g0, v)) * dt;
             if s.mass[i] > 0.0 && g != [0.0; 3] {
                 for d in 0..3 {
@@ -186,6 +207,7 @@ impl ContactState {
         }
         self.energy -= work;
         self.friction += self.chunk_work.iter().sum::<f64>();
+        self.resultant = resultant;
         if start {
             let refs = self.memory.iter().filter(|m| m.reference > 0.0);
             self.initial = refs.fold((0, 0.0), |(n, x), m| (n + 1, f64::max(x, m.reference)));
@@ -341,6 +363,7 @@ fn node_contact(
             seg: seg as u32,
             w,
             f: force,
+            normal: fn_,
         }),
         work,
     )
