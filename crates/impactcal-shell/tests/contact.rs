@@ -6,7 +6,7 @@
 //! segment beyond a tolerance, energy balance), and bit-identical results for any number of
 //! threads.
 
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 mod common;
 

@@ -101,6 +101,8 @@ pub(crate) fn closest_on_segment(
 }
 
 #[cfg(test)]
+// A point in a vertex region gets that vertex's weight exactly 1.
+#[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
 

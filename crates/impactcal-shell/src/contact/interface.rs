@@ -102,7 +102,7 @@ struct SegDef {
 /// death before birth), an empty surface, or a penalty scale factor that is not positive.
 pub(crate) fn compile(m: &Model<'_>, control: &ContactControl) -> Result<Vec<Interface>> {
     let contacts = &m.model.contacts;
-    if !contacts.is_empty() && !(control.penalty_scale > 0.0 && control.penalty_scale.is_finite()) {
+    if !contacts.is_empty() && !positive(control.penalty_scale) {
         return Err(ShellError::value(
             "contact penalty scale factor (SLSFAC)",
             format!("must be finite and positive, got {}", control.penalty_scale),
@@ -124,6 +124,11 @@ pub(crate) fn compile(m: &Model<'_>, control: &ContactControl) -> Result<Vec<Int
         out.push(build(m, control, c, id)?);
     }
     Ok(out)
+}
+
+/// True for a finite value above zero.
+fn positive(v: f64) -> bool {
+    v > 0.0 && v.is_finite()
 }
 
 fn check_settings(c: &Contact, by: &str) -> Result<()> {
@@ -151,10 +156,11 @@ fn check_settings(c: &Contact, by: &str) -> Result<()> {
         ));
     }
     for (side, s) in [("slave", c.slave_side), ("master", c.master_side)] {
-        if !(s.stiffness_scale > 0.0 && s.stiffness_scale.is_finite())
-            || !(s.thickness_scale > 0.0 && s.thickness_scale.is_finite())
-            || !(s.thickness >= 0.0 && s.thickness.is_finite())
-        {
+        let valid = positive(s.stiffness_scale)
+            && positive(s.thickness_scale)
+            && s.thickness >= 0.0
+            && s.thickness.is_finite();
+        if !valid {
             return Err(ShellError::value(
                 by,
                 format!(

@@ -199,7 +199,7 @@ impl ContactState {
                 }
             }
             work += 0.5 * (dot(g, v) + dot(g0, v)) * dt;
-            if s.mass[i] > 0.0 && g != [0.0; 3] {
+            if s.mass[i] > 0.0 && g.iter().any(|&c| c != 0.0) {
                 for d in 0..3 {
                     a[i][d] += g[d] / s.mass[i];
                 }
@@ -237,7 +237,7 @@ fn deepest(
     m: &Memory,
 ) -> Option<(usize, [f64; 4], f64, [f64; 3])> {
     let p = x[f.nodes[f.slaves[j] as usize] as usize];
-    let was = m.normal != [0.0; 3];
+    let was = m.normal.iter().any(|&c| c != 0.0);
     let mut best: Option<(usize, [f64; 4], f64, [f64; 3])> = None;
     for &s in cand {
         let s = s as usize;
