@@ -83,26 +83,21 @@ fn kernels(c: &mut Criterion) {
             .num_threads(threads)
             .build()
             .unwrap();
-        let mut search = c.benchmark_group(format!("contact_search_{threads}_thread"));
-        search.sample_size(20);
-        for n in [32u64, 64, 128] {
-            let mut sim = pool.install(|| in_contact(n));
-            let shells = 2 * n * n;
-            search.bench_with_input(BenchmarkId::from_parameter(shells), &n, |b, _| {
-                b.iter(|| pool.install(|| sim.contact_search()))
-            });
+        let kernels: [(&str, fn(&mut Simulation) -> f64); 2] = [
+            ("search", |s| s.contact_search() as f64),
+            ("forces", Simulation::contact_pass),
+        ];
+        for (name, kernel) in kernels {
+            let mut g = c.benchmark_group(format!("contact_{name}_{threads}_thread"));
+            g.sample_size(20);
+            for n in [32u64, 64, 128] {
+                let mut sim = pool.install(|| in_contact(n));
+                g.bench_with_input(BenchmarkId::from_parameter(2 * n * n), &n, |b, _| {
+                    b.iter(|| pool.install(|| kernel(&mut sim)))
+                });
+            }
+            g.finish();
         }
-        search.finish();
-        let mut force = c.benchmark_group(format!("contact_forces_{threads}_thread"));
-        force.sample_size(20);
-        for n in [32u64, 64, 128] {
-            let mut sim = pool.install(|| in_contact(n));
-            let shells = 2 * n * n;
-            force.bench_with_input(BenchmarkId::from_parameter(shells), &n, |b, _| {
-                b.iter(|| pool.install(|| sim.contact_pass()))
-            });
-        }
-        force.finish();
     }
 }
 

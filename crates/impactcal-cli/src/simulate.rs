@@ -231,32 +231,32 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some(path) = &args.energies {
         result.energies.write_csv(path)?;
     }
-    if let Some(path) = &args.wall_forces {
-        let w = result.walls.as_ref().ok_or_else(|| {
-            CliError::input(format!(
-                "{name}: --wall-forces needs a rigid wall in the model"
-            ))
-        })?;
-        w.write_csv(path)?;
+    let optional = [
+        (
+            &args.wall_forces,
+            result.walls.as_ref(),
+            "--wall-forces needs a rigid wall",
+        ),
+        (
+            &args.contact_energies,
+            result.contacts.as_ref(),
+            "--contact-energies needs a contact interface",
+        ),
+        (
+            &args.contact_forces,
+            result.contact_forces.as_ref(),
+            "--contact-forces needs a contact interface",
+        ),
+    ];
+    for (path, histories, need) in optional {
+        if let Some(path) = path {
+            let h =
+                histories.ok_or_else(|| CliError::input(format!("{name}: {need} in the model")))?;
+            h.write_csv(path)?;
+        }
     }
     if let Some(path) = &args.part_energies {
         result.part_energies.write_csv(path)?;
-    }
-    if let Some(path) = &args.contact_energies {
-        let c = result.contacts.as_ref().ok_or_else(|| {
-            CliError::input(format!(
-                "{name}: --contact-energies needs a contact interface in the model"
-            ))
-        })?;
-        c.write_csv(path)?;
-    }
-    if let Some(path) = &args.contact_forces {
-        let c = result.contact_forces.as_ref().ok_or_else(|| {
-            CliError::input(format!(
-                "{name}: --contact-forces needs a contact interface in the model"
-            ))
-        })?;
-        c.write_csv(path)?;
     }
     let s = &result.summary;
     eprintln!(
