@@ -77,13 +77,16 @@ fn in_contact(n: u64) -> Simulation {
     sim
 }
 
+/// A timed kernel on a simulation caught in contact.
+type Kernel = fn(&mut Simulation) -> f64;
+
 fn kernels(c: &mut Criterion) {
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap();
-        let kernels: [(&str, fn(&mut Simulation) -> f64); 2] = [
+        let kernels: [(&str, Kernel); 2] = [
             ("search", |s| s.contact_search() as f64),
             ("forces", Simulation::contact_pass),
         ];
