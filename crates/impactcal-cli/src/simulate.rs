@@ -129,6 +129,16 @@ pub struct Args {
     /// `<part>.internal|kinetic|hourglass|damping`).
     #[arg(long)]
     pub part_energies: Option<PathBuf>,
+    /// Write the energy of each contact interface here (wide CSV, columns
+    /// `<interface id>.energy|friction`).
+    #[arg(long)]
+    pub contact_energies: Option<PathBuf>,
+    /// Write the force of each contact interface here, sampled at the output interval as
+    /// the mean over each interval (wide CSV, columns `<interface id>.fx|fy|fz|fn`: the
+    /// resultant on the slave side, zero for a single-surface contact, and the sum of the
+    /// normal force over its contacts).
+    #[arg(long)]
+    pub contact_forces: Option<PathBuf>,
     /// The nodal quantity written to `--out`.
     #[arg(long, value_enum, default_value_t)]
     pub quantity: QuantityArg,
@@ -176,6 +186,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let started = std::time::Instant::now();
     let result = pool.install(|| -> Result<_, ShellError> {
         let mut sim = Simulation::new(&model)?;
+        for (id, n, deepest) in sim.initial_penetrations() {
+            if n > 0 {
+                eprintln!(
+                    "impactcal: warning: contact interface {id}: {n} nodes start inside a segment \
+                     (deepest {deepest:.4e}); these penetrations are kept as references that only \
+                     further penetration acts against (nodes are not moved)"
+                );
+            }
+        }
         if std::io::stderr().is_terminal() {
             let bar = indicatif::ProgressBar::new(1000);
             bar.set_style(
@@ -212,13 +231,29 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some(path) = &args.energies {
         result.energies.write_csv(path)?;
     }
-    if let Some(path) = &args.wall_forces {
-        let w = result.walls.as_ref().ok_or_else(|| {
-            CliError::input(format!(
-                "{name}: --wall-forces needs a rigid wall in the model"
-            ))
-        })?;
-        w.write_csv(path)?;
+    let optional = [
+        (
+            &args.wall_forces,
+            result.walls.as_ref(),
+            "--wall-forces needs a rigid wall",
+        ),
+        (
+            &args.contact_energies,
+            result.contacts.as_ref(),
+            "--contact-energies needs a contact interface",
+        ),
+        (
+            &args.contact_forces,
+            result.contact_forces.as_ref(),
+            "--contact-forces needs a contact interface",
+        ),
+    ];
+    for (path, histories, need) in optional {
+        if let Some(path) = path {
+            let h =
+                histories.ok_or_else(|| CliError::input(format!("{name}: {need} in the model")))?;
+            h.write_csv(path)?;
+        }
     }
     if let Some(path) = &args.part_energies {
         result.part_energies.write_csv(path)?;
@@ -226,7 +261,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let s = &result.summary;
     eprintln!(
         "impactcal: {} shells, {} cycles to t = {:.4e}; time step {:.3e} (first {:.3e}, max {:.3e}); \
-         energy ratio {:.4}; {}; peak wall force {:.4e}{}; \
+         energy ratio {:.4}; {}; peak wall force {:.4e}{}{}; \
          {:.2} s wall time on {} threads ({:.3} us per element-cycle)",
         s.elements,
         s.cycles,
@@ -238,11 +273,31 @@ pub fn run(args: Args) -> Result<(), CliError> {
         hourglass_message(&s.energies, s.hourglass_share),
         s.peak_wall_force,
         wall_peaks(&s.wall_peaks),
+        contact_message(result.contacts.as_ref()),
         wall,
         pool.current_num_threads(),
         1e6 * wall / (s.cycles.max(1) as f64 * s.elements.max(1) as f64)
     );
     Ok(())
+}
+
+/// Each contact interface's final energy and friction share, when there are interfaces.
+fn contact_message(h: Option<&impactcal::core::Histories>) -> String {
+    let Some(h) = h else {
+        return String::new();
+    };
+    let last = h.samples().saturating_sub(1);
+    let each: Vec<String> = (0..h.channels() / 2)
+        .map(|k| {
+            let id = h.labels()[2 * k].trim_end_matches(".energy");
+            format!(
+                "interface {id} {:.4e} (friction {:.4e})",
+                h.value(2 * k, last),
+                h.value(2 * k + 1, last)
+            )
+        })
+        .collect();
+    format!("; contact energy: {}", each.join(", "))
 }
 
 /// Each wall's sampled peak, when there are several walls.

@@ -111,7 +111,7 @@ fn every_unsupported_keyword_is_named_on_one_line() {
     let bad = dir.path().join("many.k");
     std::fs::write(
         &bad,
-        "*KEYWORD\n*CONTACT_AUTOMATIC_SINGLE_SURFACE\n1\n*SECTION_SOLID\n2\n*MAT_SPOTWELD\n3\n*END\n",
+        "*KEYWORD\n*CONTACT_TIED_SURFACE_TO_SURFACE\n1\n*SECTION_SOLID\n2\n*MAT_SPOTWELD\n3\n*END\n",
     )
     .unwrap();
     let out = impactcal(&["simulate", "--deck", bad.to_str().unwrap()]);
@@ -119,7 +119,7 @@ fn every_unsupported_keyword_is_named_on_one_line() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     for (kw, line) in [
-        ("*CONTACT_AUTOMATIC_SINGLE_SURFACE", 2),
+        ("*CONTACT_TIED_SURFACE_TO_SURFACE", 2),
         ("*SECTION_SOLID", 4),
         ("*MAT_SPOTWELD", 6),
     ] {
@@ -208,4 +208,104 @@ fn simulate_writes_wall_forces_and_part_energies() {
     for (a, b) in kinetic.iter().zip(part_kinetic) {
         assert!((a - b).abs() <= 1e-9 * a.abs(), "{a} vs {b}");
     }
+}
+
+/// A deck with a nodes-to-surface contact: a 2 x 2 plate (part 1) flying at 5 m/s onto a
+/// free one (part 2) 1 mm below, written by the keyword writer.
+fn plates_in_contact_deck(path: &std::path::Path) {
+    use impactcal::shell::{
+        Contact, ContactKind, ContactSurface, InitialVelocity, Material, MaterialLaw, Section,
+        ShellModel, VelocityTarget, keyword::write_deck_file,
+    };
+    let mut m = ShellModel::new("plates in contact");
+    for (part, z, base) in [(1, 0.003, 0), (2, 0.0, 100)] {
+        for j in 0..3u64 {
+            for i in 0..3u64 {
+                m.add_node(base + 1 + i + 3 * j, [0.01 * i as f64, 0.01 * j as f64, z]);
+            }
+        }
+        for j in 0..2u64 {
+            for i in 0..2u64 {
+                let n = base + 1 + i + 3 * j;
+                m.add_shell(base + 1 + i + 2 * j, part, [n, n + 1, n + 4, n + 3]);
+            }
+        }
+        m.add_part(part, 1, 1);
+    }
+    m.sections.push(Section::new(1, 0.002));
+    m.materials.push(Material {
+        id: 1,
+        density: 7850.0,
+        youngs: 210e9,
+        poisson: 0.3,
+        law: MaterialLaw::Elastic,
+    });
+    m.initial_velocities.push(InitialVelocity::translation(
+        VelocityTarget::Part(1),
+        [0.0, 0.0, -5.0],
+    ));
+    m.contacts.push(Contact::between(
+        ContactKind::NodesToSurface,
+        ContactSurface::Part(1),
+        ContactSurface::Part(2),
+    ));
+    m.control.end_time = 4e-4;
+    write_deck_file(&m, path).unwrap();
+}
+
+/// `--contact-energies` and `--contact-forces`: one column set per interface, the
+/// interface's energy at the end equal to the global contact energy (the deck has no wall),
+/// the slave side pushed up (+z) and never pulled, the summary naming the interface's
+/// energy; a deck without contact asking for them is an input error naming the option.
+#[test]
+fn simulate_writes_contact_energies_and_forces() {
+    let dir = tempfile::tempdir().unwrap();
+    let deck = dir.path().join("plates.k");
+    plates_in_contact_deck(&deck);
+    let (ce, cf, e) = (
+        dir.path().join("ce.csv"),
+        dir.path().join("cf.csv"),
+        dir.path().join("e.csv"),
+    );
+    let out = impactcal(&[
+        "simulate",
+        "--deck",
+        deck.to_str().unwrap(),
+        "--contact-energies",
+        ce.to_str().unwrap(),
+        "--contact-forces",
+        cf.to_str().unwrap(),
+        "--energies",
+        e.to_str().unwrap(),
+    ]);
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{log}");
+    assert!(log.contains("contact energy: interface 1 "), "{log}");
+    let energies = Histories::read_csv(&ce).unwrap();
+    assert_eq!(energies.labels(), ["1.energy", "1.friction"]);
+    let global = Histories::read_csv(&e).unwrap();
+    let contact = global.channel_by_label("contact").unwrap();
+    let last = energies.samples() - 1;
+    assert_eq!(energies.samples(), global.samples());
+    let (a, b) = (energies.value(0, last), contact[last]);
+    assert!((a - b).abs() <= 1e-12 * b.abs().max(1e-12), "{a} vs {b}");
+    let forces = Histories::read_csv(&cf).unwrap();
+    assert_eq!(forces.labels(), ["1.fx", "1.fy", "1.fz", "1.fn"]);
+    let fz = forces.channel_by_label("1.fz").unwrap();
+    assert!(fz.iter().all(|&f| f >= 0.0), "{fz:?}");
+    assert!(fz.iter().any(|&f| f > 0.0));
+
+    let out = impactcal(&[
+        "simulate",
+        "--deck",
+        example_file("decks", "strip_drop.k").to_str().unwrap(),
+        "--contact-forces",
+        cf.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--contact-forces needs a contact interface"),
+        "{err}"
+    );
 }

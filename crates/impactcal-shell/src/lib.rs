@@ -72,6 +72,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod airframe;
+pub mod contact;
 pub mod deck_model;
 pub mod element;
 pub mod error;
@@ -84,6 +85,9 @@ mod setup;
 pub mod simulation;
 mod validate;
 
+pub use contact::{
+    Contact, ContactControl, ContactFriction, ContactKind, ContactSurface, SideSettings,
+};
 pub use deck_model::DeckModel;
 pub use error::{Result, ShellError, UnsupportedAt};
 pub use model::{

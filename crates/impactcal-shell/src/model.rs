@@ -1,5 +1,5 @@
 //! The model description: nodes, shells, parts, sections, materials, masses, loads, the
-//! rigid wall, controls and output requests.
+//! rigid walls, contact interfaces, controls and output requests.
 //!
 //! A [`ShellModel`] is plain data with public fields, built in code or read from a keyword
 //! deck ([`crate::keyword`]). Nothing is checked here: [`crate::Simulation::new`] validates
@@ -670,6 +670,10 @@ pub struct ShellModel {
     pub prescribed: Vec<PrescribedMotion>,
     /// Spot welds.
     pub spot_welds: Vec<SpotWeld>,
+    /// Segment contact interfaces.
+    pub contacts: Vec<crate::contact::Contact>,
+    /// Settings shared by the contact interfaces.
+    pub contact_control: crate::contact::ContactControl,
     /// Curves.
     pub curves: Vec<Curve>,
     /// Body acceleration along z (gravity).

@@ -72,6 +72,7 @@ pub(crate) struct Compiled {
     pub inertia: Vec<f64>,
     pub fixed: Vec<(u32, [bool; 6])>,
     pub walls: Vec<Wall>,
+    pub contacts: Vec<crate::contact::Interface>,
     pub v0: Vec<[f64; 3]>,
     pub w0: Vec<[f64; 3]>,
     pub history: Vec<u32>,
@@ -636,6 +637,27 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         .map(|&n| lookup(&node_map, n, "node", "the history output").map(|i| i as u32))
         .collect::<Result<Vec<_>>>()?;
 
+    let contacts = crate::contact::compile(
+        &crate::contact::ContactModel {
+            model,
+            node_map: &node_map,
+            part_map: &part_map,
+            elems: &elems,
+            elem_t: elems.iter().map(|e| parts[e.props as usize].t).collect(),
+            elem_bulk: elems
+                .iter()
+                .map(|e| {
+                    let m = &parts[e.props as usize].mat;
+                    m.e / (3.0 * (1.0 - 2.0 * m.nu))
+                })
+                .collect(),
+            x0: &x0,
+            mass: &mass,
+            body_of: &body_of,
+        },
+        &model.contact_control,
+    )?;
+
     Ok(Compiled {
         node_ids: model.nodes.iter().map(|n| n.id).collect(),
         x0,
@@ -649,6 +671,7 @@ pub(crate) fn compile(model: &ShellModel) -> Result<Compiled> {
         inertia,
         fixed,
         walls,
+        contacts,
         v0,
         w0,
         history,

@@ -21,6 +21,7 @@
 use impactcal_core::Histories;
 use rayon::prelude::*;
 
+use crate::contact::{ContactNodes, ContactState};
 use crate::element::quad_lanes::{Block, LANES, quad_block};
 use crate::element::{
     self, ElementFault, ElementOutput, KernelOptions, STATE_HEAD, STATE_PER_POINT,
@@ -149,6 +150,22 @@ pub struct RunResult {
     /// wall's id is its `_ID` card's, else its 1-based position among the walls. `None`
     /// for a model without walls.
     pub walls: Option<Histories>,
+    /// The energies of each contact interface sampled at the output interval (LS-DYNA's
+    /// `sleout`): channels `<id>.energy` (the work its forces took from the structure:
+    /// spring energy stored now plus what damping and friction dissipated) and
+    /// `<id>.friction` (the friction share). An interface's id is its `_ID` card's, else
+    /// its 1-based position among the interfaces. `None` for a model without contact.
+    pub contacts: Option<Histories>,
+    /// The forces of each contact interface sampled at the output interval as the mean over
+    /// each interval (like [`RunResult::walls`]; LS-DYNA's `rcforc` resultants): channels
+    /// `<id>.fx, <id>.fy, <id>.fz`, the resultant of the interface's forces on its slave
+    /// side (the master side takes the opposite: the forces conserve momentum), and
+    /// `<id>.fn`, the sum of the normal (penalty and damping) force over every contact of
+    /// the interface. The slave side of a nodes-to-surface contact is its slave nodes; of a
+    /// surface-to-surface contact, the slave surface's nodes. A single-surface contact's
+    /// forces all act within its one side, so its resultant is zero (to round-off) and
+    /// `<id>.fn` is the measure of its load. `None` for a model without contact.
+    pub contact_forces: Option<Histories>,
     /// The energies of each part sampled at the output interval (LS-DYNA's `matsum`):
     /// channels `<part>.internal, <part>.kinetic, <part>.hourglass, <part>.damping`.
     /// Concentrated masses belong to no part.
@@ -255,6 +272,11 @@ pub struct Simulation {
     bodies: Vec<RigidState>,
     /// Per element, the mass and rotary inertia it gives each of its nodes.
     elem_mass: Vec<[f64; 2]>,
+    /// The state of each contact interface.
+    contacts: Vec<ContactState>,
+    /// Per contact interface, the impulse of its force on the slave side since the start
+    /// and the integral of its total normal force: `[x, y, z, normal]`.
+    contact_impulse: Vec<[f64; 4]>,
     started: bool,
 }
 
@@ -397,6 +419,12 @@ impl Simulation {
                 .map(|b| RigidState::initial(b, &c.mass, &c.inertia, &c.v0, &c.w0))
                 .collect(),
             elem_mass: element_masses(&c),
+            contacts: c
+                .contacts
+                .iter()
+                .map(|f| ContactState::new(f, &c.x0))
+                .collect(),
+            contact_impulse: vec![[0.0; 4]; c.contacts.len()],
             started: false,
             c,
         };
@@ -452,6 +480,66 @@ impl Simulation {
     /// The force of the walls on the structure at the current time (sum over walls).
     pub fn wall_force(&self) -> [f64; 3] {
         self.wall_force
+    }
+
+    /// Each contact interface's id, energy and friction energy now (see
+    /// [`RunResult::contacts`]), in model order.
+    pub fn contact_energies(&self) -> Vec<(u64, f64, f64)> {
+        self.c
+            .contacts
+            .iter()
+            .zip(&self.contacts)
+            .map(|(f, s)| (f.id, s.energy, s.friction))
+            .collect()
+    }
+
+    /// The contact search alone, for timing (the criterion benchmark of the contact
+    /// kernels): rebuilds every interface's candidate lists by the bucket sort on the
+    /// current positions, as a cycle does when nodes have moved far enough, and returns the
+    /// number of candidate pairs. The lists hold every pair within the search margin
+    /// whenever they are built, so calling it only moves the run's next sort.
+    pub fn contact_search(&mut self) -> usize {
+        let mut pairs = 0;
+        for (st, f) in self.contacts.iter_mut().zip(&self.c.contacts) {
+            pairs += st.sort(f, &self.x);
+        }
+        pairs
+    }
+
+    /// The contact forces alone, for timing (the criterion benchmark of the contact
+    /// kernels): one pass of every interface over its checked nodes on the current
+    /// positions and velocities with the next step (penetration, penalty, damping, friction,
+    /// the forces added in node order), and returns the summed normal force of the pass.
+    /// The pass advances the interfaces' memory (friction, contact references) and energy
+    /// as a cycle would, so a run continued after it books the extra pass: keep a
+    /// simulation used for timing for timing only.
+    pub fn contact_pass(&mut self) -> f64 {
+        let nodes = ContactNodes {
+            x: &self.x,
+            v: &self.v,
+            mass: &self.c.mass,
+        };
+        let mut normal = 0.0;
+        for (st, f) in self.contacts.iter_mut().zip(&self.c.contacts) {
+            st.cycle(f, &nodes, self.time, self.dt_half, &mut self.a);
+            normal += st.resultant[3];
+        }
+        normal
+    }
+
+    /// Each contact interface's id, the number of its nodes that penetrated a segment at
+    /// the start and the largest such penetration. These penetrations are kept as a
+    /// reference that only additional penetration acts against (nodes are not moved).
+    pub fn initial_penetrations(&self) -> Vec<(u64, usize, f64)> {
+        self.c
+            .contacts
+            .iter()
+            .zip(&self.contacts)
+            .map(|(f, s)| {
+                let (n, max) = s.initial_penetrations();
+                (f.id, n, max)
+            })
+            .collect()
     }
 
     /// The accumulated internal, hourglass and damping energies of each part, in model
@@ -706,6 +794,30 @@ impl Simulation {
         self.energies.kinetic = ke_t + ke_r;
     }
 
+    /// Segment contact: each interface's forces on the current positions with the mid-step
+    /// velocities added to the accelerations (before walls, rigid bodies and constraints),
+    /// its work over the step `dt` just taken booked as contact (and friction) energy, and
+    /// its impulse over the velocity step `dt / 2 + dt_next / 2` the forces act on.
+    fn contact(&mut self, dt: f64, dt_next: f64) {
+        let dt_v = 0.5 * (dt + dt_next);
+        let nodes = ContactNodes {
+            x: &self.x,
+            v: &self.v,
+            mass: &self.c.mass,
+        };
+        for (st, f) in self.contacts.iter_mut().zip(&self.c.contacts) {
+            let (e0, f0) = (st.energy, st.friction);
+            st.cycle(f, &nodes, self.time, dt, &mut self.a);
+            self.energies.contact += st.energy - e0;
+            self.energies.friction += st.friction - f0;
+        }
+        for (j, st) in self.contact_impulse.iter_mut().zip(&self.contacts) {
+            for k in 0..4 {
+                j[k] += st.resultant[k] * dt_v;
+            }
+        }
+    }
+
     /// Rigid walls: corrects the accelerations of the nodes that would enter a wall in the
     /// next step (kinematic) or that are in it (penalty), books the energy they remove and
     /// the impulse each wall gives.
@@ -957,6 +1069,7 @@ impl Simulation {
             .map(|c| c.dt_min)
             .fold(f64::INFINITY, f64::min);
         self.gather(0.0);
+        self.contact(0.0, dt);
         self.kick(0.0, dt);
         self.energies.initial = self.energies.kinetic;
         self.dt_half = dt;
@@ -987,6 +1100,7 @@ impl Simulation {
             Some(dt) => dt,
             None => self.control.tssfac * min,
         };
+
         if dt.is_infinite() && min.is_infinite() {
             return Err(ShellError::value(
                 "time step",
@@ -1064,6 +1178,7 @@ impl Simulation {
         let g1 = self.body_accel(self.time);
         self.energies.external_work += 0.5 * (g0 + g1) * mdz;
         self.gather(self.time);
+        self.contact(dt, dt_next);
         self.kick(0.5 * dt, dt_next);
         self.dt_half = dt_next;
         self.dt_min = self.dt_min.min(dt);
@@ -1237,6 +1352,13 @@ impl Simulation {
             "energy",
         )?;
         let walls = self.wall_histories(&samples, 9 * nh + ENERGY_LABELS.len(), interval)?;
+        let (contacts, contact_forces) = self
+            .contact_histories(
+                &samples,
+                9 * nh + ENERGY_LABELS.len() + 4 * self.c.walls.len(),
+                interval,
+            )?
+            .unzip();
         let part_energies = self.part_histories(&part_samples, interval)?;
         let mut wall_peaks = Vec::with_capacity(self.c.walls.len());
         let mut peak_total: f64 = 0.0;
@@ -1259,6 +1381,8 @@ impl Simulation {
         let mut it = nodal.into_iter();
         Ok(RunResult {
             walls,
+            contacts,
+            contact_forces,
             part_energies,
             parts: self.part_energies(),
             displacement: it.next().flatten(),
@@ -1318,6 +1442,10 @@ impl Simulation {
         for j in &self.wall_impulse {
             s.extend_from_slice(j);
         }
+        for (c, j) in self.contacts.iter().zip(&self.contact_impulse) {
+            s.extend_from_slice(&[c.energy, c.friction]);
+            s.extend_from_slice(j);
+        }
         s
     }
 
@@ -1362,24 +1490,48 @@ impl Simulation {
         for (w, wall) in self.c.walls.iter().enumerate() {
             for (k, name) in ["fx", "fy", "fz", "f"].iter().enumerate() {
                 labels.push(format!("{}.{name}", wall.id));
-                let col = at + 4 * w + k;
-                let mut prev = 0.0;
-                chans.push(
-                    samples
-                        .iter()
-                        .enumerate()
-                        .map(|(j, s)| {
-                            let f = if j == 0 { 0.0 } else { (s[col] - prev) / dt };
-                            prev = s[col];
-                            f
-                        })
-                        .collect(),
-                );
+                chans.push(mean_over_intervals(samples, at + 4 * w + k, dt));
             }
         }
         Ok(Some(Histories::from_channels(
             labels, chans, dt, 0.0, "force",
         )?))
+    }
+
+    /// The energies and the forces of each contact interface sampled at the output
+    /// interval, from column `at` of the samples (six columns per interface: energy,
+    /// friction, and the impulses `[x, y, z, normal]` since the start); see
+    /// [`RunResult::contacts`] and [`RunResult::contact_forces`].
+    fn contact_histories(
+        &self,
+        samples: &[Vec<f64>],
+        at: usize,
+        dt: f64,
+    ) -> Result<Option<(Histories, Histories)>> {
+        if self.c.contacts.is_empty() {
+            return Ok(None);
+        }
+        let (mut labels, mut chans) = (Vec::new(), Vec::new());
+        let (mut f_labels, mut f_chans) = (Vec::new(), Vec::new());
+        for (k, f) in self.c.contacts.iter().enumerate() {
+            for (j, name) in ["energy", "friction", "fx", "fy", "fz", "fn"]
+                .iter()
+                .enumerate()
+            {
+                let col = at + 6 * k + j;
+                if j < 2 {
+                    labels.push(format!("{}.{name}", f.id));
+                    chans.push(samples.iter().map(|s| s[col]).collect());
+                } else {
+                    f_labels.push(format!("{}.{name}", f.id));
+                    f_chans.push(mean_over_intervals(samples, col, dt));
+                }
+            }
+        }
+        Ok(Some((
+            Histories::from_channels(labels, chans, dt, 0.0, "energy")?,
+            Histories::from_channels(f_labels, f_chans, dt, 0.0, "force")?,
+        )))
     }
 
     /// The per-part energies sampled at the output interval: channels
@@ -1536,4 +1688,20 @@ fn chunked_sum<A: Sync>(a: &[A], b: &[f64], f: impl Fn(&A, f64) -> f64 + Sync) -
         .map(|(ca, cb)| ca.iter().zip(cb).map(|(x, &m)| f(x, m)).sum())
         .collect();
     parts.iter().sum()
+}
+
+/// The mean force over each output interval of length `dt` from the impulse since the start
+/// held in column `col` of the samples: sample `k` is the impulse between samples `k - 1`
+/// and `k` over `dt` (0 at `t = 0`).
+fn mean_over_intervals(samples: &[Vec<f64>], col: usize, dt: f64) -> Vec<f64> {
+    let mut prev = 0.0;
+    samples
+        .iter()
+        .enumerate()
+        .map(|(j, s)| {
+            let f = if j == 0 { 0.0 } else { (s[col] - prev) / dt };
+            prev = s[col];
+            f
+        })
+        .collect()
 }

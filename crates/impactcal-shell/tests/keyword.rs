@@ -230,9 +230,10 @@ $   slsfac    rwpnal
             damping: 0.0
         }
     );
-    // SLSFAC is not used: a warning says so.
+    // SLSFAC is the contact interfaces' penalty scale (none here); nothing is warned.
+    assert_eq!(m.contact_control.penalty_scale, 0.1);
     assert!(
-        deck.warnings.iter().any(|w| w.contains("RWPNAL")),
+        deck.warnings.iter().all(|w| !w.contains("CONTROL_CONTACT")),
         "{:?}",
         deck.warnings
     );
@@ -312,10 +313,10 @@ fn err(text: &str) -> ShellError {
 
 #[test]
 fn unsupported_keywords_and_bad_cards_are_typed_errors_with_lines() {
-    match err("*KEYWORD\n*CONTACT_AUTOMATIC_SINGLE_SURFACE\n1\n*END\n") {
+    match err("*KEYWORD\n*CONTACT_SINGLE_SURFACE\n1\n*END\n") {
         ShellError::UnsupportedKeyword { line, keyword, .. } => {
             assert_eq!(line, 2);
-            assert_eq!(keyword, "*CONTACT_AUTOMATIC_SINGLE_SURFACE");
+            assert_eq!(keyword, "*CONTACT_SINGLE_SURFACE");
         }
         e => panic!("{e}"),
     }

@@ -6,7 +6,7 @@
 //!
 //! The decks: `examples/decks/strip_drop.k` and, where `../shared/data/car_pole/decks`
 //! exists (GPL-3 decks, read there, never copied), the parameterised car deck with its
-//! include, less its segment contact (not read yet, so it would refuse every case). The number of cases is `IMPACTCAL_FUZZ_CASES` (default 64 per deck, which CI
+//! include. The number of cases is `IMPACTCAL_FUZZ_CASES` (default 64 per deck, which CI
 //! runs); the long run by hand and its counts are in docs/validation.md.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -38,7 +38,7 @@ fn decks() -> Vec<(&'static str, Files)> {
                 ),
                 (
                     "car6_crash_v223.k".to_string(),
-                    without_contact(&std::fs::read(car.join("car6_crash_v223.k")).unwrap()),
+                    std::fs::read(car.join("car6_crash_v223.k")).unwrap(),
                 ),
             ],
         ));
@@ -49,24 +49,6 @@ fn decks() -> Vec<(&'static str, Files)> {
         );
     }
     out
-}
-
-/// The deck without its `*CONTACT_...` keywords (segment contact is not read yet), so that
-/// the mutations reach the cards of every other keyword.
-fn without_contact(b: &[u8]) -> Vec<u8> {
-    let text = String::from_utf8_lossy(b);
-    let mut out = String::new();
-    let mut skip = false;
-    for line in text.lines() {
-        if line.starts_with('*') {
-            skip = line.to_uppercase().starts_with("*CONTACT");
-        }
-        if !skip {
-            out.push_str(line);
-            out.push('\n');
-        }
-    }
-    out.into_bytes()
 }
 
 /// The text of a file as the reader decodes it: UTF-8, else Latin-1.

@@ -114,7 +114,7 @@ fn every_unsupported_keyword_is_listed_in_one_error_with_its_line() {
     let text = edit(
         PLAIN,
         "*PART\n",
-        "*CONTACT_AUTOMATIC_SINGLE_SURFACE\n         1\n*SECTION_SOLID\n         2\n*PART\n",
+        "*CONTACT_ERODING_SINGLE_SURFACE\n         1\n*SECTION_SOLID\n         2\n*PART\n",
     );
     let text = edit(&text, "*END\n", "*MAT_SPOTWELD\n         3\n*END\n");
     match parse_deck(&text, "many.k").unwrap_err() {
@@ -127,8 +127,8 @@ fn every_unsupported_keyword_is_listed_in_one_error_with_its_line() {
                 got,
                 [
                     (
-                        line("*CONTACT_AUTOMATIC_SINGLE_SURFACE"),
-                        "*CONTACT_AUTOMATIC_SINGLE_SURFACE"
+                        line("*CONTACT_ERODING_SINGLE_SURFACE"),
+                        "*CONTACT_ERODING_SINGLE_SURFACE"
                     ),
                     (line("*SECTION_SOLID"), "*SECTION_SOLID"),
                     (line("*MAT_SPOTWELD"), "*MAT_SPOTWELD"),

@@ -131,6 +131,12 @@ pub(super) struct Reader<'a> {
     pub seen: Vec<&'static str>,
     /// `*CONTROL_CONTACT` RWPNAL, applied to every rigid wall once all are read.
     pub rwpnal: f64,
+    /// `*CONTROL_CONTACT` SFRIC, DFRIC, EDC, VFC: the friction of interfaces that give
+    /// none (FS = FD = DC = VC = 0), applied once all are read.
+    pub default_friction: crate::contact::ContactFriction,
+    /// Per interface read, its friction scale factors FSF and VSF (applied to the
+    /// defaults too).
+    pub friction_scales: Vec<(f64, f64)>,
 }
 
 /// One keyword block as its parser sees it: the options written after the keyword's name
@@ -320,6 +326,22 @@ pub(super) const TABLE: &[Entry] = &[
         &["ID"],
         fam::walls::generalized_weld,
     ),
+    // Contact interfaces.
+    e(
+        "*CONTACT_AUTOMATIC_SINGLE_SURFACE",
+        &["ID", "TITLE"],
+        fam::contacts::single_surface,
+    ),
+    e(
+        "*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE",
+        &["ID", "TITLE"],
+        fam::contacts::surface_to_surface,
+    ),
+    e(
+        "*CONTACT_AUTOMATIC_NODES_TO_SURFACE",
+        &["ID", "TITLE"],
+        fam::contacts::nodes_to_surface,
+    ),
     // Controls and output requests.
     e(
         "*CONTROL_BULK_VISCOSITY",
@@ -426,6 +448,8 @@ fn parse_source(src: Source, overrides: &Params) -> Result<Deck> {
         notes: RefCell::new(Vec::new()),
         seen: Vec::new(),
         rwpnal: 0.0,
+        default_friction: crate::contact::ContactFriction::default(),
+        friction_scales: Vec::new(),
     };
     let mut cards = 0;
     for (b, how) in blocks.iter().zip(resolved) {
@@ -515,6 +539,21 @@ fn finish(
     }
     let notes = r.notes.into_inner();
     r.warnings.extend(notes);
+    let d = r.default_friction;
+    for (c, &(fsf, vsf)) in r.model.contacts.iter_mut().zip(&r.friction_scales) {
+        let f = &mut c.friction;
+        for (v, default, scale) in [
+            (&mut f.static_coef, d.static_coef, fsf),
+            (&mut f.dynamic, d.dynamic, fsf),
+            (&mut f.decay, d.decay, 1.0),
+            (&mut f.viscous, d.viscous, vsf),
+        ] {
+            if *v == 0.0 {
+                *v = default;
+            }
+            *v *= scale;
+        }
+    }
     if r.rwpnal > 0.0 {
         for w in &mut r.model.walls {
             w.method = WallMethod::Penalty {
@@ -568,7 +607,12 @@ mod tests {
             resolve("*SENSOR_DEFINE_FORCE"),
             Some(Resolved::Skip(_))
         ));
-        assert!(resolve("*CONTACT_AUTOMATIC_SINGLE_SURFACE_ID").is_none());
+        assert_eq!(
+            read("*CONTACT_AUTOMATIC_SINGLE_SURFACE_ID").unwrap().0,
+            "*CONTACT_AUTOMATIC_SINGLE_SURFACE"
+        );
+        assert!(resolve("*CONTACT_AUTOMATIC_SINGLE_SURFACE_MPP").is_none());
+        assert!(resolve("*CONTACT_SINGLE_SURFACE").is_none());
         // Every table name is unique.
         for (i, a) in TABLE.iter().enumerate() {
             assert!(

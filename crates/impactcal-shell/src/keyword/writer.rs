@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use crate::contact::{ContactControl, ContactKind, ContactSurface};
 use crate::error::{Result, ShellError};
 use crate::model::{
     Hardening, Hourglass, HourglassForm, MaterialLaw, MotionKind, MotionTarget, NodeTarget,
@@ -92,6 +93,7 @@ pub fn write_deck(model: &ShellModel) -> Result<String> {
     write_mesh(model, &mut o)?;
     write_conditions(model, &mut o)?;
     write_walls(model, &mut o)?;
+    write_contacts(model, &mut o)?;
     o.w("*END".into());
     Ok(o.0)
 }
@@ -183,9 +185,18 @@ fn write_controls(model: &ShellModel, o: &mut Out) -> Result<()> {
         o.w("*CONTROL_ACCURACY".into());
         o.w(format!("{}{}", int(0, 10), int(2, 10)));
     }
-    if let Some(alpha) = penalty_factor(model)? {
+    let alpha = penalty_factor(model)?;
+    let cc = model.contact_control;
+    if alpha.is_some() || cc != ContactControl::default() {
         o.w("*CONTROL_CONTACT".into());
-        o.w(format!("{}{}", real(0.0, 10), real(alpha, 10)));
+        o.w(format!(
+            "{}{}",
+            real(cc.penalty_scale, 10),
+            real(alpha.unwrap_or(0.0), 10)
+        ));
+        if cc.full_thickness {
+            o.w(format!("{}{}", " ".repeat(50), int(1, 10)));
+        }
     }
     if model.output.interval > 0.0 {
         o.w("*DATABASE_NODOUT".into());
@@ -477,6 +488,72 @@ fn write_conditions(model: &ShellModel, o: &mut Out) -> Result<()> {
                 ));
             }
         }
+    }
+    Ok(())
+}
+
+/// The contact interfaces.
+fn write_contacts(model: &ShellModel, o: &mut Out) -> Result<()> {
+    let side = |s: ContactSurface| match s {
+        ContactSurface::PartSet(id) => (id, 2),
+        ContactSurface::Part(id) => (id, 3),
+        ContactSurface::NodeSet(id) => (id, 4),
+        ContactSurface::All => (0, 5),
+    };
+    for (k, c) in model.contacts.iter().enumerate() {
+        let what = || format!("contact interface {}", k + 1);
+        let name = match c.kind {
+            ContactKind::SingleSurface => "SINGLE_SURFACE",
+            ContactKind::SurfaceToSurface => "SURFACE_TO_SURFACE",
+            ContactKind::NodesToSurface => "NODES_TO_SURFACE",
+        };
+        if !(c.birth >= 0.0) {
+            return Err(unrepresentable(what(), "a negative birth time"));
+        }
+        let (ssid, sstyp) = side(c.slave);
+        let (msid, mstyp) = match c.kind {
+            ContactKind::SingleSurface => (0, 0),
+            _ if matches!(c.master, ContactSurface::NodeSet(_)) => {
+                return Err(unrepresentable(what(), "a node set as the master side"));
+            }
+            _ => side(c.master),
+        };
+        o.w(format!(
+            "*CONTACT_AUTOMATIC_{name}{}",
+            if c.id > 0 { "_ID" } else { "" }
+        ));
+        if c.id > 0 {
+            o.w(int(c.id, 10));
+        }
+        o.w(format!(
+            "{}{}{}{}",
+            int(ssid, 10),
+            int(msid, 10),
+            int(sstyp, 10),
+            int(mstyp, 10)
+        ));
+        let f = c.friction;
+        o.w(format!(
+            "{}{}{}{}{}{}{}{}",
+            real(f.static_coef, 10),
+            real(f.dynamic, 10),
+            real(f.decay, 10),
+            real(f.viscous, 10),
+            real(c.damping, 10),
+            int(0, 10),
+            real(c.birth, 10),
+            real(if c.death.is_finite() { c.death } else { 0.0 }, 10)
+        ));
+        let (s, m) = (c.slave_side, c.master_side);
+        o.w(format!(
+            "{}{}{}{}{}{}",
+            real(s.stiffness_scale, 10),
+            real(m.stiffness_scale, 10),
+            real(s.thickness, 10),
+            real(m.thickness, 10),
+            real(s.thickness_scale, 10),
+            real(m.thickness_scale, 10)
+        ));
     }
     Ok(())
 }

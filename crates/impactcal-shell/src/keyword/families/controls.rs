@@ -72,11 +72,25 @@ pub(crate) fn accuracy(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     Ok(())
 }
 
-/// `*CONTROL_CONTACT`: RWPNAL (0 constraint walls; 0 < RWPNAL <= 1 penalty walls); the
-/// other fields and the optional cards 2 to 6 are ignored with a warning.
+/// `*CONTROL_CONTACT`, up to six cards. Read: SLSFAC (the penalty scale factor of the
+/// contact interfaces, 0.1 when blank), RWPNAL (0 constraint walls; 0 < RWPNAL <= 1
+/// penalty walls), PENOPT (0 or 1: the smaller of the node's and the segment's stiffness);
+/// card 2 SSTHK (1: a single-surface contact uses the full shell thickness instead of at
+/// most 0.4 of the shortest edge); card 3 SFRIC, DFRIC, EDC, VFC (the friction of
+/// interfaces that give none); card 4 IGNORE (0 to 2: initial penetrations are always
+/// kept as references). Refused when set: TH, TH_SF, PEN_SF (card 3), SPOTHIN (card 4).
+/// Every other field has no effect on the automatic penalty contact of this solver and is
+/// ignored, with a warning when it is set.
 pub(crate) fn contact(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     let c = kw.take("the card SLSFAC, RWPNAL, ...")?;
     let f = kw.fields(&c, W10);
+    let slsfac = f.real(0, "SLSFAC", 0.0)?;
+    if slsfac < 0.0 {
+        return Err(f.err(format!(
+            "field SLSFAC: {slsfac} is not supported (a positive scale factor; blank or 0 is 0.1)"
+        )));
+    }
+    r.model.contact_control.penalty_scale = if slsfac == 0.0 { 0.1 } else { slsfac };
     let rwpnal = f.real(1, "RWPNAL", 0.0)?;
     if !(0.0..=1.0).contains(&rwpnal) {
         return Err(f.err(format!(
@@ -85,18 +99,90 @@ pub(crate) fn contact(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
         )));
     }
     r.rwpnal = rwpnal;
-    let other = (0..8)
-        .filter(|&k| k != 1)
-        .map(|k| f.real(k, "SLSFAC-ENMASS", 0.0))
-        .collect::<Result<Vec<_>>>()?;
+    let penopt = f.int(4, "PENOPT", 0)?;
+    if !(0..=1).contains(&penopt) {
+        return Err(f.err(format!(
+            "field PENOPT: {penopt} is not supported (0 or 1: the smaller of the node's and the \
+             segment's stiffness)"
+        )));
+    }
+    let mut unused: Vec<&str> = Vec::new();
+    for (k, name) in [
+        (2, "ISLCHK"),
+        (3, "SHLTHK"),
+        (5, "THKCHG"),
+        (6, "ORIEN"),
+        (7, "ENMASS"),
+    ] {
+        if f.real(k, name, 0.0)? != 0.0 {
+            unused.push(name);
+        }
+    }
+    if let Some(c) = kw.next() {
+        let g = kw.fields(&c, W10);
+        let names = [
+            "USRSTR", "USRFRC", "NSBCS", "INTERM", "XPENE", "SSTHK", "ECDT", "TIEDPRJ",
+        ];
+        for (k, name) in names.iter().enumerate() {
+            if k != 5 && g.real(k, name, 0.0)? != 0.0 {
+                unused.push(name);
+            }
+        }
+        r.model.contact_control.full_thickness = match g.int(5, "SSTHK", 0)? {
+            0 => false,
+            1 => true,
+            v => return Err(g.err(format!("field SSTHK: {v} is not supported (0 or 1)"))),
+        };
+    }
+    if let Some(c) = kw.next() {
+        let g = kw.fields(&c, W10);
+        let d = &mut r.default_friction;
+        for (k, name, v) in [
+            (0, "SFRIC", &mut d.static_coef),
+            (1, "DFRIC", &mut d.dynamic),
+            (2, "EDC", &mut d.decay),
+            (3, "VFC", &mut d.viscous),
+        ] {
+            *v = g.real(k, name, 0.0)?;
+            if *v < 0.0 {
+                return Err(g.err(format!("field {name}: must be >= 0, got {v}")));
+            }
+        }
+        for (k, name) in [(4, "TH"), (5, "TH_SF"), (6, "PEN_SF")] {
+            g.must_be_zero(k, name)?;
+        }
+    }
+    if let Some(c) = kw.next() {
+        let g = kw.fields(&c, W10);
+        match g.int(0, "IGNORE", 0)? {
+            0..=2 => {}
+            v => return Err(g.err(format!("field IGNORE: {v} is not supported (0, 1 or 2)"))),
+        }
+        g.must_be_zero(6, "SPOTHIN")?;
+        for (k, name) in [
+            (1, "FRCENG"),
+            (2, "SKIPRWG"),
+            (3, "OUTSEG"),
+            (4, "SPOTSTP"),
+            (5, "SPOTDEL"),
+        ] {
+            if g.real(k, name, 0.0)? != 0.0 {
+                unused.push(name);
+            }
+        }
+    }
     let mut extra = 0;
-    while extra < 5 && kw.next().is_some() {
+    while extra < 2 && kw.next().is_some() {
         extra += 1;
     }
-    if other.iter().any(|&v| v != 0.0) || extra > 0 {
+    if !unused.is_empty() || extra > 0 {
         r.warnings.push(kw.warning(
             c.line,
-            "only RWPNAL is used (there are no contact interfaces)",
+            format!(
+                "{}{} ignored: they have no effect on the automatic penalty contact of this solver",
+                unused.join(", "),
+                if extra > 0 { " and cards 5, 6" } else { "" }
+            ),
         ));
     }
     Ok(())

@@ -54,9 +54,16 @@ pub(crate) fn plastic_kinematic(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<(
         let id = f.id(0, "MID")?;
         let beta = f.real(6, "BETA", 0.0)?;
         if beta != 1.0 {
+            let same = if f.real(5, "ETAN", 0.0)? == 0.0 {
+                " (the same law here: ETAN = 0, no hardening)"
+            } else {
+                ""
+            };
             r.warnings.push(kw.warning(
                 c1.line,
-                format!("material {id}: BETA = {beta}; isotropic hardening (BETA = 1) is used"),
+                format!(
+                    "material {id}: BETA = {beta}; isotropic hardening (BETA = 1) is used{same}"
+                ),
             ));
         }
         let g = kw.fields(&c2, W10);

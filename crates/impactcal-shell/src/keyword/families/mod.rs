@@ -1,6 +1,7 @@
 //! The card parsers, one module per family of keywords; [`super::reader::TABLE`] maps each
 //! keyword to its parser.
 
+pub(super) mod contacts;
 pub(super) mod controls;
 pub(super) mod loads;
 pub(super) mod materials;
