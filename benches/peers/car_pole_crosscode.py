@@ -11,6 +11,9 @@ Helper of benches/peers/car_pole_crosscode.sh (standard library only). Subcomman
   outputs DIR              the four outputs of our run in DIR, computed as the study did
   compare RESULTS          table of ours against LS-DYNA's per output: mean and max relative
                            difference, Pearson and Spearman correlation over the designs
+  controls                 names of the controlled reruns at the base design
+  control NAME DIR         write DIR/main.k (base design) and DIR/car6_crash_v223.k, the
+                           model with the one change NAME (under /tmp, never the project)
   selftest                 checks of the metric code against hand-computed values
 
 The study's outputs (dbrizard/GSA-car-crash@477fb05, LSDYNAmodel.py, CAR6model.getGSAoutput)
@@ -88,6 +91,57 @@ def parameter_deck(values, include):
     return "\n".join(lines) + "\n"
 
 
+# Controlled reruns at the base design: each changes one thing of the model (in a copy of
+# the include written beside the derived deck, never in the project).
+CONTROLS = {
+    "all-nodes-moving": "every node starts at the deck's -8333 mm/s (the deck's "
+                        "*INITIAL_VELOCITY_NODE covers nodes 1-758 only)",
+    "ground-frictionless": "the ground wall's FRIC 0.2 set to 0",
+    "hourglass-half": "every *HOURGLASS QM 0.02 set to 0.01",
+}
+
+
+def control_include(name, text):
+    """The model's include text with control `name` applied; fails loudly when the card it
+    changes is not where expected."""
+    lines = text.split("\n")
+    if name == "all-nodes-moving":
+        nodes, in_nodes = [], False
+        for line in lines:
+            if line.startswith("*"):
+                in_nodes = line.strip() == "*NODE"
+            elif in_nodes and line.strip() and not line.startswith("$"):
+                nodes.append(int(line[:8]))
+        i = lines.index("*INITIAL_VELOCITY_NODE")
+        j = i + 1
+        listed = set()
+        while not lines[j].startswith("*"):
+            if lines[j].strip() and not lines[j].startswith("$"):
+                listed.add(int(lines[j][:10]))
+            j += 1
+        extra = [f"{n:10d}{-8333.0:10.1f}{0.0:10.1f}{0.0:10.1f}" for n in nodes
+                 if n not in listed]
+        return "\n".join(lines[:j] + extra + lines[j:])
+    if name == "ground-frictionless":
+        i = lines.index("*RIGIDWALL_PLANAR_ID")
+        k = next(j for j in range(i + 1, len(lines))
+                 if lines[j].strip() and not lines[j].startswith("$")
+                 and lines[j].split()[-2:] == ["0.2", "0.0"])
+        lines[k] = lines[k][:60] + f"{0.0:10.1f}" + lines[k][70:]
+        return "\n".join(lines)
+    if name == "hourglass-half":
+        out, n = [], 0
+        for k, line in enumerate(lines):
+            if k > 1 and lines[k - 2].startswith("*HOURGLASS") and line[20:30].strip() == "0.02":
+                line = line[:20] + f"{0.01:10.2f}" + line[30:]
+                n += 1
+            out.append(line)
+        if n != 7:
+            raise SystemExit(f"hourglass-half: {n} *HOURGLASS cards changed, 7 expected")
+        return "\n".join(out)
+    raise SystemExit(f"unknown control {name}; known: {', '.join(CONTROLS)}")
+
+
 def read_wide(path):
     """Our wide CSV: header `time,<labels>`, one row per sample."""
     with open(path) as f:
@@ -159,8 +213,9 @@ def spearman(a, b):
 
 
 def rel(ours, theirs):
-    """Signed relative difference (ours - theirs) / |theirs|."""
-    return (ours - theirs) / abs(theirs)
+    """Relative difference ours / theirs - 1: for the negative dmax and vfin, negative when
+    our magnitude is the smaller."""
+    return ours / theirs - 1.0
 
 
 def summary(ours, theirs):
@@ -178,8 +233,9 @@ def compare(results):
     with open(results) as f:
         rows = list(csv.DictReader(f))
     y = read_y()
-    designs = [r for r in rows if r["row"] != "base"]
+    designs = [r for r in rows if r["row"].isdigit()]
     base = [r for r in rows if r["row"] == "base"]
+    controls = [r for r in rows if r["row"] in CONTROLS]
     if not designs:
         raise SystemExit(f"{results}: no design rows")
     print(f"{len(designs)} designs of p9_X.csv (rows {', '.join(r['row'] for r in designs)})")
@@ -208,6 +264,26 @@ def compare(results):
             m = sum(BASE_REPEATS[k]) / len(BASE_REPEATS[k])
             cells.append(f"{m:.4g} | {float(r[k]):.4g} ({100 * rel(float(r[k]), m):+.1f} %)")
         print("| base (mean of 5 repeats) | " + " | ".join(cells) + " |")
+    if not (base and controls):
+        return
+    print()
+    print("Controlled reruns at the base design: each output, and its change from our base run "
+          "and (in brackets) the gap to LS-DYNA's mean that the change closes")
+    print()
+    print("| control | " + " | ".join(OUTPUTS) + " | HE |")
+    print("|---" * (2 + len(OUTPUTS)) + "|")
+    b = base[0]
+    for r in controls:
+        cells = []
+        for k in OUTPUTS:
+            ours, ref = float(r[k]), float(b[k])
+            m = sum(BASE_REPEATS[k]) / len(BASE_REPEATS[k])
+            gap = m - ref
+            closed = (ours - ref) / gap if gap else float("nan")
+            cells.append(f"{ours:.4g} ({100 * rel(ours, ref):+.1f} %; {100 * closed:+.0f} %)")
+        he = float(r["HE"])
+        cells.append(f"{he:.4g} ({100 * rel(he, float(b['HE'])):+.1f} %)")
+        print(f"| {r['row']} | " + " | ".join(cells) + " |")
 
 
 def selftest():
@@ -220,7 +296,7 @@ def selftest():
     # Monotone but not linear: Spearman 1, Pearson below 1.
     assert close(spearman([1, 2, 3, 4], [1, 10, 100, 1000]), 1.0)
     assert pearson([1, 2, 3, 4], [1, 10, 100, 1000]) < 0.9
-    assert close(rel(-110.0, -100.0), -0.1)
+    assert close(rel(-110.0, -100.0), 0.1)
     assert close(rel(90.0, 100.0), -0.1)
     s = summary([1.1, 1.8], [1.0, 2.0])
     assert close(s["mean"], 0.0) and close(s["max_abs"], 0.1) and close(s["mean_abs"], 0.1)
@@ -246,6 +322,16 @@ def main(argv):
         values = [3, 2, 5, 1, 1, 400, 400, 400, 400] if row == "base" else read_x()[int(row)]
         with open(os.path.join(out, "main.k"), "w") as f:
             f.write(parameter_deck(values, "car6_crash_v223.k"))
+    elif cmd == "controls":
+        print(" ".join(CONTROLS))
+    elif cmd == "control":
+        name, out = argv[1], argv[2]
+        with open(os.path.join(DATA, "decks", "car6_crash_v223.k")) as f:
+            text = f.read()
+        with open(os.path.join(out, "car6_crash_v223.k"), "w") as f:
+            f.write(control_include(name, text))
+        with open(os.path.join(out, "main.k"), "w") as f:
+            f.write(parameter_deck([3, 2, 5, 1, 1, 400, 400, 400, 400], "car6_crash_v223.k"))
     elif cmd == "outputs":
         o = outputs(argv[1])
         print(",".join(f"{o[k]!r}" for k in OUTPUTS + ["fmax_normal", "HE", "t_end"]))

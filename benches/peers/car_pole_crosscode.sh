@@ -8,7 +8,9 @@
 # `impactcal simulate` (release build) on THREADS threads, computes the study's four outputs
 # the study's way, keeps them (WORK/results.csv) and the run's log, and deletes the
 # histories. A design already in results.csv is not run again, so an interrupted
-# measurement resumes. At the end it prints the comparison table.
+# measurement resumes. Then the controlled reruns at the base design (`car_pole_crosscode.py
+# controls`; CONTROLS=0 skips them), each one change of the model in a copy of the include
+# under WORK. At the end it prints the comparison table.
 #
 #   benches/peers/car_pole_crosscode.sh [N] [WORK] [THREADS]
 #
@@ -32,14 +34,21 @@ mkdir -p "$work"
 results=$work/results.csv
 [ -f "$results" ] || $py header > "$results"
 echo "$(nproc) CPUs: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"
-for row in base $($py select "$n"); do
+controls=
+[ "${CONTROLS:-1}" = 0 ] || controls=$($py controls)
+for row in base $($py select "$n") $controls; do
     if grep -q "^$row," "$results"; then
         continue
     fi
     dir=$work/$row
     mkdir -p "$dir"
-    ln -sf "$data/decks/car6_crash_v223.k" "$dir/car6_crash_v223.k"
-    $py deck "$row" "$dir"
+    case " $controls " in
+    *" $row "*) $py control "$row" "$dir" ;;
+    *)
+        ln -sf "$data/decks/car6_crash_v223.k" "$dir/car6_crash_v223.k"
+        $py deck "$row" "$dir"
+        ;;
+    esac
     echo "== design $row, load before: $(cut -d' ' -f1-3 /proc/loadavg)"
     /usr/bin/time -v "$bin" simulate --deck "$dir/main.k" --threads "$threads" \
         --quantity displacement --out "$dir/nodes.csv" \
@@ -52,6 +61,7 @@ for row in base $($py select "$n"); do
     wall=$(grep -E 'Elapsed \(wall clock\)' "$dir/log.txt" | awk '{print $NF}')
     echo "$row,$($py outputs "$dir"),$cycles,$wall" >> "$results"
     rm -f "$dir"/*.csv
+    [ -L "$dir/car6_crash_v223.k" ] || rm -f "$dir/car6_crash_v223.k"
 done
 echo
 $py compare "$results"
