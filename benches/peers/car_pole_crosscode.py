@@ -9,7 +9,7 @@ Helper of benches/peers/car_pole_crosscode.sh (standard library only). Subcomman
                            the study wrote them) and an *INCLUDE of the model, which the
                            caller links into DIR (the decks are GPL-3: never copied here)
   outputs DIR              the four outputs of our run in DIR, computed as the study did
-  compare RESULTS          table of ours against LS-DYNA's per output: mean and max relative
+  compare RESULTS [FAILED] table of ours against LS-DYNA's per output: mean and max relative
                            difference, Pearson and Spearman correlation over the designs
   controls                 names of the controlled reruns at the base design
   control NAME DIR         write DIR/main.k (base design) and DIR/car6_crash_v223.k, the
@@ -229,9 +229,13 @@ def summary(ours, theirs):
     }
 
 
-def compare(results):
+def compare(results, failures=None):
     with open(results) as f:
         rows = list(csv.DictReader(f))
+    failed = []
+    if failures and os.path.exists(failures):
+        with open(failures) as f:
+            failed = [line.strip() for line in f if line.strip()]
     y = read_y()
     designs = [r for r in rows if r["row"].isdigit()]
     base = [r for r in rows if r["row"] == "base"]
@@ -239,6 +243,8 @@ def compare(results):
     if not designs:
         raise SystemExit(f"{results}: no design rows")
     print(f"{len(designs)} designs of p9_X.csv (rows {', '.join(r['row'] for r in designs)})")
+    for line in failed:
+        print(f"not compared (our run failed): design {line}")
     print()
     print("| output | LS-DYNA range | ours range | mean rel. diff. | mean abs. rel. diff. "
           "| max abs. rel. diff. | Pearson | Spearman |")
@@ -339,7 +345,7 @@ def main(argv):
         print(",".join(["row"] + OUTPUTS + ["fmax_normal", "HE", "t_end", "cycles",
                                             "wall_s"]))
     elif cmd == "compare":
-        compare(argv[1])
+        compare(argv[1], argv[2] if len(argv) > 2 else None)
     elif cmd == "selftest":
         selftest()
     else:
