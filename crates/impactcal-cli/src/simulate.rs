@@ -129,6 +129,10 @@ pub struct Args {
     /// `<part>.internal|kinetic|hourglass|damping`).
     #[arg(long)]
     pub part_energies: Option<PathBuf>,
+    /// Write the velocity of each part's centre of mass here (LS-DYNA's matsum rigid-body
+    /// velocities; wide CSV, columns `<part>.vx|vy|vz`).
+    #[arg(long)]
+    pub part_velocities: Option<PathBuf>,
     /// Write the energy of each contact interface here (wide CSV, columns
     /// `<interface id>.energy|friction`).
     #[arg(long)]
@@ -257,6 +261,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     if let Some(path) = &args.part_energies {
         result.part_energies.write_csv(path)?;
+    }
+    if let Some(path) = &args.part_velocities {
+        result.part_velocities.write_csv(path)?;
     }
     let s = &result.summary;
     eprintln!(

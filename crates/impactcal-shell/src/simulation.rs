@@ -37,6 +37,8 @@ use crate::setup::{Compiled, DriveTarget, Elem, compile, wall_gap};
 const ELEMENT_CHUNK: usize = 256;
 /// Nodes per rayon task in the node loops.
 const NODE_CHUNK: usize = 1024;
+/// Values per part in a part sample: four energies and three momentum components.
+const PART_SAMPLE: usize = 7;
 
 /// Energies at one instant.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -170,6 +172,12 @@ pub struct RunResult {
     /// channels `<part>.internal, <part>.kinetic, <part>.hourglass, <part>.damping`.
     /// Concentrated masses belong to no part.
     pub part_energies: Histories,
+    /// The velocity of each part's centre of mass sampled at the output interval
+    /// (LS-DYNA's `matsum` rigid-body velocities): channels `<part>.vx, <part>.vy,
+    /// <part>.vz`, each `sum m v / sum m` over the mass the part's shells give their nodes
+    /// (a node shared by two parts counts in each with its share). Concentrated masses
+    /// belong to no part.
+    pub part_velocities: Histories,
     /// Final energies of each part, in model order.
     pub parts: Vec<PartEnergies>,
     /// Summary figures.
@@ -1359,7 +1367,7 @@ impl Simulation {
                 interval,
             )?
             .unzip();
-        let part_energies = self.part_histories(&part_samples, interval)?;
+        let (part_energies, part_velocities) = self.part_histories(&part_samples, interval)?;
         let mut wall_peaks = Vec::with_capacity(self.c.walls.len());
         let mut peak_total: f64 = 0.0;
         if let Some(walls) = &walls {
@@ -1384,6 +1392,7 @@ impl Simulation {
             contacts,
             contact_forces,
             part_energies,
+            part_velocities,
             parts: self.part_energies(),
             displacement: it.next().flatten(),
             velocity: it.next().flatten(),
@@ -1452,11 +1461,13 @@ impl Simulation {
     /// Per part, `[internal, kinetic, hourglass, damping]` now: the element sums of the
     /// accumulated energies, and the kinetic energy of the mass (and rotary inertia) each
     /// element gives its nodes, at the velocities of the last completed cycle.
+    /// Per part, `PART_SAMPLE` values: internal, kinetic, hourglass and damping energy and
+    /// the momentum `[px, py, pz]` of the mass its shells give their nodes.
     fn part_snapshot(&self) -> Vec<f64> {
         let np = self.c.part_ids.len();
-        let mut out = vec![0.0; 4 * np];
+        let mut out = vec![0.0; PART_SAMPLE * np];
         for (k, (e, acc)) in self.c.elems.iter().zip(&self.elem_energy).enumerate() {
-            let p = 4 * e.part as usize;
+            let p = PART_SAMPLE * e.part as usize;
             out[p] += acc[0];
             out[p + 2] += acc[1];
             out[p + 3] += acc[2];
@@ -1465,6 +1476,9 @@ impl Simulation {
             for &i in &e.nodes[..n] {
                 let (v, w) = (self.v_int[i as usize], self.w_int[i as usize]);
                 out[p + 1] += 0.5 * (m * dot(v, v) + inr * dot(w, w));
+                for d in 0..3 {
+                    out[p + 4 + d] += m * v[d];
+                }
             }
         }
         out
@@ -1536,19 +1550,47 @@ impl Simulation {
 
     /// The per-part energies sampled at the output interval: channels
     /// `<part>.internal, <part>.kinetic, <part>.hourglass, <part>.damping`.
-    fn part_histories(&self, samples: &[Vec<f64>], dt: f64) -> Result<Histories> {
-        let mut labels = Vec::new();
-        let mut chans = Vec::new();
+    /// The per-part energies and centre-of-mass velocities (see
+    /// [`RunResult::part_energies`] and [`RunResult::part_velocities`]) from the part
+    /// samples.
+    fn part_histories(&self, samples: &[Vec<f64>], dt: f64) -> Result<(Histories, Histories)> {
+        let np = self.c.part_ids.len();
+        let mut mass = vec![0.0; np];
+        for (e, [m, _]) in self.c.elems.iter().zip(&self.elem_mass) {
+            mass[e.part as usize] += m * if e.tri { 3.0 } else { 4.0 };
+        }
+        let (mut labels, mut chans) = (Vec::new(), Vec::new());
+        let (mut vlabels, mut vchans) = (Vec::new(), Vec::new());
         for (p, id) in self.c.part_ids.iter().enumerate() {
+            let at = PART_SAMPLE * p;
             for (k, name) in ["internal", "kinetic", "hourglass", "damping"]
                 .iter()
                 .enumerate()
             {
                 labels.push(format!("{id}.{name}"));
-                chans.push(samples.iter().map(|s| s[4 * p + k]).collect());
+                chans.push(samples.iter().map(|s| s[at + k]).collect());
+            }
+            for (d, name) in ["vx", "vy", "vz"].iter().enumerate() {
+                vlabels.push(format!("{id}.{name}"));
+                // A part without shells has no mass and no centre: its channels are 0.
+                vchans.push(
+                    samples
+                        .iter()
+                        .map(|s| {
+                            if mass[p] > 0.0 {
+                                s[at + 4 + d] / mass[p]
+                            } else {
+                                0.0
+                            }
+                        })
+                        .collect(),
+                );
             }
         }
-        Ok(Histories::from_channels(labels, chans, dt, 0.0, "energy")?)
+        Ok((
+            Histories::from_channels(labels, chans, dt, 0.0, "energy")?,
+            Histories::from_channels(vlabels, vchans, dt, 0.0, "velocity")?,
+        ))
     }
 
     /// Estimates the largest natural circular frequency `omega_max` of the undeformed,

@@ -346,6 +346,46 @@ fn two_plates_meeting_at_speed_keep_momentum_and_energy() {
     assert!(fine.4.abs() < coarse.4.abs() / 4.0);
 }
 
+/// The parts' centre-of-mass velocities (`RunResult::part_velocities`) of the two plates
+/// meeting: each starts at its initial velocity, the two (equal masses, no external force)
+/// sum to zero at every sample, and after they part each equals the momentum of its nodes
+/// over its mass.
+#[test]
+fn part_velocities_carry_each_plates_momentum() {
+    let (m, _) = two_plates(Contact::single_surface(ContactSurface::PartSet(1)));
+    let mut sim = Simulation::new(&m).unwrap();
+    let r = sim.run().unwrap();
+    let v = &r.part_velocities;
+    assert_eq!(v.labels(), ["1.vx", "1.vy", "1.vz", "2.vx", "2.vy", "2.vz"]);
+    assert!((v.value(2, 0) - 5.0).abs() < 1e-12, "{}", v.value(2, 0));
+    assert!((v.value(5, 0) + 5.0).abs() < 1e-12, "{}", v.value(5, 0));
+    for k in 0..v.samples() {
+        for d in 0..3 {
+            let sum = v.value(d, k) + v.value(3 + d, k);
+            assert!(sum.abs() < 1e-9, "sample {k}, component {d}: {sum}");
+        }
+    }
+    let (mut p, mut mass) = (0.0, 0.0);
+    for ((vel, mn), id) in sim
+        .velocities()
+        .iter()
+        .zip(sim.masses())
+        .zip(sim.node_ids())
+    {
+        if *id < 100 {
+            p += mn * vel[2];
+            mass += mn;
+        }
+    }
+    let last = v.value(2, v.samples() - 1);
+    assert!(last < -4.5, "plate A leaves at {last}");
+    assert!(
+        (last - p / mass).abs() < 1e-9 * last.abs(),
+        "{last} vs {}",
+        p / mass
+    );
+}
+
 /// The interface's sampled forces (`RunResult::contact_forces`) against the momentum the
 /// plates exchange. In a surface-to-surface contact the slave side's resultant, integrated
 /// over the run, is the momentum plate A (the slave part) gained, component by component;
