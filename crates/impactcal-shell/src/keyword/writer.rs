@@ -5,8 +5,8 @@ use std::path::Path;
 use crate::contact::{ContactControl, ContactKind, ContactSurface};
 use crate::error::{Result, ShellError};
 use crate::model::{
-    Hardening, Hourglass, HourglassForm, MaterialLaw, MotionKind, MotionTarget, NodeTarget,
-    ShellModel, ThicknessRule, VelocityTarget, WallMethod, WallShape, WeldNodes,
+    Hardening, Hourglass, HourglassForm, Material, MaterialLaw, MotionKind, MotionTarget,
+    NodeTarget, ShellModel, ThicknessRule, VelocityTarget, WallMethod, WallShape, WeldNodes,
 };
 
 /// The IHQ of a hourglass form (1 viscous, 4 stiffness).
@@ -211,19 +211,24 @@ fn write_controls(model: &ShellModel, o: &mut Out) -> Result<()> {
     Ok(())
 }
 
+/// A material's first four fields, common to every material card written: MID, RO, E, PR.
+fn head(m: &Material) -> String {
+    format!(
+        "{}{}{}{}",
+        int(m.id, 10),
+        real(m.density, 10),
+        real(m.youngs, 10),
+        real(m.poisson, 10)
+    )
+}
+
 /// The materials.
 fn write_materials(model: &ShellModel, o: &mut Out) -> Result<()> {
     for m in &model.materials {
         match m.law {
             MaterialLaw::Elastic => {
                 o.w("*MAT_ELASTIC".into());
-                o.w(format!(
-                    "{}{}{}{}",
-                    int(m.id, 10),
-                    real(m.density, 10),
-                    real(m.youngs, 10),
-                    real(m.poisson, 10)
-                ));
+                o.w(head(m));
             }
             MaterialLaw::Plastic {
                 yield_stress,
@@ -232,11 +237,8 @@ fn write_materials(model: &ShellModel, o: &mut Out) -> Result<()> {
             } => {
                 o.w("*MAT_PLASTIC_KINEMATIC".into());
                 o.w(format!(
-                    "{}{}{}{}{}{}{}",
-                    int(m.id, 10),
-                    real(m.density, 10),
-                    real(m.youngs, 10),
-                    real(m.poisson, 10),
+                    "{}{}{}{}",
+                    head(m),
                     real(yield_stress, 10),
                     real(tangent_modulus, 10),
                     real(1.0, 10)
@@ -246,13 +248,7 @@ fn write_materials(model: &ShellModel, o: &mut Out) -> Result<()> {
             }
             MaterialLaw::PlasticCurve { hardening, rate } => {
                 o.w("*MAT_PIECEWISE_LINEAR_PLASTICITY".into());
-                o.w(format!(
-                    "{}{}{}{}",
-                    int(m.id, 10),
-                    real(m.density, 10),
-                    real(m.youngs, 10),
-                    real(m.poisson, 10)
-                ));
+                o.w(head(m));
                 let (c, p) = rate.map_or((0.0, 0.0), |r| (r.c, r.p));
                 let lcss = match hardening {
                     Hardening::Curve(id) => id,
@@ -271,13 +267,7 @@ fn write_materials(model: &ShellModel, o: &mut Out) -> Result<()> {
             }
             MaterialLaw::Rigid { constraints } => {
                 o.w("*MAT_RIGID".into());
-                o.w(format!(
-                    "{}{}{}{}",
-                    int(m.id, 10),
-                    real(m.density, 10),
-                    real(m.youngs, 10),
-                    real(m.poisson, 10)
-                ));
+                o.w(head(m));
                 let code = |d: [bool; 3]| -> u64 {
                     match d {
                         [false, false, false] => 0,
