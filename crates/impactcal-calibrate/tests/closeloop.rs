@@ -376,7 +376,10 @@ fn coloured_noise_hidden_damping_intervals_cover_the_truth() {
         }
     }
     println!("coloured hidden damping: added {added}/20, truth inside the interval {inside}/20");
-    assert!(inside >= 17, "truth inside the interval in {inside} of 20 seeds");
+    assert!(
+        inside >= 17,
+        "truth inside the interval in {inside} of 20 seeds"
+    );
 }
 
 /// How often the hidden effect is ranked first over 20 noise seeds (docs/validation.md):

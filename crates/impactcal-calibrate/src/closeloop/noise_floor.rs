@@ -1,16 +1,19 @@
-//! The noise floor: the standard deviation of the measurement noise per channel, and the
-//! model's own simulation noise, combined in quadrature into the weights
+//! The noise floor: the measurement noise per channel (its standard deviation and its AR
+//! model, the colour every likelihood of the loop whitens, `closeloop::prewhiten`), and
+//! the model's own simulation noise, combined in quadrature into the weights
 //! `w_sk = 1 / sqrt(sigma_s^2 + spread_sk^2)`.
 //!
 //! `sigma_s` is the noise as compared (after the test's filter) and comes, in this order,
-//! from the user (`sigma`, one value for every channel, which wins when given), from the
-//! pre-impact window of the test (the samples before the model's response departs from
-//! its initial value, moved by the trigger offset; at least [`MIN_PRE_IMPACT`] samples; a
-//! straight line is fitted and removed, the residual's standard deviation and lag-one
-//! autocorrelation kept), or from the band above the bandwidth of the model ensemble the
-//! loop has at that point (the nominal run and its jittered runs), where the test's
-//! spectrum must be flat like noise (`impactcal_core::quality::noise_from_band`: white
-//! noise through the test's filter, its variance and lag-one correlation). When the record
+//! from the user (`sigma`, one value for every channel, which wins when given; the noise is
+//! then taken as white), from the pre-impact window of the test (the samples before the
+//! model's response departs from its initial value, moved by the trigger offset; at least
+//! [`MIN_PRE_IMPACT`] samples; a straight line is fitted and removed, the residual's
+//! standard deviation kept and an AR model of order by BIC fitted to it,
+//! `impactcal_core::quality::ArModel`), or from the band above the bandwidth of the model
+//! ensemble the loop has at that point (the nominal run and its jittered runs), where the
+//! test's spectrum must be flat like noise (`impactcal_core::quality::noise_from_band`:
+//! white noise through the test's filter, its variance and the AR model of that filtered
+//! white noise). When the record
 //! has neither a quiet part nor such a band (the model has content above the noise up to
 //! the filter's stop band, or the band is not flat), the band's refusal is kept and the
 //! last resort serves: the test minus its CFC-filtered self, whose variance is the part of
@@ -18,11 +21,13 @@
 //! fraction of a white sequence's variance the same filter removes (measured on a seeded
 //! white sequence of the same length). It counts whatever the model does above that filter
 //! as noise: an upper bound, and the loop's thresholds are lenient by as much; give `sigma`
-//! for such a record. `spread_sk` is the standard deviation of a jitter ensemble of the
+//! for such a record. The high band says nothing of the noise's colour below the filter:
+//! it is taken as white. `spread_sk` is the standard deviation of a jitter ensemble of the
 //! model (`impactcal_core::noise`): what the model does on its own under a tiny change of
 //! its parameters, which no calibration may call model-form error.
 
-use impactcal_core::quality::{MemberEnvelope, noise_above_envelope};
+use impactcal_core::quality::ar::DEFAULT_MAX_ORDER;
+use impactcal_core::quality::{ArModel, MemberEnvelope, noise_above_envelope};
 use impactcal_core::{Cfc, Histories};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -58,8 +63,12 @@ pub struct ChannelNoise {
     pub sigma: f64,
     /// Where it came from.
     pub source: NoiseSource,
-    /// Lag-one autocorrelation of the noise (0 when not measurable).
+    /// Lag-one autocorrelation of the noise (0 when taken as white).
     pub lag1: f64,
+    /// The noise's AR coefficients `phi_1 .. phi_p` (`e_k = sum phi_i e_{k-i} + u_k`;
+    /// empty: white), whitened out of every likelihood of the loop.
+    #[serde(default)]
+    pub ar: Vec<f64>,
     /// RMS over time of the model's simulation noise (jitter spread).
     pub simulation_rms: f64,
     /// Why the band above the model's bandwidth gave no estimate, when it was tried.
@@ -77,16 +86,9 @@ pub struct NoiseFloor {
 }
 
 impl NoiseFloor {
-    /// The pooled lag-one autocorrelation of the noise, clamped to `[0, 0.99]`.
-    pub fn lag1(&self) -> f64 {
-        let n = self.channels.len().max(1) as f64;
-        (self.channels.iter().map(|c| c.lag1).sum::<f64>() / n).clamp(0.0, 0.99)
-    }
-
-    /// `(1 + rho) / (1 - rho)`: how many samples count as one independent one.
-    pub fn inflation(&self) -> f64 {
-        let r = self.lag1();
-        (1.0 + r) / (1.0 - r)
+    /// Each channel's AR coefficients, in channel order.
+    pub fn ar_models(&self) -> Vec<Vec<f64>> {
+        self.channels.iter().map(|c| c.ar.clone()).collect()
     }
 }
 
@@ -137,11 +139,16 @@ pub(crate) fn estimate(
         let sp = &spread[s * samples..(s + 1) * samples];
         let simulation_rms = (sp.iter().map(|v| v * v).sum::<f64>() / samples as f64).sqrt();
         let mut band_refusal = None;
-        let (sigma, source, lag1) = if let Some(sigma) = user_sigma {
-            (sigma, NoiseSource::User, 0.0)
+        let (sigma, source, ar) = if let Some(sigma) = user_sigma {
+            (sigma, NoiseSource::User, ArModel::white(sigma))
         } else if use_pre {
-            let (sd, r) = detrended(&ch[..pre_impact]);
-            (sd, NoiseSource::PreImpact, r)
+            let (sd, ar) = detrended(&ch[..pre_impact]).map_err(|e| {
+                CalibrateError::study(
+                    format!("noise floor of `{label}`"),
+                    format!("the pre-impact window: {e}; give [test] sigma"),
+                )
+            })?;
+            (sd, NoiseSource::PreImpact, ar)
         } else {
             if envelopes.is_none() {
                 envelopes = Some(members()?);
@@ -153,7 +160,7 @@ pub(crate) fn estimate(
                 )
             })?;
             match noise_above_envelope(ch, envelope, dt, test_cfc)? {
-                Ok(b) => (b.model.sigma(), NoiseSource::ModelFreeBand, b.model.lag1()),
+                Ok(b) => (b.model.sigma(), NoiseSource::ModelFreeBand, b.model),
                 Err(r) => {
                     band_refusal = Some(r.to_string());
                     let fraction = removed_fraction(samples, dt, cfc)?;
@@ -167,7 +174,8 @@ pub(crate) fn estimate(
                     let f = h.filtered(cfc)?;
                     let e: Vec<f64> = ch.iter().zip(f.channel(0)).map(|(a, b)| a - b).collect();
                     let var = e.iter().map(|v| v * v).sum::<f64>() / samples as f64;
-                    ((var / fraction).sqrt(), NoiseSource::HighBand, 0.0)
+                    let sigma = (var / fraction).sqrt();
+                    (sigma, NoiseSource::HighBand, ArModel::white(sigma))
                 }
             }
         };
@@ -181,7 +189,8 @@ pub(crate) fn estimate(
             label: label.clone(),
             sigma,
             source,
-            lag1,
+            lag1: ar.lag1(),
+            ar: ar.coefficients,
             simulation_rms,
             band_refusal,
         });
@@ -205,14 +214,16 @@ pub(crate) fn weights(floor: &NoiseFloor, spread: &[f64], samples: usize) -> Vec
     w
 }
 
-/// Standard deviation and lag-one autocorrelation of `x` after removing a fitted line.
-fn detrended(x: &[f64]) -> (f64, f64) {
+/// Standard deviation of `x` after removing a fitted line, and the AR model (order by BIC)
+/// of what is left.
+///
+/// # Errors
+/// [`ArModel::fit`]'s: a constant window.
+fn detrended(x: &[f64]) -> Result<(f64, ArModel)> {
     let n = x.len() as f64;
     let e = impactcal_core::quality::spectrum::detrended(x);
     let var = e.iter().map(|v| v * v).sum::<f64>() / (n - 2.0).max(1.0);
-    let c1 = e.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / (n - 1.0).max(1.0);
-    let r = if var > 0.0 { c1 / var } else { 0.0 };
-    (var.sqrt(), r)
+    Ok((var.sqrt(), ArModel::fit(&e, DEFAULT_MAX_ORDER)?))
 }
 
 /// The fraction of a white sequence's variance that the CFC filter removes.
