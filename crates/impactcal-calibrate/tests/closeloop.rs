@@ -338,13 +338,18 @@ fn coloured_noise_negative_control_is_silent_in_nine_of_ten_seeds() {
         let quiet = r.verdict == Verdict::NoModelFormError && r.added.is_empty();
         println!(
             "coloured negative control, seed {}: {:?}, chi2_red {:.3} (threshold {:.3}), \
-             sigma1 {:.1} (edge {:.1})",
+             sigma1 {:.1} (edge {:.1}), noise lag-one {:?}",
             400 + seed,
             r.verdict,
             r.detection.chi2_red,
             r.detection.threshold,
             r.detection.sigma1,
-            r.detection.noise_edge
+            r.detection.noise_edge,
+            r.noise_floor
+                .channels
+                .iter()
+                .map(|c| (c.lag1 * 100.0).round() / 100.0)
+                .collect::<Vec<_>>()
         );
         silent += usize::from(quiet);
     }

@@ -5,8 +5,14 @@
 //! that under the noise model `e` is unit white noise plus what the model lacks.
 //!
 //! - Reduced chi-square: `chi2_red = RSS / (n - p)` with `RSS = sum e^2`, the mean square
-//!   residual per independent sample, corrected for the fitted quantities. Its threshold is
-//!   the `1 - alpha` quantile of `chi2_nu / nu`, `nu = max(n - p, 1)`.
+//!   residual per independent sample, corrected for the fitted quantities. With a noise
+//!   level known (given) its threshold is the `1 - alpha` quantile of `chi2_nu / nu`,
+//!   `nu = max(n - p, 1)`. With a level estimated on the record (a quiet window of a few
+//!   dozen samples) `chi2_red` is the ratio of the residual's mean square to the estimate's,
+//!   an `F(nu, m)` variable, `m` the estimate's degrees of freedom over the channels
+//!   (`NoiseFloor::level_dof`); the threshold is its `1 - alpha` quantile. The chi-square
+//!   quantile would take an estimate from 40 samples for the truth and call its error
+//!   model-form error.
 //! - Whiteness: the Ljung-Box statistic `Q = sum_s T (T + 2) sum_{k=1..h} rho_sk^2 / (T - k)`
 //!   over `h` lags per channel, against the `1 - alpha` quantile of `chi2_{S h}`. Reported:
 //!   a residual that fails it carries colour the noise model does not explain (a missing
@@ -24,7 +30,7 @@
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
-use statrs::distribution::{ChiSquared, ContinuousCDF};
+use statrs::distribution::{ChiSquared, ContinuousCDF, FisherSnedecor};
 
 use super::linalg::svd_rows;
 use crate::error::{CalibrateError, Result};
@@ -41,8 +47,12 @@ pub struct Detection {
     pub n: usize,
     /// Fitted quantities (parameters and nuisance terms).
     pub p: usize,
-    /// The `1 - alpha` quantile of `chi2_nu / nu`.
+    /// The `1 - alpha` quantile of `chi2_nu / nu`, or of `F(nu, noise_dof)` when the noise
+    /// level was estimated.
     pub threshold: f64,
+    /// Degrees of freedom of the noise level's estimate (`None`: known).
+    #[serde(default)]
+    pub noise_dof: Option<f64>,
     /// Pooled lag-one autocorrelation of the prewhitened residual (near 0 when the noise
     /// model holds and nothing is missing).
     pub lag1: f64,
@@ -107,6 +117,23 @@ pub fn chi2_quantile(nu: f64, alpha: f64) -> Result<f64> {
     Ok(d.inverse_cdf(1.0 - alpha))
 }
 
+/// The `1 - alpha` quantile of `F(nu, m)`, the ratio of independent `chi2_nu / nu` and
+/// `chi2_m / m`.
+///
+/// # Errors
+/// [`CalibrateError::Study`] for `nu <= 0`, `m <= 0` or `alpha` outside `(0, 1)`.
+pub fn f_quantile(nu: f64, m: f64, alpha: f64) -> Result<f64> {
+    let d = FisherSnedecor::new(nu, m)
+        .map_err(|e| CalibrateError::study("F quantile", e.to_string()))?;
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(CalibrateError::study(
+            "F quantile",
+            format!("alpha {alpha} outside (0, 1)"),
+        ));
+    }
+    Ok(d.inverse_cdf(1.0 - alpha))
+}
+
 /// Pooled lag-`k` autocorrelation of the channels of `e` (`S x T`, channel-major).
 fn autocorrelation(e: &[f64], samples: usize, k: usize) -> f64 {
     let (mut num, mut den) = (0.0, 0.0);
@@ -130,7 +157,8 @@ pub(crate) fn chi2_red(e: &[f64], p: usize) -> (f64, f64) {
 }
 
 /// The detection statistics (see the module docs) of the whitened residual `e` (`S x T`),
-/// with `p` fitted quantities and level `alpha`.
+/// with `p` fitted quantities, level `alpha` and `noise_dof` the degrees of freedom of the
+/// noise level's estimate (`None`: known).
 ///
 /// # Errors
 /// [`CalibrateError::Study`] when the SVD fails or the residual is empty.
@@ -140,6 +168,7 @@ pub fn detect(
     samples: usize,
     p: usize,
     alpha: f64,
+    noise_dof: Option<f64>,
 ) -> Result<Detection> {
     let s = labels.len();
     let n = e.len();
@@ -151,7 +180,10 @@ pub fn detect(
     }
     let (chi2_red, nu) = chi2_red(e, p);
     let lag1 = autocorrelation(e, samples, 1);
-    let threshold = chi2_quantile(nu, alpha)? / nu;
+    let threshold = match noise_dof {
+        Some(m) => f_quantile(nu, m, alpha)?,
+        None => chi2_quantile(nu, alpha)? / nu,
+    };
     let mut q = 0.0;
     let h = WHITENESS_LAGS.min(samples.saturating_sub(2)).max(1);
     for ch in e.chunks(samples) {
@@ -172,6 +204,7 @@ pub fn detect(
         n,
         p,
         threshold,
+        noise_dof,
         lag1,
         ljung_box: q,
         ljung_box_threshold,
@@ -213,6 +246,13 @@ mod tests {
         // chi2_{10}, 0.95 quantile 18.307; chi2_1, 0.99 quantile 6.635 (standard tables).
         assert!((chi2_quantile(10.0, 0.05).unwrap() - 18.307).abs() < 1e-3);
         assert!((chi2_quantile(1.0, 0.01).unwrap() - 6.635).abs() < 1e-3);
+        // F_{10, 20}, 0.95 quantile 2.348; F_{1, 10}, 0.99 quantile 10.044 (standard tables);
+        // F(nu, m) tends to chi2_nu / nu as m grows.
+        assert!((f_quantile(10.0, 20.0, 0.05).unwrap() - 2.348).abs() < 2e-3);
+        assert!((f_quantile(1.0, 10.0, 0.01).unwrap() - 10.044).abs() < 2e-3);
+        let (nu, big) = (1000.0, 1e7);
+        let chi = chi2_quantile(nu, 0.01).unwrap() / nu;
+        assert!((f_quantile(nu, big, 0.01).unwrap() - chi).abs() < 1e-3);
     }
 
     #[test]
@@ -221,7 +261,7 @@ mod tests {
         let t = 400;
         let mut alarms = 0;
         for seed in 0..20 {
-            let d = detect(&labels, &white(3 * t, seed), t, 5, 0.01).unwrap();
+            let d = detect(&labels, &white(3 * t, seed), t, 5, 0.01, None).unwrap();
             assert!(d.lag1.abs() < 0.1);
             alarms += usize::from(d.model_form_error);
         }
@@ -231,7 +271,7 @@ mod tests {
         for k in 0..t {
             e[t + k] += 3.0 * (-((k as f64 - 200.0) / 50.0).powi(2)).exp();
         }
-        let d = detect(&labels, &e, t, 5, 0.01).unwrap();
+        let d = detect(&labels, &e, t, 5, 0.01, None).unwrap();
         assert!(d.model_form_error, "{d:?}");
         assert!(d.u1["b"].abs() > 0.9);
         let peak = (0..t)

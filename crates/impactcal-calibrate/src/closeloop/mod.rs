@@ -309,7 +309,15 @@ pub fn run_loop_on<M: Enrichable>(
         options.reconcile,
         options.polish,
     )?;
-    let outcome = selection::forward(&ctx, model, fit0.clone(), options, onset, n_nuisance)?;
+    let outcome = selection::forward(
+        &ctx,
+        model,
+        fit0.clone(),
+        options,
+        onset,
+        n_nuisance,
+        floor.level_dof(),
+    )?;
     let fit = &outcome.fit;
     let det0 = outcome.rounds[0].detection.clone();
     let det = outcome
@@ -374,7 +382,10 @@ pub fn run_loop_on<M: Enrichable>(
     let p_of = |d: usize| d + n_nuisance;
     let (terms_nominal, _) = ctx.profile(&y_nominal);
     let posterior = |jac| Posterior { jac };
-    let judge = Judge { options };
+    let judge = Judge {
+        options,
+        noise_dof: floor.level_dof(),
+    };
     let metrics_calibration = Stages {
         nominal: judge.errors(&ctx.frame, &y_nominal, &terms_nominal, p_of(d0), None, 0)?,
         calibrated: judge.errors(
@@ -457,7 +468,10 @@ pub fn run_loop_on<M: Enrichable>(
             noise_model(&mut frame_h, &masks_h, &floor_h)?;
             let profile = |y: &[f64]| nuisance::profile(y, &frame_h, max_shift, Some(&gains)).0;
             let ys = [y_nom_h, prep(&calibrated_h)?, prep(&enriched_h)?];
-            let judge = Judge { options };
+            let judge = Judge {
+                options,
+                noise_dof: floor_h.level_dof(),
+            };
             let at = |k: usize| {
                 judge.errors(
                     &frame_h,
@@ -646,9 +660,11 @@ fn noise_model(frame: &mut Frame, masks: &[Vec<bool>], floor: &NoiseFloor) -> Re
     Ok(())
 }
 
-/// What judges a model's response against a test: the loop's options.
+/// What judges a model's response against a test: the loop's options and the degrees of
+/// freedom of the noise level's estimate (`NoiseFloor::level_dof`).
 struct Judge<'a> {
     options: &'a LoopOptions,
+    noise_dof: Option<f64>,
 }
 
 impl Judge<'_> {
@@ -674,6 +690,7 @@ impl Judge<'_> {
             frame.samples,
             p,
             self.options.alpha,
+            self.noise_dof,
         )?;
         let iso = Iso18571::new();
         let t = frame.samples;

@@ -7,9 +7,9 @@
 //! from the user (`sigma`, one value for every channel, which wins when given; the noise is
 //! then taken as white), from the pre-impact window of the test (the samples before the
 //! model's response departs from its initial value, moved by the trigger offset; at least
-//! [`MIN_PRE_IMPACT`] samples; a straight line is fitted and removed, the residual's
-//! standard deviation kept and an AR model of order by BIC fitted to it,
-//! `impactcal_core::quality::ArModel`), or from the band above the bandwidth of the model
+//! [`MIN_PRE_IMPACT`] samples: an AR model of order by BIC fitted to it with a straight line
+//! removed, `impactcal_core::quality::ArModel`, then the level by generalised least
+//! squares through that model's own filter, see [`quiet_noise`]), or from the band above the bandwidth of the model
 //! ensemble the loop has at that point (the nominal run and its jittered runs), where the
 //! test's spectrum must be flat like noise (`impactcal_core::quality::noise_from_band`:
 //! white noise through the test's filter, its variance and the AR model of that filtered
@@ -33,6 +33,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use super::linalg::dot;
+use super::prewhiten::Prewhitener;
 use crate::error::{CalibrateError, Result};
 
 /// Fewest pre-impact samples the noise is measured on.
@@ -74,6 +76,12 @@ pub struct ChannelNoise {
     /// Why the band above the model's bandwidth gave no estimate, when it was tried.
     #[serde(default)]
     pub band_refusal: Option<String>,
+    /// Degrees of freedom of the level's estimate (`None`: taken as known, given by the user
+    /// or the high band's upper bound). The pre-impact window's: its samples less the line
+    /// and the AR coefficients; the band's: its ordinates (Hann-windowed, neighbours
+    /// overlap: one each, not two).
+    #[serde(default)]
+    pub dof: Option<f64>,
 }
 
 /// The noise floor of a test.
@@ -89,6 +97,22 @@ impl NoiseFloor {
     /// Each channel's AR coefficients, in channel order.
     pub fn ar_models(&self) -> Vec<Vec<f64>> {
         self.channels.iter().map(|c| c.ar.clone()).collect()
+    }
+
+    /// The degrees of freedom of the noise level as a chi-square over every channel sees
+    /// it: `m = S^2 / sum_s 1 / dof_s` (a channel of known level adds nothing to the sum).
+    /// A mean over `S` channels of `RSS_s / sigma_s^2` with each `sigma_s^2` estimated on
+    /// `dof_s` degrees of freedom varies as an `F` whose denominator has `m` (equal `dof`:
+    /// `m = S dof`). `None` when every level is known.
+    pub fn level_dof(&self) -> Option<f64> {
+        let inv: f64 = self
+            .channels
+            .iter()
+            .filter_map(|c| c.dof)
+            .map(|d| 1.0 / d.max(1.0))
+            .sum();
+        let s = self.channels.len() as f64;
+        (inv > 0.0).then(|| s * s / inv)
     }
 }
 
@@ -139,16 +163,11 @@ pub(crate) fn estimate(
         let sp = &spread[s * samples..(s + 1) * samples];
         let simulation_rms = (sp.iter().map(|v| v * v).sum::<f64>() / samples as f64).sqrt();
         let mut band_refusal = None;
-        let (sigma, source, ar) = if let Some(sigma) = user_sigma {
-            (sigma, NoiseSource::User, ArModel::white(sigma))
+        let (sigma, source, ar, dof) = if let Some(sigma) = user_sigma {
+            (sigma, NoiseSource::User, ArModel::white(sigma), None)
         } else if use_pre {
-            let (sd, ar) = detrended(&ch[..pre_impact]).map_err(|e| {
-                CalibrateError::study(
-                    format!("noise floor of `{label}`"),
-                    format!("the pre-impact window: {e}; give [test] sigma"),
-                )
-            })?;
-            (sd, NoiseSource::PreImpact, ar)
+            let (sd, ar, dof) = quiet_noise(&ch[..pre_impact], label)?;
+            (sd, NoiseSource::PreImpact, ar, Some(dof))
         } else {
             if envelopes.is_none() {
                 envelopes = Some(members()?);
@@ -160,7 +179,12 @@ pub(crate) fn estimate(
                 )
             })?;
             match noise_above_envelope(ch, envelope, dt, test_cfc)? {
-                Ok(b) => (b.model.sigma(), NoiseSource::ModelFreeBand, b.model),
+                Ok(b) => (
+                    b.model.sigma(),
+                    NoiseSource::ModelFreeBand,
+                    b.model,
+                    Some(b.bins as f64),
+                ),
                 Err(r) => {
                     band_refusal = Some(r.to_string());
                     let fraction = removed_fraction(samples, dt, cfc)?;
@@ -175,7 +199,7 @@ pub(crate) fn estimate(
                     let e: Vec<f64> = ch.iter().zip(f.channel(0)).map(|(a, b)| a - b).collect();
                     let var = e.iter().map(|v| v * v).sum::<f64>() / samples as f64;
                     let sigma = (var / fraction).sqrt();
-                    (sigma, NoiseSource::HighBand, ArModel::white(sigma))
+                    (sigma, NoiseSource::HighBand, ArModel::white(sigma), None)
                 }
             }
         };
@@ -193,6 +217,7 @@ pub(crate) fn estimate(
             ar: ar.coefficients,
             simulation_rms,
             band_refusal,
+            dof,
         });
     }
     Ok(NoiseFloor {
@@ -214,16 +239,54 @@ pub(crate) fn weights(floor: &NoiseFloor, spread: &[f64], samples: usize) -> Vec
     w
 }
 
-/// Standard deviation of `x` after removing a fitted line, and the AR model (order by BIC)
-/// of what is left.
+/// The noise of a quiet window `x` of `m` samples: its AR model (order `p` by BIC, fitted
+/// with a straight line removed), the standard deviation `sigma` of the noise process, and
+/// the degrees of freedom of `sigma^2`, `m - 2 - p`.
+///
+/// `sigma` is the generalised least-squares estimate through the model's own filter
+/// `L^-1` (unit variance, `closeloop::prewhiten`): the line `[1, k]` fitted to `L^-1 x` on
+/// `[L^-1 1, L^-1 k]`, `sigma^2 = RSS / (m - 2)`. The loop's residual goes through the same
+/// filter, so its whitened variance and this level are measured alike even where the
+/// fitted coefficients miss the truth (a short window biases Yule-Walker towards white):
+/// the reduced chi-square of a right model is 1 on average either way. The plain variance
+/// of the detrended window would not do: with strongly coloured noise a line through a
+/// few dozen samples takes out much of the slow part of the noise, and the level comes
+/// out low.
 ///
 /// # Errors
-/// [`ArModel::fit`]'s: a constant window.
-fn detrended(x: &[f64]) -> Result<(f64, ArModel)> {
-    let n = x.len() as f64;
+/// [`CalibrateError::Study`] naming the channel for a constant window (no noise to model)
+/// or a fitted model that is not stationary.
+fn quiet_noise(x: &[f64], label: &str) -> Result<(f64, ArModel, f64)> {
+    let what = format!("noise floor of `{label}`");
     let e = impactcal_core::quality::spectrum::detrended(x);
-    let var = e.iter().map(|v| v * v).sum::<f64>() / (n - 2.0).max(1.0);
-    Ok((var.sqrt(), ArModel::fit(&e, DEFAULT_MAX_ORDER)?))
+    let ar = ArModel::fit(&e, DEFAULT_MAX_ORDER).map_err(|err| {
+        CalibrateError::study(
+            what.as_str(),
+            format!("the pre-impact window: {err}; give [test] sigma"),
+        )
+    })?;
+    let m = x.len();
+    let w = Prewhitener::new(
+        &[label.to_string()],
+        std::slice::from_ref(&ar.coefficients),
+        vec![vec![false; m]],
+        m,
+    )?;
+    let u = w.whiten(x);
+    let c1 = w.whiten(&vec![1.0; m]);
+    let c2 = w.whiten(&(0..m).map(|k| k as f64).collect::<Vec<f64>>());
+    let (s11, s12, s22) = (dot(&c1, &c1), dot(&c1, &c2), dot(&c2, &c2));
+    let (b1, b2) = (dot(&c1, &u), dot(&c2, &u));
+    let det = s11 * s22 - s12 * s12;
+    let (a, b) = if det > 0.0 {
+        ((s22 * b1 - s12 * b2) / det, (s11 * b2 - s12 * b1) / det)
+    } else {
+        (b1 / s11, 0.0)
+    };
+    let rss: f64 = (0..m).map(|k| (u[k] - a * c1[k] - b * c2[k]).powi(2)).sum();
+    let sigma = (rss / (m as f64 - 2.0).max(1.0)).sqrt();
+    let dof = (m as f64 - 2.0 - ar.order() as f64).max(1.0);
+    Ok((sigma, ar, dof))
 }
 
 /// The fraction of a white sequence's variance that the CFC filter removes.

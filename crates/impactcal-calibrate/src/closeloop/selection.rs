@@ -97,12 +97,13 @@ pub(crate) fn forward<M: Enrichable>(
     options: &LoopOptions,
     onset: usize,
     n_nuisance: usize,
+    noise_dof: Option<f64>,
 ) -> Result<Outcome> {
     let labels = ctx.frame.labels.clone();
     let t = ctx.frame.samples;
     let detect_fit = |fit: &Fit| -> Result<Detection> {
         let p = fit.point.len() + n_nuisance;
-        let d = detect(&labels, &fit.residual, t, p, options.alpha)?;
+        let d = detect(&labels, &fit.residual, t, p, options.alpha, noise_dof)?;
         let floor = ctx
             .model_noise
             .stats(fit, &ctx.frame, Some(p), None)?
