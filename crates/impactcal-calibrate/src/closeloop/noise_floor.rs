@@ -7,9 +7,9 @@
 //! from the user (`sigma`, one value for every channel, which wins when given; the noise is
 //! then taken as white), from the pre-impact window of the test (the samples before the
 //! model's response departs from its initial value, moved by the trigger offset; at least
-//! [`MIN_PRE_IMPACT`] samples: an AR model of order by BIC fitted to it with a straight line
-//! removed, `impactcal_core::quality::ArModel`, then the level by generalised least
-//! squares through that model's own filter, see [`quiet_noise`]), or from the band above the bandwidth of the model
+//! [`MIN_PRE_IMPACT`] samples: an AR model of order by BIC, its coefficients and level by
+//! restricted maximum likelihood with a straight line in the model, see `quiet_noise`),
+//! or from the band above the bandwidth of the model
 //! ensemble the loop has at that point (the nominal run and its jittered runs), where the
 //! test's spectrum must be flat like noise (`impactcal_core::quality::noise_from_band`:
 //! white noise through the test's filter, its variance and the AR model of that filtered
@@ -239,42 +239,117 @@ pub(crate) fn weights(floor: &NoiseFloor, spread: &[f64], samples: usize) -> Vec
     w
 }
 
-/// The noise of a quiet window `x` of `m` samples: its AR model (order `p` by BIC, fitted
-/// with a straight line removed), the standard deviation `sigma` of the noise process, and
-/// the degrees of freedom of `sigma^2`, `m - 2 - p`.
+/// The noise of a quiet window `x` of `m` samples: its AR model, the standard deviation
+/// `sigma` of the noise process, and the degrees of freedom of `sigma^2`, `m - 2 - p`.
 ///
-/// `sigma` is the generalised least-squares estimate through the model's own filter
-/// `L^-1` (unit variance, `closeloop::prewhiten`): the line `[1, k]` fitted to `L^-1 x` on
-/// `[L^-1 1, L^-1 k]`, `sigma^2 = RSS / (m - 2)`. The loop's residual goes through the same
-/// filter, so its whitened variance and this level are measured alike even where the
-/// fitted coefficients miss the truth (a short window biases Yule-Walker towards white):
-/// the reduced chi-square of a right model is 1 on average either way. The plain variance
-/// of the detrended window would not do: with strongly coloured noise a line through a
-/// few dozen samples takes out much of the slow part of the noise, and the level comes
-/// out low.
+/// The order `p` is chosen by BIC on the window with a straight line removed
+/// (`ArModel::fit`, Yule-Walker). The coefficients are then fitted again by restricted
+/// maximum likelihood (REML) with the line `[1, k]` in the model: over the reflection
+/// coefficients `k_1 .. k_p` (each in `(-0.99, 0.99)`, so every candidate is stationary),
+/// the minimum of
+///
+/// `(m - 2) ln(RSS / (m - 2)) + ln det R + ln det(C^T C)`,
+///
+/// `C = L^-1 [1, k]` the whitened line, `RSS` the whitened residual's sum of squares after
+/// the line's generalised least-squares fit, `ln det R = sum_k ln v_{min(k, p)}`
+/// (`closeloop::prewhiten`); `sigma^2 = RSS / (m - 2)` there. A line through a few dozen
+/// samples of strongly coloured noise takes much of the noise's slow part with it, and
+/// Yule-Walker on what is left reads the colour low (for an AR(1) of 0.8 on 45 samples,
+/// about 0.6) and the level low with it; REML counts the line's share and removes most of
+/// that bias (Cheang and Reinsel, *Bias reduction of autoregressive estimates in time
+/// series regression model through restricted maximum likelihood*, JASA 95, 2000). The
+/// search is coordinate-wise: a grid of 0.01 on each reflection coefficient in turn,
+/// refined to 1e-4, sweeps until no coordinate moves (at most 20).
 ///
 /// # Errors
-/// [`CalibrateError::Study`] naming the channel for a constant window (no noise to model)
-/// or a fitted model that is not stationary.
+/// [`CalibrateError::Study`] naming the channel for a constant window (no noise to model).
 fn quiet_noise(x: &[f64], label: &str) -> Result<(f64, ArModel, f64)> {
     let what = format!("noise floor of `{label}`");
     let e = impactcal_core::quality::spectrum::detrended(x);
-    let ar = ArModel::fit(&e, DEFAULT_MAX_ORDER).map_err(|err| {
+    let yw = ArModel::fit(&e, DEFAULT_MAX_ORDER).map_err(|err| {
         CalibrateError::study(
             what.as_str(),
             format!("the pre-impact window: {err}; give [test] sigma"),
         )
     })?;
     let m = x.len();
+    let p = yw.order();
+    let mut k = reflections(&yw.coefficients);
+    let mut best = restricted(x, &k, label)?;
+    for _ in 0..20 {
+        let mut moved = false;
+        for i in 0..p {
+            for step in [1e-2, 1e-3, 1e-4] {
+                let centre = k[i];
+                for j in -10..=10 {
+                    let mut trial = k.clone();
+                    trial[i] = (centre + j as f64 * step).clamp(-0.99, 0.99);
+                    let r = restricted(x, &trial, label)?;
+                    if r.0 < best.0 - 1e-12 {
+                        best = r;
+                        k = trial;
+                        moved = true;
+                    }
+                }
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    let coefficients = predictor(&k);
+    let sigma = best.1.sqrt();
+    let ar = ArModel {
+        innovation_variance: best.1 * k.iter().map(|r| 1.0 - r * r).product::<f64>(),
+        variance: best.1,
+        coefficients,
+        ..yw
+    };
+    let dof = (m as f64 - 2.0 - p as f64).max(1.0);
+    Ok((sigma, ar, dof))
+}
+
+/// The reflection coefficients of the AR predictor `phi` (step-down, as in
+/// `closeloop::prewhiten`), clamped into `(-0.99, 0.99)`.
+fn reflections(phi: &[f64]) -> Vec<f64> {
+    let p = phi.len();
+    let mut a = phi.to_vec();
+    let mut k = vec![0.0; p];
+    for m in (1..=p).rev() {
+        let km = a[m - 1].clamp(-0.99, 0.99);
+        k[m - 1] = km;
+        let d = 1.0 - km * km;
+        a = (1..m).map(|j| (a[j - 1] + km * a[m - j - 1]) / d).collect();
+    }
+    k
+}
+
+/// The AR predictor of reflection coefficients `k` (the Levinson-Durbin step-up,
+/// `a_{m,j} = a_{m-1,j} - k_m a_{m-1,m-j}`, `a_{m,m} = k_m`).
+fn predictor(k: &[f64]) -> Vec<f64> {
+    let mut a: Vec<f64> = Vec::new();
+    for (m, &km) in k.iter().enumerate() {
+        let mut next: Vec<f64> = (0..m).map(|j| a[j] - km * a[m - 1 - j]).collect();
+        next.push(km);
+        a = next;
+    }
+    a
+}
+
+/// The restricted log-likelihood's `-2` times (up to a constant) of the window `x` with a
+/// line and AR noise of reflection coefficients `k` (see [`quiet_noise`]), and the level
+/// `RSS / (m - 2)` at them.
+fn restricted(x: &[f64], k: &[f64], label: &str) -> Result<(f64, f64)> {
+    let m = x.len();
     let w = Prewhitener::new(
         &[label.to_string()],
-        std::slice::from_ref(&ar.coefficients),
+        &[predictor(k)],
         vec![vec![false; m]],
         m,
     )?;
     let u = w.whiten(x);
     let c1 = w.whiten(&vec![1.0; m]);
-    let c2 = w.whiten(&(0..m).map(|k| k as f64).collect::<Vec<f64>>());
+    let c2 = w.whiten(&(0..m).map(|j| j as f64).collect::<Vec<f64>>());
     let (s11, s12, s22) = (dot(&c1, &c1), dot(&c1, &c2), dot(&c2, &c2));
     let (b1, b2) = (dot(&c1, &u), dot(&c2, &u));
     let det = s11 * s22 - s12 * s12;
@@ -283,10 +358,18 @@ fn quiet_noise(x: &[f64], label: &str) -> Result<(f64, ArModel, f64)> {
     } else {
         (b1 / s11, 0.0)
     };
-    let rss: f64 = (0..m).map(|k| (u[k] - a * c1[k] - b * c2[k]).powi(2)).sum();
-    let sigma = (rss / (m as f64 - 2.0).max(1.0)).sqrt();
-    let dof = (m as f64 - 2.0 - ar.order() as f64).max(1.0);
-    Ok((sigma, ar, dof))
+    let rss: f64 = (0..m).map(|j| (u[j] - a * c1[j] - b * c2[j]).powi(2)).sum();
+    let dof = (m as f64 - 2.0).max(1.0);
+    let level = rss / dof;
+    // ln det R: sample j is predicted at order min(j, p), variance v_min(j, p).
+    let mut v = vec![1.0; k.len() + 1];
+    for (i, r) in k.iter().enumerate() {
+        v[i + 1] = v[i] * (1.0 - r * r);
+    }
+    let log_det_r: f64 = (0..m).map(|j| v[j.min(k.len())].ln()).sum();
+    let objective =
+        dof * level.max(f64::MIN_POSITIVE).ln() + log_det_r + det.max(f64::MIN_POSITIVE).ln();
+    Ok((objective, level))
 }
 
 /// The fraction of a white sequence's variance that the CFC filter removes.
