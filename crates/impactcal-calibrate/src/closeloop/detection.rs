@@ -108,13 +108,7 @@ impl Detection {
 pub fn chi2_quantile(nu: f64, alpha: f64) -> Result<f64> {
     let d = ChiSquared::new(nu)
         .map_err(|e| CalibrateError::study("chi-square quantile", e.to_string()))?;
-    if !(alpha > 0.0 && alpha < 1.0) {
-        return Err(CalibrateError::study(
-            "chi-square quantile",
-            format!("alpha {alpha} outside (0, 1)"),
-        ));
-    }
-    Ok(d.inverse_cdf(1.0 - alpha))
+    upper_quantile(&d, alpha, "chi-square quantile")
 }
 
 /// The `1 - alpha` quantile of `F(nu, m)`, the ratio of independent `chi2_nu / nu` and
@@ -125,9 +119,14 @@ pub fn chi2_quantile(nu: f64, alpha: f64) -> Result<f64> {
 pub fn f_quantile(nu: f64, m: f64, alpha: f64) -> Result<f64> {
     let d = FisherSnedecor::new(nu, m)
         .map_err(|e| CalibrateError::study("F quantile", e.to_string()))?;
+    upper_quantile(&d, alpha, "F quantile")
+}
+
+/// The `1 - alpha` quantile of `d`, `alpha` checked to lie in `(0, 1)`.
+fn upper_quantile(d: &impl ContinuousCDF<f64, f64>, alpha: f64, what: &str) -> Result<f64> {
     if !(alpha > 0.0 && alpha < 1.0) {
         return Err(CalibrateError::study(
-            "F quantile",
+            what,
             format!("alpha {alpha} outside (0, 1)"),
         ));
     }

@@ -183,16 +183,21 @@ impl Prewhitener {
         Ok(Prewhitener { samples, channels })
     }
 
-    /// `L^-1 v` of a vector `S x T` (channel-major), channel by channel.
-    pub fn whiten(&self, v: &[f64]) -> Vec<f64> {
+    /// `op` of each channel's filter on that channel's `T` values of `v` (`S x T`); `v`
+    /// itself for the identity.
+    fn per_channel(&self, v: &[f64], op: fn(&ChannelFilter, &[f64]) -> Vec<f64>) -> Vec<f64> {
         if self.channels.is_empty() {
             return v.to_vec();
         }
-        let t = self.samples;
-        v.chunks(t)
+        v.chunks(self.samples)
             .zip(&self.channels)
-            .flat_map(|(ch, f)| f.whiten(ch))
+            .flat_map(|(ch, f)| op(f, ch))
             .collect()
+    }
+
+    /// `L^-1 v` of a vector `S x T` (channel-major), channel by channel.
+    pub fn whiten(&self, v: &[f64]) -> Vec<f64> {
+        self.per_channel(v, ChannelFilter::whiten)
     }
 
     /// `L_s^-1 v` of channel `s`'s `T` values alone (a direction zero on every other
@@ -208,14 +213,7 @@ impl Prewhitener {
     /// samples (a masked sample passes `z` through: independent of the rest). For `z` unit
     /// white noise it is the AR noise of unit variance the model describes.
     pub fn colour(&self, z: &[f64]) -> Vec<f64> {
-        if self.channels.is_empty() {
-            return z.to_vec();
-        }
-        let t = self.samples;
-        z.chunks(t)
-            .zip(&self.channels)
-            .flat_map(|(ch, f)| f.colour(ch))
-            .collect()
+        self.per_channel(z, ChannelFilter::colour)
     }
 }
 
