@@ -22,11 +22,17 @@ fn truth(hidden: &[(&str, f64)]) -> DropTower {
 }
 
 fn measure(model: &DropTower, seed: u64) -> Histories {
+    measure_coloured(model, seed, 0.0)
+}
+
+/// The test with noise of lag-one correlation `ar1` (AR(1); white for 0).
+fn measure_coloured(model: &DropTower, seed: u64, ar1: f64) -> Histories {
     let y = model.simulate(&TRUE_POINT).unwrap();
     let m = Measurement {
         time_shift: TAU,
         gains: vec![("a2".into(), GAIN)],
         snr_db: Some(40.0),
+        ar1,
         seed,
         ..Measurement::default()
     };
@@ -34,10 +40,13 @@ fn measure(model: &DropTower, seed: u64) -> Histories {
 }
 
 fn run(truth: &DropTower, seed: u64, dir: &Path, holdout: Option<&Histories>) -> LoopResult {
-    let test = measure(truth, seed);
+    run_on(&measure(truth, seed), dir, holdout)
+}
+
+fn run_on(test: &Histories, dir: &Path, holdout: Option<&Histories>) -> LoopResult {
     let set = [("v0".to_string(), 5.5)];
     let data = TestData {
-        histories: &test,
+        histories: test,
         map: None,
         cfc: None,
     };
@@ -316,6 +325,66 @@ fn bad_input_is_a_typed_error_before_any_run() {
     let e = run_loop(&model, "m", bad, None, &opts, dir.path(), &Silent).unwrap_err();
     assert!(e.to_string().contains("belt"), "{e}");
     assert!(dir.path().join("runs/nominal/journal.jsonl").exists());
+}
+/// Noise of lag-one correlation 0.8 (AR(1), 40 dB) on a test from the model itself: the
+/// loop stays silent (nothing added, no model-form error) in at least 9 of 10 seeds.
+#[test]
+fn coloured_noise_negative_control_is_silent_in_nine_of_ten_seeds() {
+    let t = truth(&[]);
+    let mut silent = 0;
+    for seed in 0..10 {
+        let dir = tempfile::tempdir().unwrap();
+        let r = run_on(&measure_coloured(&t, 400 + seed, 0.8), dir.path(), None);
+        let quiet = r.verdict == Verdict::NoModelFormError && r.added.is_empty();
+        println!(
+            "coloured negative control, seed {}: {:?}, chi2_red {:.3} (threshold {:.3}), \
+             sigma1 {:.1} (edge {:.1}), noise lag-one {:?}",
+            400 + seed,
+            r.verdict,
+            r.detection.chi2_red,
+            r.detection.threshold,
+            r.detection.sigma1,
+            r.detection.noise_edge,
+            r.noise_floor
+                .channels
+                .iter()
+                .map(|c| (c.lag1 * 100.0).round() / 100.0)
+                .collect::<Vec<_>>()
+        );
+        silent += usize::from(quiet);
+    }
+    println!("coloured negative control: silent in {silent}/10 seeds");
+    assert!(silent >= 9, "silent in {silent} of 10 seeds");
+}
+
+/// Noise of lag-one correlation 0.8 (AR(1), 40 dB) on a test with hidden damping: the
+/// added damping's 95 % interval holds the truth in at least 85 % of 20 seeds (a seed where
+/// the damping is not added counts as a miss).
+#[test]
+fn coloured_noise_hidden_damping_intervals_cover_the_truth() {
+    let value = 0.03;
+    let t = truth(&[("damping", value)]);
+    let (mut added, mut inside) = (0, 0);
+    for seed in 0..20 {
+        let dir = tempfile::tempdir().unwrap();
+        let r = run_on(&measure_coloured(&t, 500 + seed, 0.8), dir.path(), None);
+        let a = r.added.iter().find(|a| a.name == "damping");
+        println!(
+            "coloured hidden damping, seed {}: {:?}, added {:?}",
+            500 + seed,
+            r.verdict,
+            a.map(|a| (a.lower, a.value, a.upper))
+        );
+        if let Some(a) = a {
+            added += 1;
+            inside += usize::from(a.lower <= value && value <= a.upper);
+        }
+    }
+    println!("coloured hidden damping: added {added}/20, truth inside the interval {inside}/20");
+    assert!(
+        inside >= 17,
+        "truth inside the interval in {inside} of 20 seeds"
+    );
 }
 
 /// How often the hidden effect is ranked first over 20 noise seeds (docs/validation.md):

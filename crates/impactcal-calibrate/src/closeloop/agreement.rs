@@ -7,16 +7,17 @@
 //! the ensemble is the *predictive* one of each model, linearised about its response `y`
 //! (nuisance terms taken out, in the test's units after filtering):
 //!
-//! `y_j = y + (sqrt(c) U z_j + eta_j) / (w g)`,  `z_j ~ N(0, I_r)`, `eta_j ~ N(0, I)`,
+//! `y_j = y + L (U z_j + eta_j) / (w g)`,  `z_j ~ N(0, I_r)`, `eta_j ~ N(0, I)`,
 //!
 //! where `w` are the loop's whitening weights (`1 / sqrt(sigma_s^2 + spread_s(t)^2)`: the
-//! measurement noise and the model's own simulation noise), `g` the channel gains, `c` the
-//! noise's inflation for lag-one correlation, and `U` (rank `r`) an orthonormal basis of the
-//! column space of the whitened Jacobian of a fit (parameters and nuisance terms; the
-//! factored form's basis, `closeloop::jacobian`). `J delta` with `delta`
-//! drawn from the linearised posterior `N(0, c (J^T J)^+)` is exactly `sqrt(c) U z`, so the
-//! first term is the parameters' uncertainty propagated to first order, the second the noise
-//! a repeated test would carry. A model with no fit at that point (the nominal model; any
+//! measurement noise and the model's own simulation noise), `L` each channel's AR
+//! colouring of the measurement noise (the inverse of the prewhitening,
+//! `closeloop::prewhiten`), `g` the channel gains, and `U` (rank `r`) an orthonormal basis
+//! of the column space of the whitened Jacobian of a fit (parameters and nuisance terms;
+//! the factored form's basis, `closeloop::jacobian`). `J delta` with `delta` drawn from the
+//! linearised posterior `N(0, (J^T J)^+)` is exactly `U z`, so the first term is the
+//! parameters' uncertainty propagated to first order, the second the noise a repeated test
+//! would carry, coloured as the record's. A model with no fit at that point (the nominal model; any
 //! model on the holdout, where the loop makes no Jacobian) has the noise term only.
 //!
 //! If the model is right, the test is one more draw from its predictive distribution and
@@ -42,11 +43,9 @@ use crate::study::{m1, m2};
 /// Impact shapes compared a side by the loop's M2 (the study's default).
 pub const M2_SHAPES: usize = 10;
 
-/// A fit's linearised posterior: its whitened Jacobian (parameters and nuisance terms) and
-/// the noise's inflation `c`.
+/// A fit's linearised posterior: its whitened Jacobian (parameters and nuisance terms).
 pub(crate) struct Posterior<'a> {
     pub jac: &'a Jacobian,
-    pub inflation: f64,
 }
 
 /// M1 of the test (nuisance terms `terms` taken out) against the envelope of `members`
@@ -66,7 +65,7 @@ pub(crate) fn m1_exceedance(
     seed: u64,
 ) -> Result<m1::M1> {
     let t = frame.samples;
-    let lsq = posterior.map(|p| (p.jac, p.inflation.sqrt()));
+    let lsq = posterior.map(|p| p.jac);
     let scale: Vec<f64> = frame
         .weights
         .iter()
@@ -81,18 +80,18 @@ pub(crate) fn m1_exceedance(
     let mut normal = || -> f64 { StandardNormal.sample(&mut rng) };
     let runs: Vec<Vec<f64>> = (0..members)
         .map(|_| {
-            let spread = lsq.as_ref().map(|(l, root_c)| {
+            let spread = lsq.map(|l| {
                 let z: Vec<f64> = (0..l.rank()).map(|_| normal()).collect();
-                (l.span(&z), *root_c)
+                l.span(&z)
             });
+            let white: Vec<f64> = (0..y.len())
+                .map(|i| spread.as_ref().map_or(0.0, |u| u[i]) + normal())
+                .collect();
             let draw: Vec<f64> = y
                 .iter()
                 .zip(&scale)
-                .enumerate()
-                .map(|(i, (v, s))| {
-                    let p = spread.as_ref().map_or(0.0, |(u, rc)| rc * u[i]);
-                    v + (p + normal()) * s
-                })
+                .zip(frame.whitener.colour(&white))
+                .map(|((v, s), e)| v + e * s)
                 .collect();
             norm_history_of(&draw, t)
         })
@@ -147,6 +146,7 @@ mod tests {
             dt: 1e-3,
             weights: vec![1.0 / sigma; test.len()],
             test,
+            whitener: Default::default(),
         }
     }
 

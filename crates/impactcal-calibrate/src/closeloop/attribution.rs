@@ -3,25 +3,25 @@
 //!
 //! For each candidate `k` one run of the model with the candidate moved from its held value
 //! by a finite step `h_k` (a fraction of its admissible range, inwards) gives its whitened
-//! direction `g_k = w (N(y_k) - N(y*)) / h_k` under the fitted nuisance terms `N`. With `J`
-//! the whitened Jacobian of the calibrated parameters and nuisance terms and `P_J` the
-//! orthogonal projector onto its columns (whitening makes `W = I`):
+//! direction `g_k = L^-1 w (N(y_k) - N(y*)) / h_k` under the fitted nuisance terms `N`
+//! (`w` the weights, `L^-1` each channel's AR filter of the noise, `closeloop::prewhiten`).
+//! With `J` the whitened Jacobian of the calibrated parameters and nuisance terms and `P_J`
+//! the orthogonal projector onto its columns (the whitening makes the noise unit white):
 //!
 //! - confounding ratio `kappa_k = ||P_J g_k|| / ||g_k||`; above 0.9 re-tuning what is
 //!   already fitted imitates the effect: *not identifiable from these sensors*, never
 //!   attributed;
 //! - the part no fitted quantity can mimic, `g~_k = (I - P_J) g_k`, and the residual `r`:
 //!   amplitude `phi_k = <g~_k, r> / <g~_k, g~_k>` (added to the held value), standard error
-//!   `sqrt(c / <g~_k, g~_k>)` with `c = (1 + rho_0) / (1 - rho_0)` for noise of lag-one
-//!   correlation `rho_0`, and a 95 % interval of 1.96 standard errors; explained fraction
-//!   `c_k = <g~_k, r>^2 / (<g~_k, g~_k> <r, r>)`; score statistic
-//!   `LM_k = <g~_k, r>^2 / (<g~_k, g~_k> c)`, `chi2_1` under "effect absent", significant
+//!   `sqrt(1 / <g~_k, g~_k>)`, and a 95 % interval of 1.96 standard errors; explained
+//!   fraction `c_k = <g~_k, r>^2 / (<g~_k, g~_k> <r, r>)`; score statistic
+//!   `LM_k = <g~_k, r>^2 / <g~_k, g~_k>`, `chi2_1` under "effect absent", significant
 //!   above the `1 - alpha / K` quantile (Bonferroni over the `K` directions);
 //! - the model's own noise, counted coherently (`closeloop::model_noise`): the jitter
 //!   ensemble's whitened draws `d_j` give the amplitude the model's noise alone produces,
 //!   `a_j = <g~_k, d_j> / <g~_k, g~_k>`, of variance `v_k = sum_j a_j^2 / m`; the interval
-//!   is `phi_k +- 1.96 sqrt(c / <g~_k, g~_k> + v_k)`, and a significant candidate whose
-//!   `phi_k^2 / (c / <g~_k, g~_k> + v_k)` does not pass the same quantile is *within the
+//!   is `phi_k +- 1.96 sqrt(1 / <g~_k, g~_k> + v_k)`, and a significant candidate whose
+//!   `phi_k^2 / (1 / <g~_k, g~_k> + v_k)` does not pass the same quantile is *within the
 //!   model's noise* and never added (on a smooth model `v_k = 0`);
 //! - admissibility: the interval must meet the candidate's admissible range (a damping that
 //!   only a negative coefficient would explain is rejected);
@@ -236,7 +236,6 @@ pub(crate) fn attribute<M: Enrichable>(
     step: f64,
     alpha: f64,
     min_explained: f64,
-    inflation: f64,
     onset: usize,
     allowed: &dyn Fn(&str) -> bool,
 ) -> Result<Attribution> {
@@ -277,13 +276,7 @@ pub(crate) fn attribute<M: Enrichable>(
             .stage(&full, &format!("{prefix}-candidates"), &points)?;
         for (k, p) in params.iter().enumerate() {
             let yk = ctx.y_of(&outs.histories(k, &format!("candidate `{}`", p.name))?)?;
-            let mk = nuisance::apply(&yk, frame, &fit.terms);
-            let g: Vec<f64> = mk
-                .iter()
-                .zip(&base)
-                .zip(&frame.weights)
-                .map(|((a, b), w)| w * (a - b) / steps[k])
-                .collect();
+            let g = nuisance::direction(&yk, &base, frame, &fit.terms, steps[k]);
             dirs.push((
                 p.name.clone(),
                 "candidate".into(),
@@ -310,13 +303,14 @@ pub(crate) fn attribute<M: Enrichable>(
         "time_scale".into(),
         "signature".into(),
         "signature".into(),
-        Shape::Dense(scale),
+        Shape::Dense(frame.whitener.whiten(&scale)),
         None,
     ));
     for (s, l) in frame.labels.iter().enumerate() {
         let g: Vec<f64> = (0..t)
             .map(|k| frame.weights[s * t + k] * (k as f64 - t0).max(0.0))
             .collect();
+        let g = frame.whitener.whiten_channel(s, &g);
         dirs.push((
             format!("drift:{l}"),
             "signature".into(),
@@ -367,7 +361,7 @@ pub(crate) fn attribute<M: Enrichable>(
         let identifiable = kappa <= KAPPA_MAX && gtt > 0.0;
         let gr = unfitted[i].dot(r, &utr, t);
         let (explained, lm) = if identifiable && rr > 0.0 {
-            (gr * gr / (gtt * rr), gr * gr / (gtt * inflation))
+            (gr * gr / (gtt * rr), gr * gr / gtt)
         } else {
             (0.0, 0.0)
         };
@@ -377,7 +371,7 @@ pub(crate) fn attribute<M: Enrichable>(
             0.0
         };
         let total_var = if identifiable {
-            inflation / gtt + noise_var
+            1.0 / gtt + noise_var
         } else {
             f64::INFINITY
         };

@@ -1,20 +1,27 @@
-//! Detection of model-form error in the whitened residual `e_sk = w_sk (test - model)` of a
+//! Detection of model-form error in the whitened residual `e = L^-1 w (test - model)` of a
 //! calibrated model (`S` channels, `T` samples, `n = S T`, `p` fitted quantities: the
-//! calibrated parameters and the nuisance terms).
+//! calibrated parameters and the nuisance terms): `w` the weights of the noise floor and
+//! `L^-1` each channel's AR filter of the measurement noise (`closeloop::prewhiten`), so
+//! that under the noise model `e` is unit white noise plus what the model lacks.
 //!
-//! - Reduced chi-square with effective samples: the residual's pooled lag-one
-//!   autocorrelation `rho` gives `n_eff = n (1 - rho) / (1 + rho)` (AR(1)), and
-//!   `chi2_red = (RSS n_eff / n) / (n_eff - p)` with `RSS = sum e^2`: the mean square
-//!   residual per independent sample, corrected for the fitted quantities. Its threshold is
-//!   the `1 - alpha` quantile of `chi2_nu / nu`, `nu = max(n_eff - p, 1)`.
+//! - Reduced chi-square: `chi2_red = RSS / (n - p)` with `RSS = sum e^2`, the mean square
+//!   residual per independent sample, corrected for the fitted quantities. With a noise
+//!   level known (given) its threshold is the `1 - alpha` quantile of `chi2_nu / nu`,
+//!   `nu = max(n - p, 1)`. With a level estimated on the record (a quiet window of a few
+//!   dozen samples) `chi2_red` is the ratio of the residual's mean square to the estimate's,
+//!   an `F(nu, m)` variable, `m` the estimate's degrees of freedom over the channels
+//!   (`NoiseFloor::level_dof`); the threshold is its `1 - alpha` quantile. The chi-square
+//!   quantile would take an estimate from 40 samples for the truth and call its error
+//!   model-form error.
 //! - Whiteness: the Ljung-Box statistic `Q = sum_s T (T + 2) sum_{k=1..h} rho_sk^2 / (T - k)`
-//!   over `h` lags per channel, against the `1 - alpha` quantile of `chi2_{S h}`. Reported;
-//!   coloured measurement noise fails it without any model error, so it does not decide.
+//!   over `h` lags per channel, against the `1 - alpha` quantile of `chi2_{S h}`. Reported:
+//!   a residual that fails it carries colour the noise model does not explain (a missing
+//!   effect, or noise unlike the record's quiet part), but it does not decide.
 //! - Structure: the SVD of the `S x T` residual matrix. For unit white noise its largest
-//!   singular value is about `sqrt(T) + sqrt(S)`; with noise of lag-one correlation
-//!   `rho_0` (measured on the noise itself) the edge is taken as
-//!   `(sqrt(T) + sqrt(S)) sqrt((1 + rho_0) / (1 - rho_0))` times a margin of 1.2. Above the
-//!   edge the residual has a coherent pattern: `u_1` says on which sensors, `v_1` when.
+//!   singular value is about `sqrt(T) + sqrt(S)`; the edge is that times a margin of 1.2.
+//!   Above the edge the residual has a coherent pattern: `u_1` says on which sensors, `v_1`
+//!   when (in the prewhitened coordinates: a missing effect's shape after the noise's
+//!   filter, which sharpens slow shapes).
 //!
 //! Model-form error is declared when `chi2_red` exceeds its threshold **and** `sigma_1`
 //! exceeds the edge. Inside the loop the threshold is raised by what the model's own noise
@@ -23,7 +30,7 @@
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
-use statrs::distribution::{ChiSquared, ContinuousCDF};
+use statrs::distribution::{ChiSquared, ContinuousCDF, FisherSnedecor};
 
 use super::linalg::svd_rows;
 use crate::error::{CalibrateError, Result};
@@ -36,15 +43,18 @@ pub const WHITENESS_LAGS: usize = 10;
 pub struct Detection {
     /// Reduced chi-square.
     pub chi2_red: f64,
-    /// Effective number of independent samples.
-    pub n_eff: f64,
-    /// Samples compared, `S T`.
+    /// Samples compared, `S T` (independent once prewhitened).
     pub n: usize,
     /// Fitted quantities (parameters and nuisance terms).
     pub p: usize,
-    /// The `1 - alpha` quantile of `chi2_nu / nu`.
+    /// The `1 - alpha` quantile of `chi2_nu / nu`, or of `F(nu, noise_dof)` when the noise
+    /// level was estimated.
     pub threshold: f64,
-    /// Pooled lag-one autocorrelation of the residual.
+    /// Degrees of freedom of the noise level's estimate (`None`: known).
+    #[serde(default)]
+    pub noise_dof: Option<f64>,
+    /// Pooled lag-one autocorrelation of the prewhitened residual (near 0 when the noise
+    /// model holds and nothing is missing).
     pub lag1: f64,
     /// Ljung-Box statistic over [`WHITENESS_LAGS`] lags per channel.
     pub ljung_box: f64,
@@ -98,9 +108,25 @@ impl Detection {
 pub fn chi2_quantile(nu: f64, alpha: f64) -> Result<f64> {
     let d = ChiSquared::new(nu)
         .map_err(|e| CalibrateError::study("chi-square quantile", e.to_string()))?;
+    upper_quantile(&d, alpha, "chi-square quantile")
+}
+
+/// The `1 - alpha` quantile of `F(nu, m)`, the ratio of independent `chi2_nu / nu` and
+/// `chi2_m / m`.
+///
+/// # Errors
+/// [`CalibrateError::Study`] for `nu <= 0`, `m <= 0` or `alpha` outside `(0, 1)`.
+pub fn f_quantile(nu: f64, m: f64, alpha: f64) -> Result<f64> {
+    let d = FisherSnedecor::new(nu, m)
+        .map_err(|e| CalibrateError::study("F quantile", e.to_string()))?;
+    upper_quantile(&d, alpha, "F quantile")
+}
+
+/// The `1 - alpha` quantile of `d`, `alpha` checked to lie in `(0, 1)`.
+fn upper_quantile(d: &impl ContinuousCDF<f64, f64>, alpha: f64, what: &str) -> Result<f64> {
     if !(alpha > 0.0 && alpha < 1.0) {
         return Err(CalibrateError::study(
-            "chi-square quantile",
+            what,
             format!("alpha {alpha} outside (0, 1)"),
         ));
     }
@@ -120,21 +146,18 @@ fn autocorrelation(e: &[f64], samples: usize, k: usize) -> f64 {
     if den > 0.0 { num / den } else { 0.0 }
 }
 
-/// The reduced chi-square of the whitened residual `e` (`S x T`, `T = samples`) with `p`
-/// fitted quantities (see the module docs), with the effective samples `n_eff`, the pooled
-/// lag-one autocorrelation and the degrees of freedom `nu` it used:
-/// `(chi2_red, n_eff, lag1, nu)`.
-pub(crate) fn chi2_red(e: &[f64], samples: usize, p: usize) -> (f64, f64, f64, f64) {
-    let n = e.len();
+/// The reduced chi-square of the whitened residual `e` (`S x T`) with `p` fitted
+/// quantities (see the module docs), with the degrees of freedom `nu` it used:
+/// `(chi2_red, nu)`.
+pub(crate) fn chi2_red(e: &[f64], p: usize) -> (f64, f64) {
     let rss: f64 = e.iter().map(|v| v * v).sum();
-    let lag1 = autocorrelation(e, samples, 1).clamp(0.0, 0.999);
-    let n_eff = n as f64 * (1.0 - lag1) / (1.0 + lag1);
-    let nu = (n_eff - p as f64).max(1.0);
-    (rss * n_eff / n as f64 / nu, n_eff, lag1, nu)
+    let nu = (e.len() as f64 - p as f64).max(1.0);
+    (rss / nu, nu)
 }
 
 /// The detection statistics (see the module docs) of the whitened residual `e` (`S x T`),
-/// with `p` fitted quantities, noise lag-one correlation `noise_lag1` and level `alpha`.
+/// with `p` fitted quantities, level `alpha` and `noise_dof` the degrees of freedom of the
+/// noise level's estimate (`None`: known).
 ///
 /// # Errors
 /// [`CalibrateError::Study`] when the SVD fails or the residual is empty.
@@ -143,8 +166,8 @@ pub fn detect(
     e: &[f64],
     samples: usize,
     p: usize,
-    noise_lag1: f64,
     alpha: f64,
+    noise_dof: Option<f64>,
 ) -> Result<Detection> {
     let s = labels.len();
     let n = e.len();
@@ -154,8 +177,12 @@ pub fn detect(
             "empty or mis-shaped residual",
         ));
     }
-    let (chi2_red, n_eff, lag1, nu) = chi2_red(e, samples, p);
-    let threshold = chi2_quantile(nu, alpha)? / nu;
+    let (chi2_red, nu) = chi2_red(e, p);
+    let lag1 = autocorrelation(e, samples, 1);
+    let threshold = match noise_dof {
+        Some(m) => f_quantile(nu, m, alpha)?,
+        None => chi2_quantile(nu, alpha)? / nu,
+    };
     let mut q = 0.0;
     let h = WHITENESS_LAGS.min(samples.saturating_sub(2)).max(1);
     for ch in e.chunks(samples) {
@@ -167,18 +194,16 @@ pub fn detect(
     }
     let ljung_box_threshold = chi2_quantile((s * h) as f64, alpha)?;
     let (sv, u, v) = svd_rows(e, s, samples)?;
-    let r0 = noise_lag1.clamp(0.0, 0.99);
-    let noise_edge =
-        1.2 * ((samples as f64).sqrt() + (s as f64).sqrt()) * ((1.0 + r0) / (1.0 - r0)).sqrt();
+    let noise_edge = 1.2 * ((samples as f64).sqrt() + (s as f64).sqrt());
     let sigma1 = sv.first().copied().unwrap_or(0.0);
     let coherent_rank = sv.iter().filter(|&&x| x > noise_edge).count();
     let coherent = sigma1 > noise_edge;
     Ok(Detection {
         chi2_red,
-        n_eff,
         n,
         p,
         threshold,
+        noise_dof,
         lag1,
         ljung_box: q,
         ljung_box_threshold,
@@ -220,6 +245,13 @@ mod tests {
         // chi2_{10}, 0.95 quantile 18.307; chi2_1, 0.99 quantile 6.635 (standard tables).
         assert!((chi2_quantile(10.0, 0.05).unwrap() - 18.307).abs() < 1e-3);
         assert!((chi2_quantile(1.0, 0.01).unwrap() - 6.635).abs() < 1e-3);
+        // F_{10, 20}, 0.95 quantile 2.348; F_{1, 10}, 0.99 quantile 10.044 (standard tables);
+        // F(nu, m) tends to chi2_nu / nu as m grows.
+        assert!((f_quantile(10.0, 20.0, 0.05).unwrap() - 2.348).abs() < 2e-3);
+        assert!((f_quantile(1.0, 10.0, 0.01).unwrap() - 10.044).abs() < 2e-3);
+        let (nu, big) = (1000.0, 1e7);
+        let chi = chi2_quantile(nu, 0.01).unwrap() / nu;
+        assert!((f_quantile(nu, big, 0.01).unwrap() - chi).abs() < 1e-3);
     }
 
     #[test]
@@ -228,8 +260,8 @@ mod tests {
         let t = 400;
         let mut alarms = 0;
         for seed in 0..20 {
-            let d = detect(&labels, &white(3 * t, seed), t, 5, 0.0, 0.01).unwrap();
-            assert!(d.n_eff > 0.9 * 1200.0);
+            let d = detect(&labels, &white(3 * t, seed), t, 5, 0.01, None).unwrap();
+            assert!(d.lag1.abs() < 0.1);
             alarms += usize::from(d.model_form_error);
         }
         assert!(alarms <= 1, "{alarms} false alarms in 20");
@@ -238,7 +270,7 @@ mod tests {
         for k in 0..t {
             e[t + k] += 3.0 * (-((k as f64 - 200.0) / 50.0).powi(2)).exp();
         }
-        let d = detect(&labels, &e, t, 5, 0.0, 0.01).unwrap();
+        let d = detect(&labels, &e, t, 5, 0.01, None).unwrap();
         assert!(d.model_form_error, "{d:?}");
         assert!(d.u1["b"].abs() > 0.9);
         let peak = (0..t)

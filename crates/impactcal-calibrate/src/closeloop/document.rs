@@ -126,7 +126,14 @@ pub fn report(r: &LoopResult) -> Report {
         heading: "Noise floor".into(),
         blocks: vec![table(
             "Measurement noise per channel and the model's own simulation noise",
-            &["channel", "sigma", "source", "lag-1", "simulation RMS"],
+            &[
+                "channel",
+                "sigma",
+                "source",
+                "lag-1",
+                "AR order",
+                "simulation RMS",
+            ],
             r.noise_floor
                 .channels
                 .iter()
@@ -136,6 +143,7 @@ pub fn report(r: &LoopResult) -> Report {
                         f(c.sigma),
                         format!("{:?}", c.source),
                         f(c.lag1),
+                        c.ar.len().to_string(),
                         f(c.simulation_rms),
                     ]
                 })
@@ -156,7 +164,7 @@ pub fn report(r: &LoopResult) -> Report {
                 vec![
                     row("chi2_red", f(d0.chi2_red), f(d1.chi2_red)),
                     row("threshold", f(d0.threshold), f(d1.threshold)),
-                    row("n_eff", f(d0.n_eff), f(d1.n_eff)),
+                    row("samples", d0.n.to_string(), d1.n.to_string()),
                     row("sigma_1", f(d0.sigma1), f(d1.sigma1)),
                     row("noise edge", f(d0.noise_edge), f(d1.noise_edge)),
                     row("Ljung-Box Q", f(d0.ljung_box), f(d1.ljung_box)),

@@ -257,14 +257,7 @@ fn polish_from<M: Model>(
         let mut dense = Vec::with_capacity(p + 1);
         for (i, hi) in h.iter().enumerate() {
             let yi = ctx.y_of(&outs.histories(i, "a finite-difference run")?)?;
-            let mi = nuisance::apply(&yi, &ctx.frame, &terms);
-            dense.push(
-                mi.iter()
-                    .zip(&base)
-                    .zip(&ctx.frame.weights)
-                    .map(|((a, b), w)| w * (a - b) / hi)
-                    .collect::<Vec<f64>>(),
-            );
+            dense.push(nuisance::direction(&yi, &base, &ctx.frame, &terms, *hi));
         }
         let (tau, local) = nuisance::columns(&y, &ctx.frame, &terms, ctx.fixed_gains.is_none());
         dense.push(tau);

@@ -7,15 +7,18 @@
 //!    per channel, `test_s(t) = g_s y_s(t - tau) + b_s`, profiled out of every comparison
 //!    and never offered as physics; gains near a units factor are flagged.
 //! 2. **Noise floor** ([`noise_floor`]): measurement noise per channel (given, pre-impact
-//!    window, or the frequencies where the model has no content) and the model's own
-//!    simulation noise from a jitter ensemble, combined in quadrature into the whitening
-//!    weights; the masks of `core::quality` (clipped runs, spikes) give zero weight
-//!    (`study::channels::prepared_test`); the test's offsets are the biases of step 1.
+//!    window, or the frequencies where the model has no content), its level and its AR
+//!    model, and the model's own simulation noise from a jitter ensemble, combined in
+//!    quadrature into the whitening weights; the masks of `core::quality` (clipped runs,
+//!    spikes) give zero weight (`study::channels::prepared_test`); the test's offsets are the
+//!    biases of step 1. Every residual and every direction is then prewhitened channel by
+//!    channel with the noise's AR filter (`prewhiten`: the generalised least-squares form),
+//!    so that every likelihood below sees white noise.
 //! 3. **Calibration**: CORS-RBF then a Gauss-Newton polish to a least-squares
 //!    optimum.
-//! 4. **Detection** ([`detection`]): reduced chi-square in effective samples, whiteness,
-//!    the residual SVD against the noise edge; model-form error when chi-square exceeds its
-//!    quantile and the residual is coherent.
+//! 4. **Detection** ([`detection`]): reduced chi-square, whiteness, the residual SVD
+//!    against the noise edge; model-form error when chi-square exceeds its quantile and the
+//!    residual is coherent.
 //! 5. **Attribution** ([`attribution`]): one run per candidate for its direction; the
 //!    confounding ratio `kappa` against what is already fitted; amplitude with interval,
 //!    explained fraction, score statistic, admissibility, mutual coherence; a ranking.
@@ -66,6 +69,7 @@ pub mod noise_floor;
 pub mod nuisance;
 pub mod options;
 pub mod plan;
+mod prewhiten;
 pub mod result;
 pub mod selection;
 
@@ -281,7 +285,7 @@ pub fn run_loop_on<M: Enrichable>(
         (test.cfc, band),
         unit_gains.as_deref(),
     )?;
-    masked_out(&mut frame, &masks);
+    noise_model(&mut frame, &masks, &floor)?;
     let ctx = Ctx {
         frame,
         cfc: test.cfc,
@@ -292,7 +296,6 @@ pub fn run_loop_on<M: Enrichable>(
         batch: options.batch,
         model_noise,
     };
-    let inflation = floor.inflation();
     let onset = noise_floor::onset(&y_nominal, samples);
     let n_nuisance = 1 + if options.fit_gains { 2 } else { 1 } * labels.len();
 
@@ -311,10 +314,9 @@ pub fn run_loop_on<M: Enrichable>(
         model,
         fit0.clone(),
         options,
-        inflation,
         onset,
-        floor.lag1(),
         n_nuisance,
+        floor.level_dof(),
     )?;
     let fit = &outcome.fit;
     let det0 = outcome.rounds[0].detection.clone();
@@ -364,7 +366,7 @@ pub fn run_loop_on<M: Enrichable>(
         .enumerate()
         .map(|(i, p)| {
             let v = fit.point[d0 + i];
-            let se = (fit.se[d0 + i].powi(2) * inflation + noise_var[d0 + i]).sqrt();
+            let se = (fit.se[d0 + i].powi(2) + noise_var[d0 + i]).sqrt();
             Added {
                 name: p.name.clone(),
                 value: v,
@@ -379,10 +381,10 @@ pub fn run_loop_on<M: Enrichable>(
     observer.step("before and after");
     let p_of = |d: usize| d + n_nuisance;
     let (terms_nominal, _) = ctx.profile(&y_nominal);
-    let posterior = |jac| Posterior { jac, inflation };
+    let posterior = |jac| Posterior { jac };
     let judge = Judge {
-        lag1: floor.lag1(),
         options,
+        noise_dof: floor.level_dof(),
     };
     let metrics_calibration = Stages {
         nominal: judge.errors(&ctx.frame, &y_nominal, &terms_nominal, p_of(d0), None, 0)?,
@@ -463,12 +465,12 @@ pub fn run_loop_on<M: Enrichable>(
                 (test.cfc, band),
                 Some(&gains),
             )?;
-            masked_out(&mut frame_h, &masks_h);
+            noise_model(&mut frame_h, &masks_h, &floor_h)?;
             let profile = |y: &[f64]| nuisance::profile(y, &frame_h, max_shift, Some(&gains)).0;
             let ys = [y_nom_h, prep(&calibrated_h)?, prep(&enriched_h)?];
             let judge = Judge {
-                lag1: floor_h.lag1(),
                 options,
+                noise_dof: floor_h.level_dof(),
             };
             let at = |k: usize| {
                 judge.errors(
@@ -606,6 +608,7 @@ fn frame_of(
         dt,
         test: test.to_vec(),
         weights: vec![1.0; test.len()],
+        whitener: prewhiten::Prewhitener::default(),
     };
     let (terms, _) = nuisance::profile(y_nominal, &frame, max_shift, fixed_gains);
     let onset = noise_floor::onset(y_nominal, samples) as f64 + terms.tau / dt;
@@ -633,9 +636,13 @@ fn frame_of(
     Ok((frame, floor))
 }
 
-/// Zero weight for the masked samples of `core::quality` (clipped runs and spikes), per
-/// channel in frame order: they leave every residual.
-fn masked_out(frame: &mut Frame, masks: &[Vec<bool>]) {
+/// The frame's noise model: zero weight for the masked samples of `core::quality` (clipped
+/// runs and spikes, per channel in frame order: they leave every residual), and each
+/// channel's AR whitening of the noise `floor` measured, started afresh after each mask.
+///
+/// # Errors
+/// [`CalibrateError::Study`] for a noise model that is not stationary.
+fn noise_model(frame: &mut Frame, masks: &[Vec<bool>], floor: &NoiseFloor) -> Result<()> {
     let t = frame.samples;
     for (s, m) in masks.iter().enumerate() {
         for (k, &out) in m.iter().enumerate().take(t) {
@@ -644,13 +651,20 @@ fn masked_out(frame: &mut Frame, masks: &[Vec<bool>]) {
             }
         }
     }
+    let masked = frame
+        .weights
+        .chunks(t)
+        .map(|w| w.iter().map(|v| *v == 0.0).collect())
+        .collect();
+    frame.whitener = prewhiten::Prewhitener::new(&frame.labels, &floor.ar_models(), masked, t)?;
+    Ok(())
 }
 
-/// What judges a model's response against a test: the noise's lag-one correlation and the
-/// loop's options.
+/// What judges a model's response against a test: the loop's options and the degrees of
+/// freedom of the noise level's estimate (`NoiseFloor::level_dof`).
 struct Judge<'a> {
-    lag1: f64,
     options: &'a LoopOptions,
+    noise_dof: Option<f64>,
 }
 
 impl Judge<'_> {
@@ -675,8 +689,8 @@ impl Judge<'_> {
             &residual,
             frame.samples,
             p,
-            self.lag1,
             self.options.alpha,
+            self.noise_dof,
         )?;
         let iso = Iso18571::new();
         let t = frame.samples;

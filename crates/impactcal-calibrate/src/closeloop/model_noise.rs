@@ -5,8 +5,8 @@
 //! noise were independent from sample to sample. A crash model's noise is not: a jitter of
 //! `1e-4` moves the whole response, coherently over time and sensors, and a candidate's
 //! direction can fit part of that pattern as well as it fits physics. The ensemble already
-//! holds draws of the pattern: the deviations `d_j = w (N(y_j) - N(y_0))` of the `m` jittered
-//! runs from the nominal one, whitened under the fit's nuisance terms `N`. (A residual
+//! holds draws of the pattern: the deviations `d_j = L^-1 w (N(y_j) - N(y_0))` of the `m`
+//! jittered runs from the nominal one, whitened under the fit's nuisance terms `N`. (A residual
 //! between a test and a model at another point carries the difference of two such draws,
 //! the same variance as `y_j - y_0`.)
 //!
@@ -16,8 +16,8 @@
 //! `v_i = sum_j (delta_ji - s_ji)^2 / m` is the variance the model's noise adds to parameter
 //! `i`, counted coherently: the sample form of `J^+ Sigma_model J^+T` with the noise
 //! covariance `Sigma_model` estimated by `sum_j d_j d_j^T / m`. A parameter's variance is
-//! then `c se_i^2 + v_i` (`c` the measurement noise's inflation, `se_i` its linearised
-//! standard error for unit white noise).
+//! then `se_i^2 + v_i` (`se_i` its linearised standard error under the measurement noise's
+//! model, the whitening being `L^-1 w`, `closeloop::prewhiten`).
 //!
 //! For a candidate direction `g~` (already orthogonal to `J`) the same regression is
 //! `a_j = <g~, d_j> / <g~, g~>`, the amplitude the model's noise alone would attribute to
@@ -86,7 +86,7 @@ impl ModelNoise {
     }
 
     /// One pass over the draws, each whitened under the nuisance terms of `fit`,
-    /// `w (N(y + d_j) - N(y))`, regressed on its Jacobian: per draw, the energy outside the
+    /// `L^-1 w (N(y + d_j) - N(y))`, regressed on its Jacobian: per draw, the energy outside the
     /// fitted span, the dense coefficients `J^+ d_j`, with `chi2 = Some(p)` the reduced
     /// chi-square of the unfitted part taken as a residual with `p` fitted quantities, and
     /// with `products` the inner products it returns for the whitened draw and its
@@ -110,17 +110,12 @@ impl ModelNoise {
             let d = self.deviation(j)?;
             let y: Vec<f64> = fit.y.iter().zip(&d).map(|(a, b)| a + b).collect();
             drop(d);
-            let dw: Vec<f64> = nuisance::apply(&y, frame, &fit.terms)
-                .iter()
-                .zip(&base)
-                .zip(&frame.weights)
-                .map(|((a, b), w)| w * (a - b))
-                .collect();
+            let dw = nuisance::direction(&y, &base, frame, &fit.terms, 1.0);
             let u = fit.jac.unfitted(&dw);
             out.unfitted.push(u.iter().map(|v| v * v).sum());
             out.solved.push(fit.jac.solve(&dw));
             if let Some(p) = chi2 {
-                out.chi2.push(chi2_red(&u, frame.samples, p).0);
+                out.chi2.push(chi2_red(&u, p).0);
             }
             if let Some(f) = products {
                 out.products.push(f(&dw, &fit.jac.coefficients(&dw)));

@@ -1,16 +1,19 @@
-//! The noise floor: the standard deviation of the measurement noise per channel, and the
-//! model's own simulation noise, combined in quadrature into the weights
+//! The noise floor: the measurement noise per channel (its standard deviation and its AR
+//! model, the colour every likelihood of the loop whitens, `closeloop::prewhiten`), and
+//! the model's own simulation noise, combined in quadrature into the weights
 //! `w_sk = 1 / sqrt(sigma_s^2 + spread_sk^2)`.
 //!
 //! `sigma_s` is the noise as compared (after the test's filter) and comes, in this order,
-//! from the user (`sigma`, one value for every channel, which wins when given), from the
-//! pre-impact window of the test (the samples before the model's response departs from
-//! its initial value, moved by the trigger offset; at least [`MIN_PRE_IMPACT`] samples; a
-//! straight line is fitted and removed, the residual's standard deviation and lag-one
-//! autocorrelation kept), or from the band above the bandwidth of the model ensemble the
-//! loop has at that point (the nominal run and its jittered runs), where the test's
-//! spectrum must be flat like noise (`impactcal_core::quality::noise_from_band`: white
-//! noise through the test's filter, its variance and lag-one correlation). When the record
+//! from the user (`sigma`, one value for every channel, which wins when given; the noise is
+//! then taken as white), from the pre-impact window of the test (the samples before the
+//! model's response departs from its initial value, moved by the trigger offset; at least
+//! [`MIN_PRE_IMPACT`] samples: an AR model of order by BIC, its coefficients and level by
+//! restricted maximum likelihood with a straight line in the model, see `quiet_noise`),
+//! or from the band above the bandwidth of the model
+//! ensemble the loop has at that point (the nominal run and its jittered runs), where the
+//! test's spectrum must be flat like noise (`impactcal_core::quality::noise_from_band`:
+//! white noise through the test's filter, its variance and the AR model of that filtered
+//! white noise). When the record
 //! has neither a quiet part nor such a band (the model has content above the noise up to
 //! the filter's stop band, or the band is not flat), the band's refusal is kept and the
 //! last resort serves: the test minus its CFC-filtered self, whose variance is the part of
@@ -18,16 +21,20 @@
 //! fraction of a white sequence's variance the same filter removes (measured on a seeded
 //! white sequence of the same length). It counts whatever the model does above that filter
 //! as noise: an upper bound, and the loop's thresholds are lenient by as much; give `sigma`
-//! for such a record. `spread_sk` is the standard deviation of a jitter ensemble of the
+//! for such a record. The high band says nothing of the noise's colour below the filter:
+//! it is taken as white. `spread_sk` is the standard deviation of a jitter ensemble of the
 //! model (`impactcal_core::noise`): what the model does on its own under a tiny change of
 //! its parameters, which no calibration may call model-form error.
 
-use impactcal_core::quality::{MemberEnvelope, noise_above_envelope};
+use impactcal_core::quality::ar::DEFAULT_MAX_ORDER;
+use impactcal_core::quality::{ArModel, MemberEnvelope, noise_above_envelope};
 use impactcal_core::{Cfc, Histories};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use super::linalg::dot;
+use super::prewhiten::Prewhitener;
 use crate::error::{CalibrateError, Result};
 
 /// Fewest pre-impact samples the noise is measured on.
@@ -58,13 +65,23 @@ pub struct ChannelNoise {
     pub sigma: f64,
     /// Where it came from.
     pub source: NoiseSource,
-    /// Lag-one autocorrelation of the noise (0 when not measurable).
+    /// Lag-one autocorrelation of the noise (0 when taken as white).
     pub lag1: f64,
+    /// The noise's AR coefficients `phi_1 .. phi_p` (`e_k = sum phi_i e_{k-i} + u_k`;
+    /// empty: white), whitened out of every likelihood of the loop.
+    #[serde(default)]
+    pub ar: Vec<f64>,
     /// RMS over time of the model's simulation noise (jitter spread).
     pub simulation_rms: f64,
     /// Why the band above the model's bandwidth gave no estimate, when it was tried.
     #[serde(default)]
     pub band_refusal: Option<String>,
+    /// Degrees of freedom of the level's estimate (`None`: taken as known, given by the user
+    /// or the high band's upper bound). The pre-impact window's: its samples less the line
+    /// and the AR coefficients; the band's: its ordinates (Hann-windowed, neighbours
+    /// overlap: one each, not two).
+    #[serde(default)]
+    pub dof: Option<f64>,
 }
 
 /// The noise floor of a test.
@@ -77,16 +94,25 @@ pub struct NoiseFloor {
 }
 
 impl NoiseFloor {
-    /// The pooled lag-one autocorrelation of the noise, clamped to `[0, 0.99]`.
-    pub fn lag1(&self) -> f64 {
-        let n = self.channels.len().max(1) as f64;
-        (self.channels.iter().map(|c| c.lag1).sum::<f64>() / n).clamp(0.0, 0.99)
+    /// Each channel's AR coefficients, in channel order.
+    pub fn ar_models(&self) -> Vec<Vec<f64>> {
+        self.channels.iter().map(|c| c.ar.clone()).collect()
     }
 
-    /// `(1 + rho) / (1 - rho)`: how many samples count as one independent one.
-    pub fn inflation(&self) -> f64 {
-        let r = self.lag1();
-        (1.0 + r) / (1.0 - r)
+    /// The degrees of freedom of the noise level as a chi-square over every channel sees
+    /// it: `m = S^2 / sum_s 1 / dof_s` (a channel of known level adds nothing to the sum).
+    /// A mean over `S` channels of `RSS_s / sigma_s^2` with each `sigma_s^2` estimated on
+    /// `dof_s` degrees of freedom varies as an `F` whose denominator has `m` (equal `dof`:
+    /// `m = S dof`). `None` when every level is known.
+    pub fn level_dof(&self) -> Option<f64> {
+        let inv: f64 = self
+            .channels
+            .iter()
+            .filter_map(|c| c.dof)
+            .map(|d| 1.0 / d.max(1.0))
+            .sum();
+        let s = self.channels.len() as f64;
+        (inv > 0.0).then(|| s * s / inv)
     }
 }
 
@@ -137,11 +163,11 @@ pub(crate) fn estimate(
         let sp = &spread[s * samples..(s + 1) * samples];
         let simulation_rms = (sp.iter().map(|v| v * v).sum::<f64>() / samples as f64).sqrt();
         let mut band_refusal = None;
-        let (sigma, source, lag1) = if let Some(sigma) = user_sigma {
-            (sigma, NoiseSource::User, 0.0)
+        let (sigma, source, ar, dof) = if let Some(sigma) = user_sigma {
+            (sigma, NoiseSource::User, ArModel::white(sigma), None)
         } else if use_pre {
-            let (sd, r) = detrended(&ch[..pre_impact]);
-            (sd, NoiseSource::PreImpact, r)
+            let (sd, ar, dof) = quiet_noise(&ch[..pre_impact], label)?;
+            (sd, NoiseSource::PreImpact, ar, Some(dof))
         } else {
             if envelopes.is_none() {
                 envelopes = Some(members()?);
@@ -153,7 +179,12 @@ pub(crate) fn estimate(
                 )
             })?;
             match noise_above_envelope(ch, envelope, dt, test_cfc)? {
-                Ok(b) => (b.model.sigma(), NoiseSource::ModelFreeBand, b.model.lag1()),
+                Ok(b) => (
+                    b.model.sigma(),
+                    NoiseSource::ModelFreeBand,
+                    b.model,
+                    Some(b.bins as f64),
+                ),
                 Err(r) => {
                     band_refusal = Some(r.to_string());
                     let fraction = removed_fraction(samples, dt, cfc)?;
@@ -167,7 +198,8 @@ pub(crate) fn estimate(
                     let f = h.filtered(cfc)?;
                     let e: Vec<f64> = ch.iter().zip(f.channel(0)).map(|(a, b)| a - b).collect();
                     let var = e.iter().map(|v| v * v).sum::<f64>() / samples as f64;
-                    ((var / fraction).sqrt(), NoiseSource::HighBand, 0.0)
+                    let sigma = (var / fraction).sqrt();
+                    (sigma, NoiseSource::HighBand, ArModel::white(sigma), None)
                 }
             }
         };
@@ -181,9 +213,11 @@ pub(crate) fn estimate(
             label: label.clone(),
             sigma,
             source,
-            lag1,
+            lag1: ar.lag1(),
+            ar: ar.coefficients,
             simulation_rms,
             band_refusal,
+            dof,
         });
     }
     Ok(NoiseFloor {
@@ -205,14 +239,137 @@ pub(crate) fn weights(floor: &NoiseFloor, spread: &[f64], samples: usize) -> Vec
     w
 }
 
-/// Standard deviation and lag-one autocorrelation of `x` after removing a fitted line.
-fn detrended(x: &[f64]) -> (f64, f64) {
-    let n = x.len() as f64;
+/// The noise of a quiet window `x` of `m` samples: its AR model, the standard deviation
+/// `sigma` of the noise process, and the degrees of freedom of `sigma^2`, `m - 2 - p`.
+///
+/// The order `p` is chosen by BIC on the window with a straight line removed
+/// (`ArModel::fit`, Yule-Walker). The coefficients are then fitted again by restricted
+/// maximum likelihood (REML) with the line `[1, k]` in the model: over the reflection
+/// coefficients `k_1 .. k_p` (each in `(-0.99, 0.99)`, so every candidate is stationary),
+/// the minimum of
+///
+/// `(m - 2) ln(RSS / (m - 2)) + ln det R + ln det(C^T C)`,
+///
+/// `C = L^-1 [1, k]` the whitened line, `RSS` the whitened residual's sum of squares after
+/// the line's generalised least-squares fit, `ln det R = sum_k ln v_{min(k, p)}`
+/// (`closeloop::prewhiten`); `sigma^2 = RSS / (m - 2)` there. A line through a few dozen
+/// samples of strongly coloured noise takes much of the noise's slow part with it, and
+/// Yule-Walker on what is left reads the colour low (for an AR(1) of 0.8 on 45 samples,
+/// about 0.6) and the level low with it; REML counts the line's share and removes most of
+/// that bias (Cheang and Reinsel, *Bias reduction of autoregressive estimates in time
+/// series regression model through restricted maximum likelihood*, JASA 95, 2000). The
+/// search is coordinate-wise: a grid of 0.01 on each reflection coefficient in turn,
+/// refined to 1e-4, sweeps until no coordinate moves (at most 20).
+///
+/// # Errors
+/// [`CalibrateError::Study`] naming the channel for a constant window (no noise to model).
+fn quiet_noise(x: &[f64], label: &str) -> Result<(f64, ArModel, f64)> {
+    let what = format!("noise floor of `{label}`");
     let e = impactcal_core::quality::spectrum::detrended(x);
-    let var = e.iter().map(|v| v * v).sum::<f64>() / (n - 2.0).max(1.0);
-    let c1 = e.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / (n - 1.0).max(1.0);
-    let r = if var > 0.0 { c1 / var } else { 0.0 };
-    (var.sqrt(), r)
+    let yw = ArModel::fit(&e, DEFAULT_MAX_ORDER).map_err(|err| {
+        CalibrateError::study(
+            what.as_str(),
+            format!("the pre-impact window: {err}; give [test] sigma"),
+        )
+    })?;
+    let m = x.len();
+    let p = yw.order();
+    let mut k = reflections(&yw.coefficients);
+    let mut best = restricted(x, &k, label)?;
+    for _ in 0..20 {
+        let mut moved = false;
+        for i in 0..p {
+            for step in [1e-2, 1e-3, 1e-4] {
+                let centre = k[i];
+                for j in -10..=10 {
+                    let mut trial = k.clone();
+                    trial[i] = (centre + j as f64 * step).clamp(-0.99, 0.99);
+                    let r = restricted(x, &trial, label)?;
+                    if r.0 < best.0 - 1e-12 {
+                        best = r;
+                        k = trial;
+                        moved = true;
+                    }
+                }
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    let coefficients = predictor(&k);
+    let sigma = best.1.sqrt();
+    let ar = ArModel {
+        innovation_variance: best.1 * k.iter().map(|r| 1.0 - r * r).product::<f64>(),
+        variance: best.1,
+        coefficients,
+        ..yw
+    };
+    let dof = (m as f64 - 2.0 - p as f64).max(1.0);
+    Ok((sigma, ar, dof))
+}
+
+/// The reflection coefficients of the AR predictor `phi` (step-down, as in
+/// `closeloop::prewhiten`), clamped into `(-0.99, 0.99)`.
+fn reflections(phi: &[f64]) -> Vec<f64> {
+    let p = phi.len();
+    let mut a = phi.to_vec();
+    let mut k = vec![0.0; p];
+    for m in (1..=p).rev() {
+        let km = a[m - 1].clamp(-0.99, 0.99);
+        k[m - 1] = km;
+        let d = 1.0 - km * km;
+        a = (1..m).map(|j| (a[j - 1] + km * a[m - j - 1]) / d).collect();
+    }
+    k
+}
+
+/// The AR predictor of reflection coefficients `k` (the Levinson-Durbin step-up,
+/// `a_{m,j} = a_{m-1,j} - k_m a_{m-1,m-j}`, `a_{m,m} = k_m`).
+fn predictor(k: &[f64]) -> Vec<f64> {
+    let mut a: Vec<f64> = Vec::new();
+    for (m, &km) in k.iter().enumerate() {
+        let mut next: Vec<f64> = (0..m).map(|j| a[j] - km * a[m - 1 - j]).collect();
+        next.push(km);
+        a = next;
+    }
+    a
+}
+
+/// The restricted log-likelihood's `-2` times (up to a constant) of the window `x` with a
+/// line and AR noise of reflection coefficients `k` (see [`quiet_noise`]), and the level
+/// `RSS / (m - 2)` at them.
+fn restricted(x: &[f64], k: &[f64], label: &str) -> Result<(f64, f64)> {
+    let m = x.len();
+    let w = Prewhitener::new(
+        &[label.to_string()],
+        &[predictor(k)],
+        vec![vec![false; m]],
+        m,
+    )?;
+    let u = w.whiten(x);
+    let c1 = w.whiten(&vec![1.0; m]);
+    let c2 = w.whiten(&(0..m).map(|j| j as f64).collect::<Vec<f64>>());
+    let (s11, s12, s22) = (dot(&c1, &c1), dot(&c1, &c2), dot(&c2, &c2));
+    let (b1, b2) = (dot(&c1, &u), dot(&c2, &u));
+    let det = s11 * s22 - s12 * s12;
+    let (a, b) = if det > 0.0 {
+        ((s22 * b1 - s12 * b2) / det, (s11 * b2 - s12 * b1) / det)
+    } else {
+        (b1 / s11, 0.0)
+    };
+    let rss: f64 = (0..m).map(|j| (u[j] - a * c1[j] - b * c2[j]).powi(2)).sum();
+    let dof = (m as f64 - 2.0).max(1.0);
+    let level = rss / dof;
+    // ln det R: sample j is predicted at order min(j, p), variance v_min(j, p).
+    let mut v = vec![1.0; k.len() + 1];
+    for (i, r) in k.iter().enumerate() {
+        v[i + 1] = v[i] * (1.0 - r * r);
+    }
+    let log_det_r: f64 = (0..m).map(|j| v[j.min(k.len())].ln()).sum();
+    let objective =
+        dof * level.max(f64::MIN_POSITIVE).ln() + log_det_r + det.max(f64::MIN_POSITIVE).ln();
+    Ok((objective, level))
 }
 
 /// The fraction of a white sequence's variance that the CFC filter removes.

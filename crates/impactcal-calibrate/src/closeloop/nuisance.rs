@@ -15,6 +15,8 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use super::prewhiten::Prewhitener;
+
 /// The likely units factors and what each suggests.
 const UNITS: [(f64, &str); 5] = [
     (9.81, "g vs m/s^2"),
@@ -35,6 +37,9 @@ pub(crate) struct Frame {
     pub test: Vec<f64>,
     /// Whitening weights `1 / sigma_sk`, `S x T`.
     pub weights: Vec<f64>,
+    /// The noise model after the weights: each channel's AR whitening, and the masked
+    /// samples (`closeloop::prewhiten`).
+    pub whitener: Prewhitener,
 }
 
 /// The estimated nuisance terms.
@@ -157,8 +162,10 @@ pub(crate) fn corrected_test(frame: &Frame, terms: &Terms) -> Vec<f64> {
     out
 }
 
-/// Per channel, the weighted fit of the test on `[ys, 1]` at the given shifted model:
-/// `(g, b, rss)`. `fixed_gains` keeps the gains and fits only the biases.
+/// Per channel, the generalised least-squares fit of the test on `[ys, 1]` at the given
+/// shifted model under the frame's noise model: the ordinary fit of `L^-1 w z` on
+/// `[L^-1 w ys, L^-1 w]` (`closeloop::prewhiten`), `(g, b, rss)`. `fixed_gains` keeps the
+/// gains and fits only the biases.
 fn channel_fits(
     ys: &[f64],
     frame: &Frame,
@@ -169,14 +176,19 @@ fn channel_fits(
     for s in 0..frame.labels.len() {
         let r = s * t..(s + 1) * t;
         let (y, z, w) = (&ys[r.clone()], &frame.test[r.clone()], &frame.weights[r]);
+        let white = |v: &dyn Fn(usize) -> f64| -> Vec<f64> {
+            frame
+                .whitener
+                .whiten_channel(s, &(0..t).map(|k| w[k] * v(k)).collect::<Vec<f64>>())
+        };
+        let (c, a, u) = (white(&|_| 1.0), white(&|k| y[k]), white(&|k| z[k]));
         let (mut sw, mut sy, mut sz, mut syy, mut syz) = (0.0, 0.0, 0.0, 0.0, 0.0);
         for k in 0..t {
-            let w2 = w[k] * w[k];
-            sw += w2;
-            sy += w2 * y[k];
-            sz += w2 * z[k];
-            syy += w2 * y[k] * y[k];
-            syz += w2 * y[k] * z[k];
+            sw += c[k] * c[k];
+            sy += c[k] * a[k];
+            sz += c[k] * u[k];
+            syy += a[k] * a[k];
+            syz += a[k] * u[k];
         }
         let (g, b) = match fixed_gains {
             Some(g) => (g[s], (sz - g[s] * sy) / sw),
@@ -190,7 +202,7 @@ fn channel_fits(
             }
         };
         rss += (0..t)
-            .map(|k| (w[k] * (z[k] - g * y[k] - b)).powi(2))
+            .map(|k| (u[k] - g * a[k] - b * c[k]).powi(2))
             .sum::<f64>();
         gains.push(g);
         biases.push(b);
@@ -260,21 +272,42 @@ pub(crate) fn profile(
     best
 }
 
-/// The whitened residual `w (test - N(y))` of a model run under nuisance `terms`.
+/// The whitened residual `L^-1 w (test - N(y))` of a model run under nuisance `terms`
+/// (`L^-1` the frame's noise model, `closeloop::prewhiten`).
 pub(crate) fn residual(y: &[f64], frame: &Frame, terms: &Terms) -> Vec<f64> {
-    apply(y, frame, terms)
+    let weighted: Vec<f64> = apply(y, frame, terms)
         .iter()
         .zip(&frame.test)
         .zip(&frame.weights)
         .map(|((m, z), w)| w * (z - m))
-        .collect()
+        .collect();
+    frame.whitener.whiten(&weighted)
+}
+
+/// The whitened change `L^-1 w (N(y_1) - N(y_0)) / h` between two model runs under the
+/// same nuisance terms, given `base = N(y_0)`: a finite-difference direction of the fit.
+pub(crate) fn direction(
+    y1: &[f64],
+    base: &[f64],
+    frame: &Frame,
+    terms: &Terms,
+    h: f64,
+) -> Vec<f64> {
+    let weighted: Vec<f64> = apply(y1, frame, terms)
+        .iter()
+        .zip(base)
+        .zip(&frame.weights)
+        .map(|((a, b), w)| w * (a - b) / h)
+        .collect();
+    frame.whitener.whiten(&weighted)
 }
 
 /// The whitened derivative columns of the nuisance terms at `y`, in the form
 /// [`Jacobian::new`](super::jacobian::Jacobian::new) takes them: the dense `tau` column
 /// (`-g_s y'_s(t - tau)`), and the per-channel columns, each channel's bias (1 on that
 /// channel) and gain (`y_s(t - tau)` on that channel; left out when `gains` is false, the
-/// gains being known), whitened; every vector `S x T`.
+/// gains being known), weighted and prewhitened (`L^-1 w`, channel by channel, so that a
+/// per-channel column stays on its channel); every vector `S x T`.
 pub(crate) fn columns(
     y: &[f64],
     frame: &Frame,
@@ -293,11 +326,12 @@ pub(crate) fn columns(
             tau_col[s * t + k] = -terms.gains[s] * dy * frame.weights[s * t + k];
         }
     }
-    let mut local = vec![frame.weights.clone()];
+    let mut local = vec![frame.whitener.whiten(&frame.weights)];
     if gains {
-        local.push(ys.iter().zip(&frame.weights).map(|(v, w)| v * w).collect());
+        let g: Vec<f64> = ys.iter().zip(&frame.weights).map(|(v, w)| v * w).collect();
+        local.push(frame.whitener.whiten(&g));
     }
-    (tau_col, local)
+    (frame.whitener.whiten(&tau_col), local)
 }
 
 #[cfg(test)]
@@ -326,6 +360,7 @@ mod tests {
             dt,
             test: vec![],
             weights: vec![1.0; 2 * t],
+            whitener: Prewhitener::default(),
         };
         frame.test = apply(&y, &frame, &truth);
         let (est, rss) = profile(&y, &frame, 2e-3, None);

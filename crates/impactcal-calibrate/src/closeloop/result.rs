@@ -38,13 +38,14 @@ pub struct Added {
     pub upper: f64,
     /// The part of the standard error the model's own noise contributes, counted
     /// coherently from the jitter ensemble (`closeloop::model_noise`); the interval is
-    /// `value +- 1.96 sqrt(c se^2 + model_noise_sd^2)`.
+    /// `value +- 1.96 sqrt(se^2 + model_noise_sd^2)`, `se` the linearised standard error
+    /// under the noise model (`closeloop::prewhiten`).
     #[serde(default)]
     pub model_noise_sd: f64,
 }
 
-/// Information criteria of one model of the sequence (known-noise forms, in effective
-/// samples: `AIC = RSS/c + 2k`, `BIC = RSS/c + k ln n_eff`, `c` the noise's inflation).
+/// Information criteria of one model of the sequence (known-noise forms on the prewhitened
+/// residual of `n` samples: `AIC = RSS + 2k`, `BIC = RSS + k ln n`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModelScore {
     /// The candidates added in this model.

@@ -8,9 +8,10 @@
 //! held value and at its linear estimate), its own budget, then the Gauss-Newton polish. The
 //! addition is kept when the Bayesian information criterion falls by more than 2.
 //!
-//! With known noise (the whitening), in effective samples (`c = (1 + rho_0) / (1 - rho_0)`,
-//! `n_eff = n / c`), for `k` fitted quantities: `AIC = RSS / c + 2 k`,
-//! `BIC = RSS / c + k ln n_eff`; Akaike weights
+//! With known noise (the weights and each channel's AR whitening, `closeloop::prewhiten`:
+//! the residual is unit white noise under the noise model, so `RSS` is `-2` times its
+//! Gaussian log-likelihood up to a constant), for `k` fitted quantities over `n` samples:
+//! `AIC = RSS + 2 k`, `BIC = RSS + k ln n`; Akaike weights
 //! `w_m = exp(-(AIC_m - AIC_min) / 2) / sum_j exp(-(AIC_j - AIC_min) / 2)`.
 //!
 //! When no candidate is eligible only because its linearised share of the residual is below
@@ -27,8 +28,8 @@
 //!
 //! Every addition must also move its quantity away from the held value by more than the
 //! noise can: the recalibrated value `v` is kept only when
-//! `(v - held)^2 > z^2 (c se^2 + v_model)`, `z^2` the `1 - alpha` quantile of `chi2_1`, `se`
-//! the linearised standard error, `c` the noise's inflation and `v_model` the variance the
+//! `(v - held)^2 > z^2 (se^2 + v_model)`, `z^2` the `1 - alpha` quantile of `chi2_1`, `se`
+//! the linearised standard error under the noise model and `v_model` the variance the
 //! model's own noise adds, counted coherently from the jitter ensemble
 //! (`closeloop::model_noise`). A crash model recalibrated with one more quantity can reach a
 //! point where its own noise happens to match the test better; a change of the quantity no
@@ -56,11 +57,10 @@ pub(crate) struct Outcome {
     pub stopped: String,
 }
 
-/// The information criteria of a fit with `k` quantities (see the module docs).
-pub fn criteria(rss: f64, n: usize, k: usize, inflation: f64) -> (f64, f64) {
-    let n_eff = n as f64 / inflation;
-    let e = rss / inflation;
-    (e + 2.0 * k as f64, e + k as f64 * n_eff.ln())
+/// The information criteria `(AIC, BIC)` of a fit with `k` quantities, whitened residual
+/// sum of squares `rss` over `n` samples (see the module docs).
+pub fn criteria(rss: f64, n: usize, k: usize) -> (f64, f64) {
+    (rss + 2.0 * k as f64, rss + k as f64 * (n as f64).ln())
 }
 
 /// Akaike weights of a list of AIC values.
@@ -71,15 +71,9 @@ pub fn akaike_weights(aic: &[f64]) -> Vec<f64> {
     w.iter().map(|x| x / s).collect()
 }
 
-fn score(
-    fit: &Fit,
-    added: &[Parameter],
-    n_nuisance: usize,
-    inflation: f64,
-    kept: bool,
-) -> ModelScore {
+fn score(fit: &Fit, added: &[Parameter], n_nuisance: usize, kept: bool) -> ModelScore {
     let k = fit.point.len() + n_nuisance;
-    let (aic, bic) = criteria(fit.rss, fit.residual.len(), k, inflation);
+    let (aic, bic) = criteria(fit.rss, fit.residual.len(), k);
     ModelScore {
         added: added.iter().map(|p| p.name.clone()).collect(),
         k,
@@ -101,16 +95,15 @@ pub(crate) fn forward<M: Enrichable>(
     model: &M,
     fit0: Fit,
     options: &LoopOptions,
-    inflation: f64,
     onset: usize,
-    noise_lag1: f64,
     n_nuisance: usize,
+    noise_dof: Option<f64>,
 ) -> Result<Outcome> {
     let labels = ctx.frame.labels.clone();
     let t = ctx.frame.samples;
     let detect_fit = |fit: &Fit| -> Result<Detection> {
         let p = fit.point.len() + n_nuisance;
-        let d = detect(&labels, &fit.residual, t, p, noise_lag1, options.alpha)?;
+        let d = detect(&labels, &fit.residual, t, p, options.alpha, noise_dof)?;
         let floor = ctx
             .model_noise
             .stats(fit, &ctx.frame, Some(p), None)?
@@ -124,7 +117,7 @@ pub(crate) fn forward<M: Enrichable>(
     let mut cur = model.enrich(&[])?;
     let mut added: Vec<Parameter> = Vec::new();
     let mut rounds = Vec::new();
-    let mut models = vec![score(&fit, &added, n_nuisance, inflation, true)];
+    let mut models = vec![score(&fit, &added, n_nuisance, true)];
     let stopped;
     loop {
         let r = rounds.len();
@@ -138,7 +131,6 @@ pub(crate) fn forward<M: Enrichable>(
                 options.candidate_step,
                 options.alpha,
                 options.min_explained,
-                inflation,
                 onset,
                 &|n| options.allows(n),
             )?)
@@ -224,8 +216,8 @@ pub(crate) fn forward<M: Enrichable>(
             options.recalibrate,
             options.polish,
         )?;
-        let s = score(&fit_n, &trial_added, n_nuisance, inflation, true);
-        let control_score = score(&control, &added, n_nuisance, inflation, true);
+        let s = score(&fit_n, &trial_added, n_nuisance, true);
+        let control_score = score(&control, &added, n_nuisance, true);
         let prev_bic = models.last().map_or(f64::INFINITY, |m| m.bic);
         let (base_rss, base_bic) = if control.rss < fit.rss {
             (control.rss, control_score.bic.min(prev_bic))
@@ -237,7 +229,7 @@ pub(crate) fn forward<M: Enrichable>(
         let value = fit_n.point[last];
         let draws = ctx.model_noise.stats(&fit_n, &ctx.frame, None, None)?;
         let noise_var = draws.parameter_variances(fit_n.point.len())[last];
-        let sd = (fit_n.se[last].powi(2) * inflation + noise_var).sqrt();
+        let sd = (fit_n.se[last].powi(2) + noise_var).sqrt();
         let change = (value - p.nominal).abs() * best.response_per_unit;
         let by_itself = draws.largest();
         let refusal = if trial && (realised.is_nan() || realised < options.min_explained) {
@@ -332,7 +324,7 @@ mod tests {
         assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
         // exp(-1) relative weight for a difference of 2.
         assert!((w[1] / w[0] - (-1.0f64).exp()).abs() < 1e-12);
-        let (aic, bic) = criteria(100.0, 1000, 3, 1.0);
+        let (aic, bic) = criteria(100.0, 1000, 3);
         assert!((aic - 106.0).abs() < 1e-12);
         assert!((bic - (100.0 + 3.0 * 1000f64.ln())).abs() < 1e-12);
     }
