@@ -15,13 +15,16 @@
 //! ```text
 //! cargo run --release --example loop_family -- <dir> <kind> <level> <seed>
 //!     [--end 0.015] [--channels 24] [--candidates a,b,c] [--reconcile 24]
-//!     [--recalibrate 24] [--keep]
+//!     [--recalibrate 24] [--polish 8] [--known-gains] [--declare START] [--keep]
 //! ```
 //!
 //! `kind` is one of `damping`, `mass`, `friction`, `rate`, `material`, `none`; `level` 1 or
 //! 2 picks the kind's amplitude (table `KINDS`). The loop's journal goes to
 //! `<dir>/<kind>-<level>-<seed>` and is deleted after the record is printed unless
-//! `--keep`.
+//! `--keep`. Probes of one case: `--known-gains` fixes the gains at 1 (`fit_gains = false`);
+//! `--declare START` declares the hidden quantity beside Table 2 from `START` and adds
+//! nothing (`max_added = 0`): the problem the loop's recalibration solves, from a chosen
+//! start and with its own budget (`--reconcile`).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::time::Instant;
@@ -29,7 +32,7 @@ use std::time::Instant;
 use impactcal::calibrate::closeloop::{Holdout, LoopOptions, LoopResult, Verdict, run_loop};
 use impactcal::calibrate::study::{Silent, TestData};
 use impactcal::core::synthetic::{Measurement, measured};
-use impactcal::core::{Cfc, Enrichable, Histories, Model};
+use impactcal::core::{Cfc, Enrichable, Histories, Model, Parameter, ParameterSpace};
 use impactcal::shell::airframe::{Airframe, AirframeModel, AirframeOptions, MeshDensity, Preset};
 use serde_json::json;
 
@@ -65,6 +68,9 @@ struct Spec {
     candidates: Option<Vec<String>>,
     reconcile: usize,
     recalibrate: usize,
+    polish: usize,
+    fit_gains: bool,
+    declare: Option<f64>,
     keep: bool,
 }
 
@@ -83,6 +89,9 @@ fn spec() -> Spec {
         candidates: None,
         reconcile: 24,
         recalibrate: 24,
+        polish: LoopOptions::default().polish,
+        fit_gains: true,
+        declare: None,
         keep: false,
     };
     let mut i = 4;
@@ -96,8 +105,14 @@ fn spec() -> Spec {
             }
             "--reconcile" => s.reconcile = v.expect(usage).parse().expect(usage),
             "--recalibrate" => s.recalibrate = v.expect(usage).parse().expect(usage),
-            "--keep" => {
-                s.keep = true;
+            "--polish" => s.polish = v.expect(usage).parse().expect(usage),
+            "--declare" => s.declare = Some(v.expect(usage).parse().expect(usage)),
+            "--keep" | "--known-gains" => {
+                if a[i] == "--keep" {
+                    s.keep = true;
+                } else {
+                    s.fit_gains = false;
+                }
                 i += 1;
                 continue;
             }
@@ -126,7 +141,8 @@ fn main() {
     let started = Instant::now();
     let mut o = AirframeOptions::new(MeshDensity::Coarse);
     o.end_time = s.end;
-    let model = AirframeModel::preset(Airframe::new(o).unwrap(), Preset::Table2).unwrap();
+    let airframe = Airframe::new(o).unwrap();
+    let model = AirframeModel::preset(airframe.clone(), Preset::Table2).unwrap();
     let truth_set: Vec<(String, f64)> = hidden(&s.kind, s.level).into_iter().collect();
     let held = truth_set.first().map(|(q, _)| {
         model
@@ -159,14 +175,41 @@ fn main() {
         measured(&h.select(&channels).unwrap(), &m).unwrap()
     };
     let (test, holdout) = (measure(&y, s.seed), measure(&yh, s.seed + 100));
-    let options = LoopOptions {
+    let mut options = LoopOptions {
         reconcile: s.reconcile,
         recalibrate: s.recalibrate,
+        polish: s.polish,
+        fit_gains: s.fit_gains,
         candidates: s.candidates.clone(),
         seed: 1,
         ..LoopOptions::default()
     };
-    let run_dir = s.dir.join(format!("{}-{}-{}", s.kind, s.level, s.seed));
+    // A probe: the hidden quantity declared beside Table 2, calibrated from `start` with
+    // nothing added (the 7-parameter problem the loop's recalibration solves).
+    let probe = match (s.declare, truth_set.first()) {
+        (Some(start), Some((q, _))) => {
+            let c = model
+                .candidates()
+                .into_iter()
+                .find(|c| c.name() == q)
+                .unwrap();
+            let p = &c.parameter;
+            let mut params = model.space().parameters().to_vec();
+            params.push(Parameter::new(q.clone(), p.lower, p.upper, start).unwrap());
+            options.max_added = 0;
+            Some(AirframeModel::new(airframe, ParameterSpace::new(params).unwrap()).unwrap())
+        }
+        _ => None,
+    };
+    let loop_model = probe.as_ref().unwrap_or(&model);
+    let run_dir = s.dir.join(format!(
+        "{}-{}-{}{}",
+        s.kind,
+        s.level,
+        s.seed,
+        s.declare
+            .map_or(String::new(), |v| format!("-declared-{v}"))
+    ));
     let data = TestData {
         histories: &test,
         map: None,
@@ -177,7 +220,7 @@ fn main() {
         set: &hold,
     };
     let r = run_loop(
-        &model,
+        loop_model,
         &format!("coarse airframe, 0-{} s, Table2 declared", s.end),
         data,
         Some(h),
@@ -186,7 +229,14 @@ fn main() {
         &Silent,
     )
     .unwrap();
-    let line = record(&s, &truth_set, held, &r, &wrong, started.elapsed().as_secs_f64());
+    let line = record(
+        &s,
+        &truth_set,
+        held,
+        &r,
+        &wrong,
+        started.elapsed().as_secs_f64(),
+    );
     println!("{line}");
     if !s.keep {
         let _ = std::fs::remove_dir_all(&run_dir);
@@ -225,6 +275,8 @@ fn record(
         "kind": s.kind,
         "level": s.level,
         "seed": s.seed,
+        "probe": {"declared_from": s.declare, "fit_gains": s.fit_gains,
+                  "reconcile": s.reconcile, "recalibrate": s.recalibrate, "polish": s.polish},
         "end": s.end,
         "channels": s.channels,
         "hidden": hidden.map(|(q, v)| json!({"name": q, "truth": v, "held": held})),
