@@ -238,7 +238,10 @@ fn main() {
         started.elapsed().as_secs_f64(),
     );
     println!("{line}");
-    if !s.keep {
+    if s.keep {
+        std::fs::write(run_dir.join("loop.json"), serde_json::to_string_pretty(&r).unwrap())
+            .unwrap();
+    } else {
         let _ = std::fs::remove_dir_all(&run_dir);
     }
 }
