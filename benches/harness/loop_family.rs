@@ -19,7 +19,8 @@
 //! ```
 //!
 //! `kind` is one of `damping`, `mass`, `friction`, `rate`, `material`, `none`; `level` 1 or
-//! 2 picks the kind's amplitude (table `KINDS`). The loop's journal goes to
+//! 2 picks the kind's amplitude (table `KINDS`); a kind `QUANTITY=VALUE` hides any catalogue
+//! quantity at any value (`level` is then ignored). The loop's journal goes to
 //! `<dir>/<kind>-<level>-<seed>` and is deleted after the record is printed unless
 //! `--keep`. Probes of one case: `--known-gains` fixes the gains at 1 (`fit_gains = false`);
 //! `--declare START` declares the hidden quantity beside Table 2 from `START` and adds
@@ -128,6 +129,9 @@ fn spec() -> Spec {
 fn hidden(kind: &str, level: usize) -> Option<(String, f64)> {
     if kind == "none" {
         return None;
+    }
+    if let Some((q, v)) = kind.split_once('=') {
+        return Some((q.to_string(), v.parse().expect("kind QUANTITY=VALUE")));
     }
     let (_, q, v) = KINDS
         .iter()
@@ -239,8 +243,11 @@ fn main() {
     );
     println!("{line}");
     if s.keep {
-        std::fs::write(run_dir.join("loop.json"), serde_json::to_string_pretty(&r).unwrap())
-            .unwrap();
+        std::fs::write(
+            run_dir.join("loop.json"),
+            serde_json::to_string_pretty(&r).unwrap(),
+        )
+        .unwrap();
     } else {
         let _ = std::fs::remove_dir_all(&run_dir);
     }
@@ -291,7 +298,8 @@ fn record(
         "hidden_status": hidden_score.map(|c| c.status.clone()),
         "added": r.added.iter().map(|a| json!({
             "name": a.name, "value": a.value, "lower": a.lower, "upper": a.upper,
-            "model_noise_sd": a.model_noise_sd})).collect::<Vec<_>>(),
+            "model_noise_sd": a.model_noise_sd, "pending_step": a.pending_step}))
+            .collect::<Vec<_>>(),
         "truth_inside": inside,
         "verdict": verdict,
         "stopped": r.stopped,

@@ -123,6 +123,12 @@ pub(crate) struct Fit {
     pub jac: Arc<Jacobian>,
     /// Standard errors of the parameters for unit white noise.
     pub se: Vec<f64>,
+    /// The Gauss-Newton step still pending at the point, `J^+ e` (parameters only): how
+    /// far the linearised least-squares optimum lies from where the polish stopped. Near
+    /// zero when the polish converged; when it stopped on its iteration budget or on a
+    /// step that did not lower the residual, the point is that far from the optimum the
+    /// standard errors are about.
+    pub pending: Vec<f64>,
     /// Runs this fit used.
     pub runs: usize,
 }
@@ -275,6 +281,7 @@ fn polish_from<M: Model>(
             rss,
             jac: Arc::new(jac),
             se,
+            pending: step[..p].to_vec(),
             runs: 0,
         };
         if it >= iterations || predicted < 1e-3 {

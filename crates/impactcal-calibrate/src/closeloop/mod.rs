@@ -366,13 +366,15 @@ pub fn run_loop_on<M: Enrichable>(
         .enumerate()
         .map(|(i, p)| {
             let v = fit.point[d0 + i];
-            let se = (fit.se[d0 + i].powi(2) + noise_var[d0 + i]).sqrt();
+            let pending = fit.pending[d0 + i];
+            let se = (fit.se[d0 + i].powi(2) + noise_var[d0 + i] + pending * pending).sqrt();
             Added {
                 name: p.name.clone(),
                 value: v,
                 lower: v - 1.96 * se,
                 upper: v + 1.96 * se,
                 model_noise_sd: noise_var[d0 + i].sqrt(),
+                pending_step: pending,
             }
         })
         .collect();
