@@ -15,7 +15,7 @@
 //! ```text
 //! cargo run --release --example loop_family -- <dir> <kind> <level> <seed>
 //!     [--end 0.015] [--channels 24] [--candidates a,b,c] [--reconcile 24]
-//!     [--recalibrate 24] [--polish 8] [--known-gains] [--declare START] [--keep]
+//!     [--recalibrate 24] [--polish 8] [--jitter 1e-4] [--known-gains] [--declare START] [--keep]
 //! ```
 //!
 //! `kind` is one of `damping`, `mass`, `friction`, `rate`, `material`, `none`; `level` 1 or
@@ -72,6 +72,7 @@ struct Spec {
     polish: usize,
     fit_gains: bool,
     declare: Option<f64>,
+    jitter: f64,
     keep: bool,
 }
 
@@ -93,6 +94,7 @@ fn spec() -> Spec {
         polish: LoopOptions::default().polish,
         fit_gains: true,
         declare: None,
+        jitter: LoopOptions::default().jitter,
         keep: false,
     };
     let mut i = 4;
@@ -107,6 +109,7 @@ fn spec() -> Spec {
             "--reconcile" => s.reconcile = v.expect(usage).parse().expect(usage),
             "--recalibrate" => s.recalibrate = v.expect(usage).parse().expect(usage),
             "--polish" => s.polish = v.expect(usage).parse().expect(usage),
+            "--jitter" => s.jitter = v.expect(usage).parse().expect(usage),
             "--declare" => s.declare = Some(v.expect(usage).parse().expect(usage)),
             "--keep" | "--known-gains" => {
                 if a[i] == "--keep" {
@@ -184,6 +187,7 @@ fn main() {
         recalibrate: s.recalibrate,
         polish: s.polish,
         fit_gains: s.fit_gains,
+        jitter: s.jitter,
         candidates: s.candidates.clone(),
         seed: 1,
         ..LoopOptions::default()
@@ -286,7 +290,7 @@ fn record(
         "level": s.level,
         "seed": s.seed,
         "probe": {"declared_from": s.declare, "fit_gains": s.fit_gains,
-                  "reconcile": s.reconcile, "recalibrate": s.recalibrate, "polish": s.polish},
+                  "reconcile": s.reconcile, "jitter": s.jitter, "recalibrate": s.recalibrate, "polish": s.polish},
         "end": s.end,
         "channels": s.channels,
         "hidden": hidden.map(|(q, v)| json!({"name": q, "truth": v, "held": held})),
