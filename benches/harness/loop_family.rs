@@ -211,12 +211,18 @@ fn main() {
     };
     let loop_model = probe.as_ref().unwrap_or(&model);
     let run_dir = s.dir.join(format!(
-        "{}-{}-{}{}",
+        "{}-{}-{}{}{}{}",
         s.kind,
         s.level,
         s.seed,
         s.declare
-            .map_or(String::new(), |v| format!("-declared-{v}"))
+            .map_or(String::new(), |v| format!("-declared-{v}")),
+        if s.fit_gains { "" } else { "-known-gains" },
+        if s.jitter == LoopOptions::default().jitter {
+            String::new()
+        } else {
+            format!("-jitter-{}", s.jitter)
+        }
     ));
     let data = TestData {
         histories: &test,
