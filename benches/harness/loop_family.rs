@@ -211,7 +211,7 @@ fn main() {
     };
     let loop_model = probe.as_ref().unwrap_or(&model);
     let run_dir = s.dir.join(format!(
-        "{}-{}-{}{}{}{}",
+        "{}-{}-{}{}{}{}{}",
         s.kind,
         s.level,
         s.seed,
@@ -222,6 +222,11 @@ fn main() {
             String::new()
         } else {
             format!("-jitter-{}", s.jitter)
+        },
+        if s.polish == LoopOptions::default().polish {
+            String::new()
+        } else {
+            format!("-polish-{}", s.polish)
         }
     ));
     let data = TestData {
