@@ -11,7 +11,10 @@
 //! least-squares step of the linearised problem moves `theta` (clipped to the bounds). The
 //! Jacobian is held factored (`closeloop::jacobian`): the per-channel gain and bias columns
 //! are eliminated channel by channel, never formed as columns of the whole test. The step is tried at full, quarter and sixteenth length and kept when the
-//! profiled residual falls; the polish stops when no step helps, when the predicted fall is
+//! profiled residual falls; after two full steps in a row it is also tried at twice and four
+//! times its length, kept while the residual goes on falling (a Jacobian whose columns carry
+//! the model's own roughness gives steps that are too short, and a polish of full steps
+//! only crawls towards the optimum); the polish stops when no step helps, when the predicted fall is
 //! below `1e-3` (in units of the noise variance), or after its iteration budget.
 
 use std::cell::Cell;
@@ -226,6 +229,17 @@ fn steps(space: &ParameterSpace, point: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// Longest expansion of a Gauss-Newton step after two full steps in a row: `2^k` times the
+/// step for `k = 1..=EXPANSIONS`.
+const EXPANSIONS: u32 = 2;
+
+/// `point + scale * step`, clipped to the bounds.
+fn along(space: &ParameterSpace, point: &[f64], step: &[f64], scale: f64) -> Vec<f64> {
+    let mut x: Vec<f64> = point.iter().zip(step).map(|(x, d)| x + scale * d).collect();
+    clip(space, &mut x);
+    x
+}
+
 fn clip(space: &ParameterSpace, x: &mut [f64]) {
     for (v, p) in x.iter_mut().zip(space.parameters()) {
         *v = v.clamp(p.lower, p.upper);
@@ -243,7 +257,9 @@ fn polish_from<M: Model>(
     let space = model.space();
     let p = space.dim();
     let mut it = 0;
+    let mut full_before = false;
     loop {
+        let mut point_y_rss: Option<(Vec<f64>, Vec<f64>, f64)> = None;
         let (terms, rss) = ctx.profile(&y);
         let residual = nuisance::residual(&y, &ctx.frame, &terms);
         let h = steps(space, &point);
@@ -288,23 +304,46 @@ fn polish_from<M: Model>(
             return Ok(here);
         }
         let mut moved = false;
+        let mut full = false;
         for (attempt, scale) in [1.0, 0.25, 0.0625].iter().enumerate() {
-            let mut trial: Vec<f64> = point
-                .iter()
-                .zip(&step)
-                .map(|(x, d)| x + scale * d)
-                .collect();
-            clip(space, &mut trial);
+            let trial = along(space, &point, &step, *scale);
             if trial == point {
                 break;
             }
             let yt = ctx.run_one(model, &format!("{prefix}-gn{it}-try{attempt}"), &trial)?;
-            if ctx.profile(&yt).1 < rss {
-                point = trial;
-                y = yt;
-                moved = true;
+            let rt = ctx.profile(&yt).1;
+            if rt < rss {
+                (full, moved) = (attempt == 0, true);
+                point_y_rss = Some((trial, yt, rt));
                 break;
             }
+        }
+        // Two full steps in a row: the linearised model keeps under-predicting the way down
+        // (a finite-difference Jacobian whose columns carry the model's own roughness is
+        // too long, and its steps too short: errors in the regressors attenuate the fit).
+        // Longer steps along the same direction are tried while they lower the residual.
+        if full && full_before {
+            for k in 1..=EXPANSIONS {
+                let scale = f64::from(1u32 << k);
+                let trial = along(space, &point, &step, scale);
+                let Some((best, _, best_rss)) = point_y_rss.as_ref() else {
+                    break;
+                };
+                if &trial == best {
+                    break;
+                }
+                let yt = ctx.run_one(model, &format!("{prefix}-gn{it}-ext{k}"), &trial)?;
+                let rt = ctx.profile(&yt).1;
+                if rt >= *best_rss {
+                    break;
+                }
+                point_y_rss = Some((trial, yt, rt));
+            }
+        }
+        full_before = full;
+        if let Some((p_new, y_new, _)) = point_y_rss.take() {
+            point = p_new;
+            y = y_new;
         }
         if !moved {
             return Ok(here);
