@@ -172,13 +172,7 @@ fn hidden_damping_on_the_airframe_is_found_and_the_error_falls() {
     }
     assert!((r.nuisance.time_shift - TAU).abs() < 2e-5, "{summary}");
     // The error falls on the calibration test and on the holdout, never fitted.
-    let e = &r.errors;
-    assert!(
-        e.calibration.enriched < 0.5 * e.calibration.calibrated,
-        "{summary}"
-    );
-    let h = e.holdout.as_ref().unwrap();
-    assert!(h.enriched < 0.5 * h.calibrated, "{summary}");
+    errors_fall(&r, 0.5, 0.5, &summary);
     // M1: the test leaves the enriched model's predictive envelope less often than the
     // calibrated one's, on both tests.
     for m in [&r.metrics_calibration, r.metrics_holdout.as_ref().unwrap()] {
@@ -284,11 +278,17 @@ fn a_hidden_mass_with_a_wrong_gain_is_found_and_the_gain_recovered() {
         "{summary}"
     );
     assert!((r.nuisance.time_shift - TAU3).abs() < 2e-5, "{summary}");
+    errors_fall(&r, 0.7, 1.0, &summary);
+}
+
+/// Asserts that the enriched model's error is under `calibration` times the calibrated
+/// one's on the calibration test and under `holdout` times it on the holdout.
+fn errors_fall(r: &LoopResult, calibration: f64, holdout: f64, summary: &str) {
     let e = &r.errors;
     assert!(
-        e.calibration.enriched < 0.7 * e.calibration.calibrated,
+        e.calibration.enriched < calibration * e.calibration.calibrated,
         "{summary}"
     );
     let h = e.holdout.as_ref().unwrap();
-    assert!(h.enriched < h.calibrated, "{summary}");
+    assert!(h.enriched < holdout * h.calibrated, "{summary}");
 }
