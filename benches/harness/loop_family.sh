@@ -18,12 +18,18 @@ cargo build --release --example loop_family --manifest-path "$root/Cargo.toml" >
 bin="$root/target/release/examples/loop_family"
 mkdir -p "$work"
 touch "$records"
+# One case of each kind first (amplitude 1, seed 1) and the control, so that a family stopped
+# early has seen every kind; then the rest.
+kinds="mass damping friction rate material"
 cases=()
+for kind in $kinds none; do cases+=("$kind 1 1"); done
 for seed in 1 2; do
-  for kind in mass damping friction rate material; do
-    for level in 1 2; do cases+=("$kind $level $seed"); done
+  for kind in $kinds; do
+    for level in 1 2; do
+      [[ "$seed $level" == "1 1" ]] || cases+=("$kind $level $seed")
+    done
   done
-  cases+=("none 1 $seed")
+  [[ $seed == 1 ]] || cases+=("none 1 $seed")
 done
 for c in "${cases[@]}"; do
   read -r kind level seed <<<"$c"
