@@ -66,18 +66,35 @@ fn tests(hidden: &[(String, f64)], seed: u64) -> (Histories, Histories) {
     let x = true_point(&m);
     let y = truth.simulate(&x).unwrap();
     let labels = loudest(&y);
-    let measure = |y: &Histories, seed: u64| {
-        let m = Measurement {
-            time_shift: TAU,
-            snr_db: Some(40.0),
-            seed,
-            ..Measurement::default()
-        };
-        measured(&y.select(&labels).unwrap(), &m).unwrap()
+    let m = Measurement {
+        time_shift: TAU,
+        snr_db: Some(40.0),
+        seed,
+        ..Measurement::default()
     };
+    measure_both(&truth, &x, &y, &labels, &m, seed + 1)
+}
+
+/// The truth's run `y` at `x` and its run at the holdout's sink speed, measured on `labels`
+/// with `m`, the holdout with the noise seed `holdout_seed`.
+fn measure_both(
+    truth: &AirframeModel,
+    x: &[f64],
+    y: &Histories,
+    labels: &[String],
+    m: &Measurement,
+    holdout_seed: u64,
+) -> (Histories, Histories) {
     let speed = [("impact.vertical".to_string(), HOLDOUT_SPEED)];
-    let yh = truth.at_condition(&speed).unwrap().simulate(&x).unwrap();
-    (measure(&y, seed), measure(&yh, seed + 1))
+    let yh = truth.at_condition(&speed).unwrap().simulate(x).unwrap();
+    let mh = Measurement {
+        seed: holdout_seed,
+        ..m.clone()
+    };
+    (
+        measured(&y.select(labels).unwrap(), m).unwrap(),
+        measured(&yh.select(labels).unwrap(), &mh).unwrap(),
+    )
 }
 
 fn options() -> LoopOptions {
@@ -156,10 +173,9 @@ fn hidden_damping_on_the_airframe_is_found_and_the_error_falls() {
     assert_eq!(r.verdict, Verdict::Attributed, "{}\n{summary}", r.stopped);
     let a = &r.added[0];
     assert_eq!(a.name, "damping");
-    // Its value within 5 % of the truth. (Its 95 % interval, which counts the model's own
-    // noise coherently from the jitter draws, is still narrower than the error: 9.964
-    // [9.943, 9.985] with a model-noise part of 0.0014; the 0.4 % bias is not what a
-    // 1e-4 jitter moves.)
+    // Its value within 5 % of the truth. (Its 95 % interval is not asserted: 9.909
+    // [9.801, 10.016] holds the truth only through the Gauss-Newton step still pending,
+    // 0.051; the model-noise part of a 1e-4 jitter is 0.0018.)
     assert!((a.value - 10.0).abs() < 0.5, "{a:?}");
     // The declared thicknesses recovered within 2 %, and the nuisance terms.
     let x = true_point(&model());
@@ -228,19 +244,14 @@ fn a_hidden_mass_with_a_wrong_gain_is_found_and_the_gain_recovered() {
     let vertical: Vec<&String> = f.labels().iter().filter(|l| l.ends_with(".z")).collect();
     let labels = f.select(&vertical).unwrap().most_varying(12);
     let wrong = labels[0].clone();
-    let measure = |y: &Histories, seed: u64| {
-        let m = Measurement {
-            time_shift: TAU3,
-            gains: vec![(wrong.clone(), GAIN)],
-            snr_db: Some(46.0206),
-            seed,
-            ..Measurement::default()
-        };
-        measured(&y.select(&labels).unwrap(), &m).unwrap()
+    let m = Measurement {
+        time_shift: TAU3,
+        gains: vec![(wrong.clone(), GAIN)],
+        snr_db: Some(46.0206),
+        seed: 1,
+        ..Measurement::default()
     };
-    let speed = [("impact.vertical".to_string(), HOLDOUT_SPEED)];
-    let yh = truth.at_condition(&speed).unwrap().simulate(&x).unwrap();
-    let (test, holdout) = (measure(&y, 1), measure(&yh, 101));
+    let (test, holdout) = measure_both(&truth, &x, &y, &labels, &m, 101);
     let options = LoopOptions {
         reconcile: 16,
         polish: 12,
