@@ -171,8 +171,10 @@ impl Ctx<'_> {
 }
 
 /// Calibrates `model` from `start` (the first point is the incumbent) with `budget` CORS
-/// runs and at most `polish` Gauss-Newton iterations; journal stages are named
-/// `<prefix>-...`.
+/// runs and at most `polish` Gauss-Newton iterations from the search's best point; when
+/// that is not the best of the starts, a second polish goes on from that start (stages
+/// `<prefix>-warm-...`) and the lower residual is the fit. Journal stages are named
+/// `<prefix>-...`; the fit's `runs` count both polishes.
 ///
 /// # Errors
 /// Run failures of the incumbent, CORS errors, journal errors.
