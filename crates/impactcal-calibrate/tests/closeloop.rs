@@ -6,7 +6,9 @@
 
 use std::path::Path;
 
-use impactcal_calibrate::closeloop::{Holdout, LoopOptions, LoopResult, Verdict, run_loop};
+use impactcal_calibrate::closeloop::{
+    Errors, Holdout, LoopOptions, LoopResult, Stages, Verdict, run_loop,
+};
 use impactcal_calibrate::study::{Silent, TestData};
 use impactcal_core::drop_tower::DropTower;
 use impactcal_core::synthetic::{Measurement, measured};
@@ -73,12 +75,70 @@ fn holdout_of(truth: &DropTower, seed: u64) -> Histories {
     )
 }
 
+/// One line of the figures docs/validation.md records for a loop (printed with
+/// `--nocapture`).
+fn summary(case: &str, r: &LoopResult) -> String {
+    let d = &r.detection;
+    let f = &r.detection_final;
+    let top = r
+        .candidates
+        .first()
+        .map(|c| {
+            format!(
+                "{} (explained {:.2}, kappa {:.2})",
+                c.name, c.explained_fraction, c.kappa
+            )
+        })
+        .unwrap_or_default();
+    let added: Vec<String> = r
+        .added
+        .iter()
+        .map(|a| format!("{} {:.5} [{:.5}, {:.5}]", a.name, a.value, a.lower, a.upper))
+        .collect();
+    let stage = |m: &Stages<Errors>| {
+        format!(
+            "L2 {:.4} -> {:.4} -> {:.4}, C {:.4} -> {:.4}, R {:.3} -> {:.3}, chi2_red {:.2}",
+            m.nominal.rel_l2,
+            m.calibrated.rel_l2,
+            m.enriched.rel_l2,
+            m.calibrated.sprague_geers_c,
+            m.enriched.sprague_geers_c,
+            m.calibrated.iso18571_r,
+            m.enriched.iso18571_r,
+            m.enriched.chi2_red
+        )
+    };
+    format!(
+        "{case}: {:?}; chi2_red {:.4} (threshold {:.3}), sigma1 {:.1} (edge {:.1}); first {top}; \
+         added {added:?}; tau {:.4e}, gains {:?}; after chi2_red {:.3} (threshold {:.3}); \
+         calibration {}; holdout {}; BIC {:?}; runs {}",
+        r.verdict,
+        d.chi2_red,
+        d.threshold,
+        d.sigma1,
+        d.noise_edge,
+        r.nuisance.time_shift,
+        r.nuisance.gains,
+        f.chi2_red,
+        f.threshold,
+        stage(&r.metrics_calibration),
+        r.metrics_holdout.as_ref().map(stage).unwrap_or_default(),
+        r.models
+            .iter()
+            .filter(|m| m.kept)
+            .map(|m| m.bic.round())
+            .collect::<Vec<_>>(),
+        r.runs
+    )
+}
+
 #[test]
 fn hidden_damping_is_found_added_and_the_error_falls_on_calibration_and_holdout() {
     let t = truth(&[("damping", 0.03)]);
     let dir = tempfile::tempdir().unwrap();
     let holdout = holdout_of(&t, 1);
     let r = run(&t, 1, dir.path(), Some(&holdout));
+    println!("{}", summary("hidden damping", &r));
     // Detection.
     assert!(r.detection.model_form_error);
     assert!(r.detection.chi2_red > r.detection.threshold && r.detection.coherent);
@@ -143,6 +203,7 @@ fn negative_control_at_most_one_false_alarm_in_ten_seeds() {
     for seed in 0..10 {
         let dir = tempfile::tempdir().unwrap();
         let r = run(&t, 100 + seed, dir.path(), None);
+        println!("{}", summary(&format!("negative control, seed {seed}"), &r));
         if r.verdict != Verdict::NoModelFormError {
             alarms += 1;
         }
@@ -162,6 +223,7 @@ fn a_stiffness_scale_confounded_with_the_modulus_is_not_identifiable_nor_attribu
     let t = truth(&[("stiffness_scale", 1.2)]);
     let dir = tempfile::tempdir().unwrap();
     let r = run(&t, 2, dir.path(), None);
+    println!("{}", summary("stiffness_scale 1.2", &r));
     let s = r
         .candidates
         .iter()
@@ -181,6 +243,7 @@ fn two_hidden_effects_are_both_added_each_lowering_bic() {
     let t = truth(&[("damping", 0.03), ("added_mass", 0.3)]);
     let dir = tempfile::tempdir().unwrap();
     let r = run(&t, 3, dir.path(), None);
+    println!("{}", summary("damping and added_mass", &r));
     let mut names: Vec<&str> = r.added.iter().map(|a| a.name.as_str()).collect();
     names.sort_unstable();
     assert_eq!(names, ["added_mass", "damping"], "{:?}", r.stopped);
@@ -202,6 +265,7 @@ fn an_effect_outside_the_candidate_list_ends_unattributed() {
     let t = truth(&[]).with_appendage(0.05, 400.0).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let r = run(&t, 4, dir.path(), None);
+    println!("{}", summary("appendage", &r));
     assert_eq!(r.verdict, Verdict::Unattributed);
     assert!(r.added.is_empty());
     let d = r.unattributed.as_ref().unwrap();
