@@ -39,6 +39,7 @@ pub use impactcal_calibrate as calibrate;
 pub use impactcal_core as core;
 pub use impactcal_cors as cors;
 pub use impactcal_erbf as erbf;
+pub use impactcal_experiment as experiment;
 pub use impactcal_runner as runner;
 pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
@@ -51,6 +52,7 @@ use impactcal_calibrate::CalibrateError;
 use impactcal_core::CoreError;
 use impactcal_cors::CorsError;
 use impactcal_erbf::ErbfError;
+use impactcal_experiment::ExperimentError;
 use impactcal_runner::RunnerError;
 use impactcal_sensors::SensorsError;
 use impactcal_shapes::ShapesError;
@@ -90,6 +92,9 @@ pub enum Error {
     /// From `impactcal-runner`: solver runs, executors, the run journal.
     #[error(transparent)]
     Runner(#[from] RunnerError),
+    /// From `impactcal-experiment`: experiment files, model assembly, study and loop runs.
+    #[error(transparent)]
+    Experiment(#[from] ExperimentError),
 }
 
 impl Error {
@@ -104,28 +109,11 @@ impl Error {
             Error::Erbf(e) => e.kind(),
             Error::Sobol(e) => e.kind(),
             Error::Cors(e) => e.kind(),
-            Error::Shell(e) => shell_kind(e),
+            Error::Shell(e) => e.kind(),
             Error::Calibrate(e) => e.kind(),
             Error::Runner(e) => e.kind(),
+            Error::Experiment(e) => e.kind(),
         }
-    }
-}
-
-/// The kind of a solver error: a deck, model or value that cannot be used is bad input, an
-/// unstable run is a numerical failure, a file is I/O. A variant this classification does
-/// not know yet counts as a failure.
-fn shell_kind(e: &ShellError) -> ErrorKind {
-    match e {
-        ShellError::Core(c) => c.kind(),
-        ShellError::Keyword { .. }
-        | ShellError::UnsupportedKeyword { .. }
-        | ShellError::UnsupportedKeywords { .. }
-        | ShellError::Reference { .. }
-        | ShellError::Element { .. }
-        | ShellError::Value { .. } => ErrorKind::BadInput,
-        ShellError::Io { .. } => ErrorKind::Io,
-        ShellError::Unstable { .. } => ErrorKind::Numerical,
-        _ => ErrorKind::Numerical,
     }
 }
 

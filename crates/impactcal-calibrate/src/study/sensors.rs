@@ -28,6 +28,10 @@ pub struct SensorsResult {
     pub expansion_rel_error: Option<f64>,
     /// Condition number of the expansion's fit.
     pub expansion_condition: Option<f64>,
+    /// Why fewer shapes were kept than the options ask for: the ensemble's data has a lower
+    /// numerical rank (absent when the requested number was kept).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 /// Whether `count` sensors fit on `candidates` channels.
@@ -92,8 +96,21 @@ pub fn place_sensors(
             }
         }
     }
-    let ensemble = ImpactShapes::from_matrix(y.as_ref(), &ShapeOptions::count(shapes))?;
+    // A number of shapes above what the ensemble's data can carry is lowered to its
+    // numerical rank, with a note, rather than ending a study whose runs are done.
+    let (ensemble, note) = match ImpactShapes::from_matrix(y.as_ref(), &ShapeOptions::count(shapes))
+    {
+        Err(impactcal_shapes::ShapesError::TooManyShapes { requested, rank }) if rank > 0 => (
+            ImpactShapes::from_matrix(y.as_ref(), &ShapeOptions::count(rank))?,
+            Some(format!(
+                "{requested} shapes asked for, but the ensemble's data has numerical rank \
+                 {rank}: {rank} shapes kept"
+            )),
+        ),
+        other => (other?, None),
+    };
     drop(y);
+    let shapes = ensemble.len();
     let placement = place(
         &CandidateShapes::new(candidates.to_vec(), ensemble.shapes())?,
         &PlacementOptions::new(count),
@@ -125,5 +142,6 @@ pub fn place_sensors(
         condition_number: placement.condition_number,
         expansion_rel_error,
         expansion_condition,
+        note,
     })
 }
