@@ -92,9 +92,16 @@ pub enum Error {
     /// From `impactcal-runner`: solver runs, executors, the run journal.
     #[error(transparent)]
     Runner(#[from] RunnerError),
-    /// From `impactcal-experiment`: experiment files, model assembly, study and loop runs.
+    /// From `impactcal-experiment`: experiment files, model assembly, study and loop runs
+    /// (boxed: its messages carry the file, line and key).
     #[error(transparent)]
-    Experiment(#[from] ExperimentError),
+    Experiment(Box<ExperimentError>),
+}
+
+impl From<ExperimentError> for Error {
+    fn from(e: ExperimentError) -> Self {
+        Error::Experiment(Box::new(e))
+    }
 }
 
 impl Error {

@@ -71,7 +71,7 @@ pub enum ModelSpec {
     /// An external solver through a deck template.
     External {
         /// The `[solver]` table.
-        solver: SolverSection,
+        solver: Box<SolverSection>,
         /// The declared parameters (a bounds file naming the template's parameters).
         space: SpaceSection,
     },
@@ -224,7 +224,7 @@ impl ModelSpec {
                     ));
                 }
                 Ok(ModelSpec::External {
-                    solver: solver.clone(),
+                    solver: Box::new(solver.clone()),
                     space,
                 })
             }

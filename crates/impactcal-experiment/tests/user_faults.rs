@@ -53,7 +53,7 @@ fn a_parameterised_deck_is_declared_by_its_own_names_with_round_off_bounds() {
     let h = model.simulate(&[0.08]).unwrap();
     assert!(h.samples() > 1);
     // The same thickness through the deck's own model: the same histories, bit for bit.
-    let deck = impactcal_shell::keyword::read_deck(&d.join("param.k")).unwrap();
+    let deck = impactcal_shell::keyword::read_deck(d.join("param.k")).unwrap();
     let direct = impactcal_shell::DeckModel::from_deck(deck, None).unwrap();
     let g = direct.simulate(&[0.08000000000000002]).unwrap();
     assert_eq!(h.data(), g.data());
