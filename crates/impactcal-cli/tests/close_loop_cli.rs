@@ -91,7 +91,7 @@ fn bad_input_exits_2_with_one_line() {
     let cases = [
         (GOOD.replace("v0 = 5.5", "v0 = 30.0"), "[holdout] set"),
         (
-            GOOD.replace("seed = 1", "seed = 1\n\n[loop]\ncandidates = []"),
+            GOOD.replace("seed = 1", "seed = 1\ncandidates = []"),
             "candidate list",
         ),
         (
