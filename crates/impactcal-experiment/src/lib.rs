@@ -493,16 +493,8 @@ pub fn write_study(
     geometry: Option<&Geometry>,
     out: &Path,
 ) -> Result<Finished<StudyResult>> {
-    let json = out.join("study.json");
-    write_json(&result, &json)?;
     let report = impactcal_calibrate::study::document::report(&result, geometry);
-    let files = impactcal_calibrate::report::write(&report, out)?;
-    Ok(Finished {
-        result,
-        report,
-        json,
-        files,
-    })
+    finish(result, report, out, "study.json")
 }
 
 /// Writes a loop's `loop.json` and report into `out`.
@@ -510,9 +502,14 @@ pub fn write_study(
 /// # Errors
 /// I/O and rendering errors.
 pub fn write_loop(result: LoopResult, out: &Path) -> Result<Finished<LoopResult>> {
-    let json = out.join("loop.json");
-    write_json(&result, &json)?;
     let report = impactcal_calibrate::closeloop::document::report(&result);
+    finish(result, report, out, "loop.json")
+}
+
+/// Writes `result` as `out/<json>` and `report` into `out`.
+fn finish<R: Serialize>(result: R, report: Report, out: &Path, json: &str) -> Result<Finished<R>> {
+    let json = out.join(json);
+    write_json(&result, &json)?;
     let files = impactcal_calibrate::report::write(&report, out)?;
     Ok(Finished {
         result,

@@ -375,19 +375,10 @@ fn check_keys(doc: &DeTable<'_>, text: &str, file: &str) -> Result<()> {
     Ok(())
 }
 
-/// Up to three names of `names` closest to `name` (Jaro-Winkler similarity), quoted.
+/// Up to three names of `names` closest to `name` (Jaro-Winkler similarity), quoted: the
+/// same suggestion a parameter name gets ([`impactcal_calibrate::study::subspace::near`]).
 pub fn closest(name: &str, names: &[&str]) -> String {
-    let mut scored: Vec<(f64, &str)> = names
-        .iter()
-        .map(|n| (strsim::jaro_winkler(name, n), *n))
-        .collect();
-    scored.sort_by(|a, b| b.0.total_cmp(&a.0));
-    scored
-        .iter()
-        .take(3)
-        .map(|(_, n)| format!("`{n}`"))
-        .collect::<Vec<_>>()
-        .join(", ")
+    impactcal_calibrate::study::subspace::near(name, names)
 }
 
 #[cfg(test)]
