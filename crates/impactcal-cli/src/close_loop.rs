@@ -15,15 +15,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         thread_pool(args.threads)?.install(|| experiment.close_loop_with(&args.out, &progress));
     progress.done();
     let done = done?;
-    for line in &done.report.lead {
-        eprintln!("{line}");
-    }
-    eprintln!(
-        "verdict: {}; wrote {} and {}",
-        verdict(&done.result),
-        done.json.display(),
-        done.files.html.display()
-    );
+    crate::output::print_finished(&done, &format!("verdict: {}; ", verdict(&done.result)));
     Ok(())
 }
 

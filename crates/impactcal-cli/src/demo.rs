@@ -161,14 +161,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let result = pool.install(|| run_model(&sub, &description, test, options, dir, &progress));
         progress.done();
         let done = write_study(result?, Some(&geometry), dir)?;
-        for line in &done.report.lead {
-            eprintln!("{line}");
-        }
-        eprintln!(
-            "wrote {} and {}",
-            done.json.display(),
-            done.files.html.display()
-        );
+        crate::output::print_finished(&done, "");
         Ok(done.result)
     };
     let table1 = StudyOptions {

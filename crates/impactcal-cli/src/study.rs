@@ -58,15 +58,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let progress = Progress::new();
     let done = thread_pool(args.threads)?.install(|| experiment.study_with(&args.out, &progress));
     progress.done();
-    let done = done?;
-    for line in &done.report.lead {
-        eprintln!("{line}");
-    }
-    eprintln!(
-        "wrote {} and {}",
-        done.json.display(),
-        done.files.html.display()
-    );
+    crate::output::print_finished(&done?, "");
     Ok(())
 }
 
