@@ -25,10 +25,14 @@ pub fn test_on_model(
     cfc: Option<Cfc>,
     model: &Histories,
 ) -> Result<Histories> {
-    let on_labels = on_model_labels(test, map, cfc, model)?;
+    window_of(&on_model_labels(test, map, cfc, model)?, model)
+}
+
+/// A test already on the model's labels (`on_model_labels`) on the model's time points.
+fn window_of(on_labels: &Histories, model: &Histories) -> Result<Histories> {
     let what = "the test against the model's window (the test must cover it)";
     Ok(interpolate_onto(
-        &on_labels,
+        on_labels,
         model.start(),
         model.dt(),
         model.samples(),
@@ -57,17 +61,28 @@ pub fn pre_trigger(
     model: &Histories,
     most: usize,
 ) -> Result<Option<Histories>> {
-    let dt = model.dt();
-    let room = (model.start() - test.start()) / dt;
-    let n = (room + 1e-6).floor().max(0.0) as usize;
-    let k = n.min(most);
+    if lead_samples(test, model, most) == 0 {
+        return Ok(None);
+    }
+    lead_of(&on_model_labels(test, map, cfc, model)?, model, most)
+}
+
+/// How many samples of `test`'s record before `model.start()` [`pre_trigger`] keeps.
+fn lead_samples(test: &Histories, model: &Histories, most: usize) -> usize {
+    let room = (model.start() - test.start()) / model.dt();
+    ((room + 1e-6).floor().max(0.0) as usize).min(most)
+}
+
+/// [`pre_trigger`] of a test already on the model's labels (`on_model_labels`).
+fn lead_of(on_labels: &Histories, model: &Histories, most: usize) -> Result<Option<Histories>> {
+    let k = lead_samples(on_labels, model, most);
     if k == 0 {
         return Ok(None);
     }
-    let on_labels = on_model_labels(test, map, cfc, model)?;
+    let dt = model.dt();
     let what = "the test's record before the model's start";
     Ok(Some(interpolate_onto(
-        &on_labels,
+        on_labels,
         model.start() - k as f64 * dt,
         dt,
         k,
@@ -306,8 +321,10 @@ pub fn prepared_test(
         m.entries.iter_mut().for_each(|e| e.conversion = None);
         m
     });
-    let on_model = test_on_model(&repaired, plain.as_ref(), cfc, model)?;
-    let lead = pre_trigger(&repaired, plain.as_ref(), cfc, model, MAX_PRE_TRIGGER)?;
+    // Converted and filtered once; the window and the pre-trigger are both read from it.
+    let on_labels = on_model_labels(&repaired, plain.as_ref(), cfc, model)?;
+    let on_model = window_of(&on_labels, model)?;
+    let lead = lead_of(&on_labels, model, MAX_PRE_TRIGGER)?;
     let test_label = |model_label: &str| -> String {
         map.and_then(|m| {
             m.entries
