@@ -284,6 +284,7 @@ pub fn run_loop_on<M: Enrichable>(
         options,
         (test.cfc, band),
         unit_gains.as_deref(),
+        preparation.pre_trigger.as_ref(),
     )?;
     noise_model(&mut frame, &masks, &floor)?;
     let ctx = Ctx {
@@ -424,7 +425,7 @@ pub fn run_loop_on<M: Enrichable>(
                 )?
                 .histories(0, "the holdout's nominal run")?;
             check_covered(h.histories, test.map, &nominal_h, "holdout")?;
-            let (test_h, masks_h, _) =
+            let (test_h, masks_h, preparation_h) =
                 prepared_test(h.histories, test.map, test.cfc, &nominal_h, None)?;
             let calibrated_h = runner
                 .at(h.set)
@@ -466,6 +467,7 @@ pub fn run_loop_on<M: Enrichable>(
                 options,
                 (test.cfc, band),
                 Some(&gains),
+                preparation_h.pre_trigger.as_ref(),
             )?;
             noise_model(&mut frame_h, &masks_h, &floor_h)?;
             let profile = |y: &[f64]| nuisance::profile(y, &frame_h, max_shift, Some(&gains)).0;
@@ -589,7 +591,8 @@ fn model_spread<M: Model>(
 /// jitter runs of `model_noise` (read one at a time, only when a channel's noise comes
 /// from the band) are the model ensemble whose bandwidth bounds the noise's band;
 /// `filters` the test's CFC (the one the test and the runs went through) and the class of
-/// the high band.
+/// the high band; `lead` the test's record before the model's start
+/// (`study::channels::pre_trigger`), measured with the window's quiet start.
 #[allow(clippy::too_many_arguments)]
 fn frame_of(
     labels: &[String],
@@ -603,6 +606,7 @@ fn frame_of(
     options: &LoopOptions,
     filters: (Option<Cfc>, Cfc),
     fixed_gains: Option<&[f64]>,
+    lead: Option<&Histories>,
 ) -> Result<(Frame, NoiseFloor)> {
     let mut frame = Frame {
         labels: labels.to_vec(),
@@ -615,6 +619,14 @@ fn frame_of(
     let (terms, _) = nuisance::profile(y_nominal, &frame, max_shift, fixed_gains);
     let onset = noise_floor::onset(y_nominal, samples) as f64 + terms.tau / dt;
     let pre = (onset - 3.0).floor().max(0.0) as usize;
+    // A test that departs before the model's start leaves its record's last samples out.
+    let lead: Vec<f64> = lead.map_or_else(Vec::new, |h| {
+        let late = (3.0 - onset).ceil().max(0.0) as usize;
+        let keep = h.samples().saturating_sub(late);
+        (0..h.channels())
+            .flat_map(|c| h.channel(c)[..keep].iter().copied())
+            .collect()
+    });
     let members = || {
         let runs = (0..model_noise.len()).map(|j| Ok(model_noise.run(j)?.data().to_vec()));
         noise_floor::envelopes_of(
@@ -629,6 +641,7 @@ fn frame_of(
         &members,
         samples,
         dt,
+        &lead,
         pre.min(samples),
         spread,
         options.sigma,

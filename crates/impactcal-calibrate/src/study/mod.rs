@@ -166,7 +166,7 @@ pub fn run(
             run_values: nominal_raw.channels() * nominal_raw.samples(),
             samples: nominal_raw.samples(),
             channels: test_m.channels(),
-            runs: options.ensemble,
+            runs: options.halton_runs,
             shapes: options.shapes,
             sensors: options.sensors,
             parameters: space.dim(),
@@ -181,7 +181,7 @@ pub fn run(
     };
     plan.check_all()?;
     observer.step(&plan.line());
-    let jitter = JitterOptions::new(options.noise_runs, options.noise_eps, options.seed);
+    let jitter = JitterOptions::new(options.jitter_runs, options.jitter_eps, options.seed);
     let jitter_pts = jitter_points(&space, &nominal_point, &jitter)?;
     let noise_runs = runs.stage("noise", &jitter_pts)?;
     let noise_ok: Vec<usize> = (0..noise_runs.len())
@@ -239,7 +239,7 @@ pub fn run(
     let design = sample(
         &space,
         SamplingMethod::ScrambledHalton,
-        options.ensemble,
+        options.halton_runs,
         options.seed,
     )?;
     let points: Vec<Vec<f64>> = (0..design.points.nrows())
@@ -334,7 +334,7 @@ pub fn run(
         },
         noise: NoiseSummary {
             runs: noise_ok.len(),
-            eps: options.noise_eps,
+            eps: options.jitter_eps,
             fraction: options.noise_fraction,
             relative_spread: noise.relative_spread(window_end, &noise_idx),
             relative_spread_sensors: None,
@@ -380,6 +380,9 @@ pub fn run(
         &base_obj,
         &test_obj,
     )?;
+    if let Some(note) = &sensors.note {
+        observer.step(&format!("note: {note}"));
+    }
     let selected = sensors.selected.clone();
     let sensor_idx: Vec<usize> = selected.iter().filter_map(|l| noise.index_of(l)).collect();
     result.noise.relative_spread_sensors = Some(noise.relative_spread(window_end, &sensor_idx));
@@ -460,7 +463,7 @@ pub fn run(
         &start,
         &start_outcome,
         options.reconcile_runs,
-        options.reconcile_batch,
+        options.cors_batch,
         options.seed,
         &mut run_batch,
         &prediction_error,

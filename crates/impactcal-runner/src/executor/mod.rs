@@ -28,12 +28,19 @@ pub use slurm::SlurmOptions;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProcessOptions {
-    /// Concurrent solver processes (at least 1).
+    /// Concurrent solver processes (at least 1; default: the cores this process may use,
+    /// `std::thread::available_parallelism`).
+    #[serde(default = "machine_cores")]
     pub jobs: usize,
     /// Time limit per run in seconds; a run still going is killed and counts as failed
     /// (and is retried within the batch's limit). None: no limit.
     #[serde(default)]
     pub timeout: Option<f64>,
+}
+
+/// The cores this process may use (1 when the system cannot say).
+pub fn machine_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
 }
 
 impl ProcessOptions {
