@@ -311,6 +311,10 @@ fn record(
         "hidden_rank": rank.map(|k| k + 1),
         "hidden_kappa": hidden_score.map(|c| c.kappa),
         "hidden_status": hidden_score.map(|c| c.status.clone()),
+        "hidden_twins": hidden.map(|(q, _)| r.indistinguishable.iter()
+            .filter(|(a, b, _)| a == q || b == q)
+            .map(|(a, b, mu)| json!({"name": if a == q { b } else { a }, "coherence": mu}))
+            .collect::<Vec<_>>()),
         "added": r.added.iter().map(|a| json!({
             "name": a.name, "value": a.value, "lower": a.lower, "upper": a.upper,
             "model_noise_sd": a.model_noise_sd, "pending_step": a.pending_step}))
