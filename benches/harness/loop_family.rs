@@ -317,7 +317,8 @@ fn record(
             .collect::<Vec<_>>()),
         "added": r.added.iter().map(|a| json!({
             "name": a.name, "value": a.value, "lower": a.lower, "upper": a.upper,
-            "model_noise_sd": a.model_noise_sd, "pending_step": a.pending_step}))
+            "model_noise_sd": a.model_noise_sd, "roughness_sd": a.roughness_sd,
+            "pending_step": a.pending_step}))
             .collect::<Vec<_>>(),
         "truth_inside": inside,
         "verdict": verdict,

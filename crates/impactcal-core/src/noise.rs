@@ -569,14 +569,20 @@ mod tests {
         let o = JitterOptions::new(200, 1e-2, 7);
         // At the upper bound of `a` (2.0) and inside `g`'s range.
         let pts = jitter_points_in_range(&space, &[2.0, 10.0], &o).unwrap();
-        assert_eq!(pts, jitter_points_in_range(&space, &[2.0, 10.0], &o).unwrap());
+        assert_eq!(
+            pts,
+            jitter_points_in_range(&space, &[2.0, 10.0], &o).unwrap()
+        );
         for p in &pts {
             // Width 1.5: a move of at most 0.015, never above the bound.
             assert!(p[0] <= 2.0 && p[0] >= 2.0 - 1.5e-2);
             // Width 20: at most 0.2 either way, whatever the value.
             assert!((p[1] - 10.0).abs() <= 0.2);
         }
-        assert!(pts.iter().any(|p| p[0] == 2.0), "draws above the bound are clipped to it");
+        assert!(
+            pts.iter().any(|p| p[0] == 2.0),
+            "draws above the bound are clipped to it"
+        );
         assert!(pts.iter().any(|p| (p[1] - 10.0).abs() > 0.15));
         assert!(pts.iter().any(|p| p[1] < 10.0) && pts.iter().any(|p| p[1] > 10.0));
         assert!(jitter_points_in_range(&space, &[1.0], &o).is_err());

@@ -235,8 +235,16 @@ pub const RENAMED: &[(&str, &str, &str)] = &[
     ("study", "reconcile_batch", "[study] cors_batch"),
     ("study", "sigma", "[test] sigma"),
     ("loop", "ensemble", "[loop] jitter_runs"),
-    ("loop", "jitter", "[loop] jitter_width (a fraction of each range, no longer of each value)"),
-    ("loop", "jitter_eps", "[loop] jitter_width (a fraction of each range, no longer of each value)"),
+    (
+        "loop",
+        "jitter",
+        "[loop] jitter_width (a fraction of each range, no longer of each value)",
+    ),
+    (
+        "loop",
+        "jitter_eps",
+        "[loop] jitter_width (a fraction of each range, no longer of each value)",
+    ),
     ("loop", "reconcile", "[loop] reconcile_runs"),
     ("loop", "recalibrate", "[loop] recalibrate_runs"),
     ("loop", "batch", "[loop] cors_batch"),

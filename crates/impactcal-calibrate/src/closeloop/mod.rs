@@ -357,10 +357,9 @@ pub fn run_loop_on<M: Enrichable>(
     } else {
         None
     };
-    let noise_var = ctx
-        .model_noise
-        .stats(fit, &ctx.frame, None, None)?
-        .parameter_variances(fit.point.len());
+    let draws = ctx.model_noise.stats(fit, &ctx.frame, None, None)?;
+    let noise_var = draws.parameter_variances(fit.point.len());
+    let roughness = draws.objective_noise();
     let added: Vec<Added> = outcome
         .added
         .iter()
@@ -368,13 +367,16 @@ pub fn run_loop_on<M: Enrichable>(
         .map(|(i, p)| {
             let v = fit.point[d0 + i];
             let pending = fit.pending[d0 + i];
-            let se = (fit.se[d0 + i].powi(2) + noise_var[d0 + i] + pending * pending).sqrt();
+            let rough_var = fit.se[d0 + i].powi(2) * roughness;
+            let se =
+                (fit.se[d0 + i].powi(2) + noise_var[d0 + i] + rough_var + pending * pending).sqrt();
             Added {
                 name: p.name.clone(),
                 value: v,
                 lower: v - 1.96 * se,
                 upper: v + 1.96 * se,
                 model_noise_sd: noise_var[d0 + i].sqrt(),
+                roughness_sd: rough_var.sqrt(),
                 pending_step: pending,
             }
         })
