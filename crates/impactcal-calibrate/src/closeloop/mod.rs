@@ -370,13 +370,19 @@ pub fn run_loop_on<M: Enrichable>(
             let rough_var = fit.se[d0 + i].powi(2) * roughness;
             let se =
                 (fit.se[d0 + i].powi(2) + noise_var[d0 + i] + rough_var + pending * pending).sqrt();
+            // Not determined by the data at the end point: the interval is the whole range.
+            let (lower, upper, roughness_sd) = if se.is_finite() {
+                (v - 1.96 * se, v + 1.96 * se, rough_var.sqrt())
+            } else {
+                (p.lower, p.upper, 0.0)
+            };
             Added {
                 name: p.name.clone(),
                 value: v,
-                lower: v - 1.96 * se,
-                upper: v + 1.96 * se,
+                lower,
+                upper,
                 model_noise_sd: noise_var[d0 + i].sqrt(),
-                roughness_sd: rough_var.sqrt(),
+                roughness_sd,
                 pending_step: pending,
             }
         })
