@@ -15,7 +15,7 @@
 //! ```text
 //! cargo run --release --example loop_family -- <dir> <kind> <level> <seed>
 //!     [--end 0.015] [--channels 24] [--candidates a,b,c] [--reconcile 24]
-//!     [--recalibrate 24] [--polish 8] [--jitter 1e-3] [--known-gains] [--declare START] [--keep]
+//!     [--recalibrate 24] [--polish 8] [--jitter 1e-4] [--known-gains] [--declare START] [--keep]
 //! ```
 //!
 //! `kind` is one of `damping`, `mass`, `friction`, `rate`, `material`, `none`; `level` 1 or
@@ -94,7 +94,7 @@ fn spec() -> Spec {
         polish: LoopOptions::default().polish,
         fit_gains: true,
         declare: None,
-        jitter: LoopOptions::default().jitter_width,
+        jitter: LoopOptions::default().jitter,
         keep: false,
     };
     let mut i = 4;
@@ -187,7 +187,7 @@ fn main() {
         recalibrate: s.recalibrate,
         polish: s.polish,
         fit_gains: s.fit_gains,
-        jitter_width: s.jitter,
+        jitter: s.jitter,
         candidates: s.candidates.clone(),
         seed: 1,
         ..LoopOptions::default()
@@ -218,7 +218,7 @@ fn main() {
         s.declare
             .map_or(String::new(), |v| format!("-declared-{v}")),
         if s.fit_gains { "" } else { "-known-gains" },
-        if s.jitter == LoopOptions::default().jitter_width {
+        if s.jitter == LoopOptions::default().jitter {
             String::new()
         } else {
             format!("-jitter-{}", s.jitter)

@@ -134,57 +134,22 @@ pub fn jitter_points(
 ) -> Result<Vec<Vec<f64>>> {
     options.validate()?;
     space.to_unit(point)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let scales: Vec<f64> = space
         .parameters()
         .iter()
         .zip(point)
         .map(|(p, &x)| if x != 0.0 { x.abs() } else { p.width() })
         .collect();
-    Ok(draw(space, point, &scales, options, false))
-}
-
-/// The jittered points of an ensemble about `point` on the scale of each parameter's range:
-/// `options.runs` points, each coordinate moved by `eps (upper_i - lower_i) u` with `u`
-/// uniform in `[-1, 1]`, clipped to the bounds. This is the scale of a finite-difference
-/// step taken as a fraction of the range (the closed loop's polish), where [`jitter_points`]
-/// moves each value by a fraction of itself.
-///
-/// # Errors
-/// As [`jitter_points`].
-pub fn jitter_points_in_range(
-    space: &ParameterSpace,
-    point: &[f64],
-    options: &JitterOptions,
-) -> Result<Vec<Vec<f64>>> {
-    options.validate()?;
-    space.to_unit(point)?;
-    let scales: Vec<f64> = space.parameters().iter().map(|p| p.width()).collect();
-    Ok(draw(space, point, &scales, options, true))
-}
-
-/// `options.runs` draws of `x_i + eps s_i u`, `u` uniform in `[-1, 1]`, clipped to the
-/// bounds when `clip`.
-fn draw(
-    space: &ParameterSpace,
-    point: &[f64],
-    scales: &[f64],
-    options: &JitterOptions,
-    clip: bool,
-) -> Vec<Vec<f64>> {
-    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    (0..options.runs)
+    Ok((0..options.runs)
         .map(|_| {
             point
                 .iter()
-                .zip(scales)
-                .zip(space.parameters())
-                .map(|((&x, &s), p)| {
-                    let y = x + options.eps * s * rng.random_range(-1.0..=1.0);
-                    if clip { y.clamp(p.lower, p.upper) } else { y }
-                })
+                .zip(&scales)
+                .map(|(&x, &s)| x + options.eps * s * rng.random_range(-1.0..=1.0))
                 .collect()
         })
-        .collect()
+        .collect())
 }
 
 /// The noise a model produces on its own at one point: per channel and per sample the
@@ -561,31 +526,6 @@ mod tests {
         assert!(jitter_points(&space, &[1.0], &o).is_err());
         assert!(jitter_points(&space, &[1.0, 0.0], &JitterOptions::new(1, 1e-3, 0)).is_err());
         assert!(jitter_points(&space, &[1.0, 0.0], &JitterOptions::new(4, 0.0, 0)).is_err());
-    }
-
-    #[test]
-    fn jitter_points_in_range_scale_with_the_range_and_stay_inside() {
-        let space = model().0;
-        let o = JitterOptions::new(200, 1e-2, 7);
-        // At the upper bound of `a` (2.0) and inside `g`'s range.
-        let pts = jitter_points_in_range(&space, &[2.0, 10.0], &o).unwrap();
-        assert_eq!(
-            pts,
-            jitter_points_in_range(&space, &[2.0, 10.0], &o).unwrap()
-        );
-        for p in &pts {
-            // Width 1.5: a move of at most 0.015, never above the bound.
-            assert!(p[0] <= 2.0 && p[0] >= 2.0 - 1.5e-2);
-            // Width 20: at most 0.2 either way, whatever the value.
-            assert!((p[1] - 10.0).abs() <= 0.2);
-        }
-        assert!(
-            pts.iter().any(|p| p[0] == 2.0),
-            "draws above the bound are clipped to it"
-        );
-        assert!(pts.iter().any(|p| (p[1] - 10.0).abs() > 0.15));
-        assert!(pts.iter().any(|p| p[1] < 10.0) && pts.iter().any(|p| p[1] > 10.0));
-        assert!(jitter_points_in_range(&space, &[1.0], &o).is_err());
     }
 
     /// The spread of `a t` is `t` times the standard deviation of `a`; the growing channel

@@ -35,9 +35,7 @@
 //! ```
 //!
 //! Each word means one thing: `halton_runs` is the study's Halton ensemble, `jitter_runs`
-//! the runs of the jitter ensemble measuring the model's own noise (study and loop),
-//! `jitter_eps` the study's jitter as a fraction of each value and `jitter_width` the loop's
-//! as a fraction of each range (the polish's finite-difference step),
+//! and `jitter_eps` the jitter ensemble measuring the model's own noise (study and loop),
 //! `cors_batch` the points CORS-RBF proposes at a time (study and loop), `[executor]
 //! retries` the runner's further attempts. Every key is set in one place: a key of an
 //! earlier schema is an error that names its new place ([`RENAMED`]), an unknown key one
@@ -209,7 +207,7 @@ pub const SECTIONS: &[(&str, Option<&[&str]>)] = &[
             "min_explained",
             "max_added",
             "jitter_runs",
-            "jitter_width",
+            "jitter_eps",
             "reconcile_runs",
             "recalibrate_runs",
             "polish",
@@ -235,16 +233,7 @@ pub const RENAMED: &[(&str, &str, &str)] = &[
     ("study", "reconcile_batch", "[study] cors_batch"),
     ("study", "sigma", "[test] sigma"),
     ("loop", "ensemble", "[loop] jitter_runs"),
-    (
-        "loop",
-        "jitter",
-        "[loop] jitter_width (a fraction of each range, no longer of each value)",
-    ),
-    (
-        "loop",
-        "jitter_eps",
-        "[loop] jitter_width (a fraction of each range, no longer of each value)",
-    ),
+    ("loop", "jitter", "[loop] jitter_eps"),
     ("loop", "reconcile", "[loop] reconcile_runs"),
     ("loop", "recalibrate", "[loop] recalibrate_runs"),
     ("loop", "batch", "[loop] cors_batch"),
@@ -455,7 +444,6 @@ mod tests {
             ("[study]\nsigma = 0.1\n", 4, "[test] sigma"),
             ("[loop]\nensemble = 6\n", 4, "[loop] jitter_runs"),
             ("[loop]\nbatch = 6\n", 4, "[loop] cors_batch"),
-            ("[loop]\njitter_eps = 1e-4\n", 4, "[loop] jitter_width"),
             ("[loop]\nsigma = 0.1\n", 4, "[test] sigma"),
             ("[budget]\nreconcile = 16\n", 4, "[loop] reconcile_runs"),
             ("[batch]\nretries = 1\n", 4, "[executor] retries"),

@@ -27,7 +27,6 @@ use super::jacobian::Jacobian;
 use super::linalg::dot;
 use super::model_noise::ModelNoise;
 use super::nuisance::{self, Frame, Terms};
-use super::options::FINITE_STEP;
 use super::plan::Plan;
 use crate::error::{CalibrateError, Result};
 use crate::study::execute::{Dispatch, Observer, Outcomes, Runs, Worker};
@@ -248,7 +247,7 @@ fn steps(space: &ParameterSpace, point: &[f64]) -> Vec<f64> {
         .iter()
         .zip(point)
         .map(|(p, &x)| {
-            let h = FINITE_STEP * p.width();
+            let h = 1e-3 * p.width();
             if x + h > p.upper { -h } else { h }
         })
         .collect()

@@ -76,7 +76,7 @@ pub mod selection;
 use std::cell::Cell;
 use std::path::Path;
 
-use impactcal_core::noise::{JitterOptions, SimulationNoise, jitter_points_in_range};
+use impactcal_core::noise::{JitterOptions, SimulationNoise, jitter_points};
 use impactcal_core::{Cfc, ChannelMap, Enrichable, Histories, Model};
 
 use crate::error::{CalibrateError, Result};
@@ -91,7 +91,7 @@ pub use detection::Detection;
 pub use discrepancy::Discrepancy;
 pub use noise_floor::NoiseFloor;
 pub use nuisance::Nuisance;
-pub use options::{FINITE_STEP, LoopOptions};
+pub use options::LoopOptions;
 pub use plan::{LoopShapes, estimated_peak};
 pub use result::{Added, ErrorSummary, Errors, LoopResult, ModelScore, Round, Stages, Verdict};
 
@@ -564,8 +564,8 @@ fn model_spread<M: Model>(
     cfc: Option<Cfc>,
     name: &str,
 ) -> Result<(Vec<f64>, ModelNoise)> {
-    let jitter = JitterOptions::new(options.ensemble, options.jitter_width, options.seed);
-    let pts = jitter_points_in_range(model.space(), point, &jitter)?;
+    let jitter = JitterOptions::new(options.ensemble, options.jitter, options.seed);
+    let pts = jitter_points(model.space(), point, &jitter)?;
     let runs = runner.stage(model, name, &pts)?;
     let used: Vec<usize> = (0..runs.len()).filter(|&i| runs.succeeded(i)).collect();
     if used.len() < 2 {

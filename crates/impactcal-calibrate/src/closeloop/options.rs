@@ -4,10 +4,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{CalibrateError, Result};
 
-/// The polish's finite-difference step as a fraction of each parameter's admissible range,
-/// and the default half-width of the jitter ensemble ([`LoopOptions::jitter_width`]).
-pub const FINITE_STEP: f64 = 1e-3;
-
 /// Options of the closed loop. Defaults in parentheses.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -22,13 +18,9 @@ pub struct LoopOptions {
     /// and JSON `jitter_runs`).
     #[serde(rename = "jitter_runs")]
     pub ensemble: usize,
-    /// Half-width of the jitter ensemble as a fraction of each parameter's admissible range
-    /// (default [`FINITE_STEP`], 1e-3, the polish's finite-difference step; `jitter_width`):
-    /// each jittered run moves every parameter by `jitter_width (upper - lower) u`, `u`
-    /// uniform in `[-1, 1]`. The model's noise that moves the fit's end point is its
-    /// roughness at the scale the polish resolves, which is that step (docs/closed-loop.md,
-    /// "The jitter's scale").
-    pub jitter_width: f64,
+    /// Relative jitter of the ensemble (default 1e-4; `jitter_eps`).
+    #[serde(rename = "jitter_eps")]
+    pub jitter: f64,
     /// CORS runs of the first calibration (default 24).
     #[serde(rename = "reconcile_runs")]
     pub reconcile: usize,
@@ -80,7 +72,7 @@ impl Default for LoopOptions {
             min_explained: 0.5,
             max_added: 3,
             ensemble: 8,
-            jitter_width: FINITE_STEP,
+            jitter: 1e-4,
             reconcile: 24,
             recalibrate: 24,
             polish: 8,
@@ -136,10 +128,10 @@ impl LoopOptions {
                 format!("{} runs; the model's noise needs at least 2", self.ensemble),
             );
         }
-        if !(self.jitter_width > 0.0 && self.jitter_width < 0.1) {
+        if !(self.jitter > 0.0 && self.jitter < 0.1) {
             return bad(
-                "jitter_width",
-                format!("{} must lie in (0, 0.1)", self.jitter_width),
+                "jitter_eps",
+                format!("{} must lie in (0, 0.1)", self.jitter),
             );
         }
         if self.m1_members < 19 {
