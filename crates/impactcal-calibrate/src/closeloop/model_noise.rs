@@ -35,8 +35,9 @@
 //! in the interval of an added quantity: the spread of the optimiser's end point, which
 //! the linearised error does not count (docs/closed-loop.md, "Intervals").
 //!
-//! With a smooth model (the drop tower) each `d_j` is its first-order response `J s_j`, so
-//! `v_i`, `a_j` and `R` vanish and nothing changes; on a crash model they are what keeps the
+//! With a smooth model (the drop tower) each `d_j` is its first-order response at the
+//! nominal point, so `v_i`, `a_j` and `R` hold only the change of that response between
+//! the nominal and the fitted point: small, and erring wide; on a crash model they are what keeps the
 //! loop from adding a quantity whose change the model's own noise can produce, and its
 //! intervals from claiming a precision the optimiser cannot reach.
 
