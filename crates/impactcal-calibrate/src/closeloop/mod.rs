@@ -357,23 +357,33 @@ pub fn run_loop_on<M: Enrichable>(
     } else {
         None
     };
-    let noise_var = ctx
-        .model_noise
-        .stats(fit, &ctx.frame, None, None)?
-        .parameter_variances(fit.point.len());
+    let draws = ctx.model_noise.stats(fit, &ctx.frame, None, None)?;
+    let noise_var = draws.parameter_variances(fit.point.len());
+    let roughness = draws.objective_noise();
     let added: Vec<Added> = outcome
         .added
         .iter()
         .enumerate()
         .map(|(i, p)| {
             let v = fit.point[d0 + i];
-            let se = (fit.se[d0 + i].powi(2) + noise_var[d0 + i]).sqrt();
+            let pending = fit.pending[d0 + i];
+            let rough_var = fit.se[d0 + i].powi(2) * roughness;
+            let se =
+                (fit.se[d0 + i].powi(2) + noise_var[d0 + i] + rough_var + pending * pending).sqrt();
+            // Not determined by the data at the end point: the interval is the whole range.
+            let (lower, upper, roughness_sd) = if se.is_finite() {
+                (v - 1.96 * se, v + 1.96 * se, rough_var.sqrt())
+            } else {
+                (p.lower, p.upper, 0.0)
+            };
             Added {
                 name: p.name.clone(),
                 value: v,
-                lower: v - 1.96 * se,
-                upper: v + 1.96 * se,
+                lower,
+                upper,
                 model_noise_sd: noise_var[d0 + i].sqrt(),
+                roughness_sd,
+                pending_step: pending,
             }
         })
         .collect();
