@@ -1,7 +1,7 @@
 //! Executors: where the runs of a batch happen.
 //!
-//! - [`Executor::Local`]: in this process, runs in parallel on rayon's thread pool (the
-//!   built-in solver in process; an external command as a child process per run);
+//! - [`Executor::Local`]: in this process, runs in parallel on rayon's thread pool (an
+//!   in-process solver in process; an external command as a child process per run);
 //! - [`Executor::Processes`]: a pool of at most `jobs` concurrent solver processes, each
 //!   with a time limit after which it is killed;
 //! - [`Executor::Slurm`]: one Slurm job array per batch, each task in its own work
@@ -65,15 +65,14 @@ impl ProcessOptions {
     }
 }
 
-/// The solver command of an executor that runs processes (the built-in solver runs in
+/// The solver command of an executor that runs processes (an in-process solver runs in
 /// process only).
 fn argv<'d>(driver: &'d Driver<'_>) -> Result<&'d [String]> {
     match &driver.batch.solver().command {
         crate::solver::SolverCommand::Argv(argv) => Ok(argv),
-        crate::solver::SolverCommand::BuiltIn { .. }
-        | crate::solver::SolverCommand::InProcess { .. } => Err(config(
-            "the processes and slurm executors run a solver command; the built-in solver and \
-             an in-process model run in process only (executor kind = \"local\")",
+        crate::solver::SolverCommand::InProcess { .. } => Err(config(
+            "the processes and slurm executors run a solver command; an in-process solver \
+             runs in process only (executor kind = \"local\")",
         )),
     }
 }
@@ -85,8 +84,11 @@ fn config(message: impl Into<String>) -> RunnerError {
     }
 }
 
-/// Where the runs of a batch happen.
-#[derive(Debug, Clone, PartialEq)]
+/// Where the runs of a batch happen. In a configuration file it is the `[executor]` table,
+/// chosen by `kind` (`"local"`, `"processes"`, `"slurm"`) with the variant's options beside
+/// it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
 #[non_exhaustive]
 pub enum Executor {
     /// In this process, in parallel on rayon's pool.
@@ -129,20 +131,20 @@ impl Executor {
 ///
 /// # Errors
 /// Faults of the batch as a whole: the journal cannot be written or belongs to another
-/// batch; the built-in solver asked of an executor that runs processes; a scheduler that
+/// batch; an in-process solver asked of an executor that runs processes; a scheduler that
 /// cannot be queried; [`RunnerError::Cancelled`] when `cancel` was set (runs in flight are
 /// killed or cancelled; the journal holds the rest).
 pub fn run_batch(batch: &Batch, executor: &Executor, cancel: &Cancel) -> Result<BatchReport> {
     run_batch_with(batch, executor, cancel, Hooks::default())
 }
 
-/// [`run_batch`] with [`Hooks`]: the model an in-process solver runs, and callbacks that
+/// [`run_batch`] with [`Hooks`]: the solver an in-process command runs, and callbacks that
 /// receive each run's histories as it finishes (so that nothing holds every run's
 /// histories unless the caller keeps them).
 ///
 /// # Errors
-/// As [`run_batch`]; [`RunnerError::Config`] when the solver runs an in-process model and
-/// `hooks.model` is `None`.
+/// As [`run_batch`]; [`RunnerError::Config`] when the solver runs in process and
+/// `hooks.in_process` is `None`.
 pub fn run_batch_with(
     batch: &Batch,
     executor: &Executor,
@@ -152,10 +154,10 @@ pub fn run_batch_with(
     if matches!(
         batch.solver().command,
         crate::solver::SolverCommand::InProcess { .. }
-    ) && hooks.model.is_none()
+    ) && hooks.in_process.is_none()
     {
         return Err(config(
-            "the solver runs an in-process model, but no model was given",
+            "the solver runs in process, but no in-process solver was given",
         ));
     }
     let (driver, pending, in_flight) = Driver::open(batch, cancel, executor.name(), hooks)?;
