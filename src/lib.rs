@@ -12,7 +12,7 @@
 //! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals | core |
 //! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) | core, erbf |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe | core |
-//! | [`runner`] | `impactcal-runner` | where runs happen: in process, a local process pool, a Slurm cluster; external solvers through deck templates; work directories and a run journal | core, shell (the in-process built-in solver) |
+//! | [`runner`] | `impactcal-runner` | where runs happen: in process, a local process pool, a Slurm cluster; external solvers through deck templates; work directories and a run journal | core (an in-process solver, such as the built-in one, is handed to it from above) |
 //! | [`calibrate`] | `impactcal-calibrate` | curve metrics (Sprague-Geers, Russell, ISO/TS 18571); the calibration study (M1, sensors, M2, surrogates, sensitivity, CORS reconciliation); the closed loop (residual, attribution, enrichment, recalibration, errors before and after); journals and reports | core, shapes, sensors, erbf, sobol, cors, runner |
 //! | [`experiment`] | `impactcal-experiment` | experiment files: one schema for studies and closed loops, model assembly (airframe, deck, drop tower, external solver), `Experiment::study`, `close_loop` and `point` | core, shell, runner, calibrate |
 //!

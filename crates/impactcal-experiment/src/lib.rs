@@ -24,25 +24,30 @@
 //! executable unless [`Experiment::with_program`] names another (the `impactcal` command
 //! answers `point`; a program of one's own answers it by calling [`Experiment::point`]).
 
+pub mod builtin;
 pub mod error;
 pub mod model;
 pub mod schema;
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use impactcal_calibrate::closeloop::{Holdout, LoopOptions, LoopResult, run_loop_on};
 use impactcal_calibrate::report::{Report, ReportFiles};
 use impactcal_calibrate::study::document::Geometry;
 use impactcal_calibrate::study::{
-    Executor, InProcess, Observer, Runner, Silent, StudyResult, TestData, ValidStudyOptions, Worker,
+    InProcess, ModelRuns, Observer, Silent, SolverRuns, StudyResult, TestData, ValidStudyOptions,
 };
 use impactcal_core::enrich::rebuild;
 use impactcal_core::{Cfc, ChannelMap, Histories, IsoMme, Model, ParamGuard, TestRecord};
-use impactcal_runner::config::ExecutorSection;
+use impactcal_runner::config::ExecutorTable;
 use impactcal_runner::workdir::{PARAMS, RunRecord};
-use impactcal_runner::{Cancel, OutputSpec, Solver, SolverCommand};
+use impactcal_runner::{
+    Cancel, Executor, InProcessSolver, OutputSpec, Runner, Solver, SolverCommand,
+};
 use serde::Serialize;
 
+pub use builtin::BuiltInSolver;
 pub use error::{ExperimentError, Result};
 pub use model::{Built, ExperimentModel, ModelSpec};
 pub use schema::ExperimentFile;
@@ -259,9 +264,9 @@ impl Experiment {
             map: measured.map.as_ref(),
             cfc: measured.cfc,
         };
-        let run = |executor: &dyn Executor| {
+        let run = |model_runs: &dyn ModelRuns| {
             impactcal_calibrate::study::run(
-                executor,
+                model_runs,
                 &built.description,
                 test,
                 &options,
@@ -281,39 +286,53 @@ impl Experiment {
         write_study(result, built.geometry.as_ref(), out)
     }
 
-    /// The runner of a study whose runs go through a solver command: an external `[solver]`
-    /// on any executor, or the built-in model on a process pool or Slurm (each run `point`
-    /// on this file in its directory). `None` for the built-in model in this process.
-    fn study_runner(&self, built: &Built) -> Result<Option<Runner>> {
-        let (section, retries) = self.executor();
-        let solver = match (&self.file.solver, &section) {
-            (Some(s), _) => {
+    /// The runs of a study that go through the runner's solver: an external `[solver]` on
+    /// any executor (without a `command` on the local executor, the built-in solver on each
+    /// run's deck, in process), or the built-in model on a process pool or Slurm (each run
+    /// `point` on this file in its directory). `None` for the built-in model in this
+    /// process.
+    fn study_runner(&self, built: &Built) -> Result<Option<SolverRuns>> {
+        let table = self.executor_table();
+        let (solver, in_process) = match (&self.file.solver, &table.executor) {
+            (Some(s), executor) => {
                 let program = self.program()?;
-                s.solver(self.base(), &self.path, &section, Some(&program))
-                    .map_err(|e| ExperimentError::from(e).in_section(&self.name, "solver"))?
+                let solver = s
+                    .solver(self.base(), &self.path, executor, Some(&program))
+                    .map_err(|e| ExperimentError::from(e).in_section(&self.name, "solver"))?;
+                let builtin: Arc<dyn InProcessSolver + Send> =
+                    Arc::new(BuiltInSolver::new(s.quantity));
+                (solver, Some(builtin))
             }
-            (None, ExecutorSection::Local) => return Ok(None),
-            (None, _) => self.point_solver(Some("velocity"))?,
+            (None, Executor::Local) => return Ok(None),
+            (None, _) => (self.point_solver(Some("velocity"))?, None),
         };
-        let executor = section.executor();
-        executor
-            .check()
-            .map_err(|e| ExperimentError::from(e).in_section(&self.name, "executor"))?;
-        Ok(Some(Runner {
+        let runner = Runner {
+            in_process,
+            ..self.runner(table, solver)?
+        };
+        Ok(Some(SolverRuns {
             space: built.space.clone(),
-            solver,
-            executor,
-            retries,
-            cancel: self.cancel.clone(),
+            runner,
         }))
     }
 
-    /// `[executor]` (default: in this process) and its retries.
-    fn executor(&self) -> (ExecutorSection, u32) {
-        match &self.file.executor {
-            Some(e) => (e.executor.clone(), e.retries),
-            None => (ExecutorSection::Local, 2),
-        }
+    /// `[executor]` (default: in this process, 2 retries).
+    fn executor_table(&self) -> ExecutorTable {
+        self.file.executor.clone().unwrap_or_default()
+    }
+
+    /// The runner of `solver` on the executor of `table`, checked, with its retries and
+    /// this experiment's cancel token.
+    fn runner(&self, table: ExecutorTable, solver: Solver) -> Result<Runner> {
+        table
+            .executor
+            .check()
+            .map_err(|e| ExperimentError::from(e).in_section(&self.name, "executor"))?;
+        Ok(Runner {
+            retries: table.retries,
+            cancel: self.cancel.clone(),
+            ..Runner::new(solver, table.executor)
+        })
     }
 
     fn program(&self) -> Result<PathBuf> {
@@ -401,21 +420,13 @@ impl Experiment {
 
     /// The worker of a loop whose `[executor]` runs processes: `point` on this file in each
     /// run's directory. `None` in process.
-    fn worker(&self) -> Result<Option<Worker>> {
-        let (section, retries) = self.executor();
-        if section == ExecutorSection::Local {
+    fn worker(&self) -> Result<Option<Runner>> {
+        let table = self.executor_table();
+        if table.executor == Executor::Local {
             return Ok(None);
         }
-        let executor = section.executor();
-        executor
-            .check()
-            .map_err(|e| ExperimentError::from(e).in_section(&self.name, "executor"))?;
-        Ok(Some(Worker {
-            solver: self.point_solver(None)?,
-            executor,
-            retries,
-            cancel: self.cancel.clone(),
-        }))
+        let solver = self.point_solver(None)?;
+        self.runner(table, solver).map(Some)
     }
 
     /// One run of the experiment's model in the run directory `dir`: reads its

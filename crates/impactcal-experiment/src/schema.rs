@@ -46,7 +46,7 @@ use std::path::PathBuf;
 
 use impactcal_calibrate::closeloop::LoopOptions;
 use impactcal_calibrate::study::StudyOptions;
-use impactcal_runner::config::{ExecutorSection, SolverSection};
+use impactcal_runner::config::{ExecutorTable, SolverSection};
 use serde::Deserialize;
 use toml::de::{DeTable, DeValue};
 
@@ -70,7 +70,8 @@ pub struct ExperimentFile {
     pub holdout: Option<HoldoutSection>,
     /// `[solver]`: an external solver instead of `[model]`.
     pub solver: Option<SolverSection>,
-    /// `[executor]`: where the runs happen (default: in this process).
+    /// `[executor]`: where the runs happen (default: in this process) and the runner's
+    /// retries: the runner's own table, as in a batch file.
     pub executor: Option<ExecutorTable>,
     /// `[study]`: the study's options.
     #[serde(default)]
@@ -130,21 +131,6 @@ pub struct HoldoutSection {
     pub data: PathBuf,
     /// Its condition, as held quantities of the model.
     pub set: BTreeMap<String, f64>,
-}
-
-/// `[executor]`: the runner's executor (`kind` and its options) and the runner's retries.
-#[derive(Debug, Clone, Deserialize)]
-pub struct ExecutorTable {
-    /// Further attempts of a run that fails in a way another attempt may cure (default 2).
-    #[serde(default = "default_retries")]
-    pub retries: u32,
-    /// Where the runs happen.
-    #[serde(flatten)]
-    pub executor: ExecutorSection,
-}
-
-fn default_retries() -> u32 {
-    2
 }
 
 /// The sections of a file and their keys (`None`: any key, as in `[parameters]`). Tables
@@ -487,7 +473,7 @@ mod tests {
         .unwrap();
         let e = f.executor.unwrap();
         assert_eq!(e.retries, 1);
-        let ExecutorSection::Processes(p) = e.executor else {
+        let impactcal_runner::Executor::Processes(p) = e.executor else {
             panic!("{:?}", e.executor)
         };
         assert_eq!(p.jobs, impactcal_runner::executor::machine_cores());

@@ -29,11 +29,12 @@ use super::model_noise::ModelNoise;
 use super::nuisance::{self, Frame, Terms};
 use super::plan::Plan;
 use crate::error::{CalibrateError, Result};
-use crate::study::execute::{Dispatch, Observer, Outcomes, Runs, Worker};
+use crate::study::execute::{Dispatch, Observer, Outcomes, Runs};
 use crate::study::reconcile;
+use impactcal_runner::Runner;
 
 /// The journaled runner of one loop (its output folder and fingerprint), counting the runs
-/// it is asked for: in this process, or through a [`Worker`] on its executor. Each batch
+/// it is asked for: in this process, or through a worker [`Runner`] on its executor. Each batch
 /// names the model's parameters (declared, then added candidates) and the `condition` the
 /// model is at, so that a worker rebuilds exactly the model the loop runs.
 #[derive(Clone, Copy)]
@@ -42,7 +43,7 @@ pub(crate) struct Journaled<'a> {
     pub fingerprint: &'a str,
     pub observer: &'a dyn Observer,
     pub used: &'a Cell<usize>,
-    pub worker: Option<&'a Worker>,
+    pub worker: Option<&'a Runner>,
     pub condition: &'a [(String, f64)],
     /// The loop's memory plan, once the nominal run has given its shapes.
     pub plan: Option<&'a Plan>,

@@ -84,7 +84,8 @@ use crate::memory::Guard;
 use crate::metrics::{CurveMetrics, Iso18571};
 use crate::study::TestData;
 use crate::study::channels::prepared_test;
-use crate::study::execute::{Observer, Worker};
+use crate::study::execute::Observer;
+use impactcal_runner::Runner;
 
 pub use attribution::{Amplitude, Attribution, Score};
 pub use detection::Detection;
@@ -141,7 +142,7 @@ pub fn run_loop<M: Enrichable>(
     )
 }
 
-/// [`run_loop`] with the model's runs on a [`Worker`] (a process pool, a Slurm cluster)
+/// [`run_loop`] with the model's runs on a worker [`Runner`] (a process pool, a Slurm cluster)
 /// instead of this process (`worker = None`). Each run's `params.json` names the model's
 /// parameters (declared, then added candidates, in the order of [`Enrichable::enrich`]) and
 /// the condition `set` of a holdout run; the worker must rebuild exactly that model (as
@@ -161,7 +162,7 @@ pub fn run_loop_on<M: Enrichable>(
     options: &LoopOptions,
     dir: &Path,
     observer: &dyn Observer,
-    worker: Option<&Worker>,
+    worker: Option<&Runner>,
 ) -> Result<LoopResult> {
     let space = model.space().clone();
     let d0 = space.dim();

@@ -23,7 +23,7 @@
 //! 9. the before/after table: prediction error, `Q(t)` error, M2 count above 0.9, and per
 //!    sensor relative L2, Sprague-Geers C and ISO/TS 18571 R.
 //!
-//! Every true-model run goes through one [`Executor`] and the runner's journal in the output
+//! Every true-model run is made as one [`ModelRuns`] says, through the runner's journal in the output
 //! folder ([`execute`]: recorded before it starts and after its result is read); running the
 //! same study again, after an interruption at any moment, reuses finished runs, re-attaches
 //! to runs still queued or running and gives the same result, bit for bit. [`StudyResult`] holds every number (`study.json`);
@@ -55,7 +55,7 @@ use crate::error::{CalibrateError, Result};
 use crate::memory::Guard;
 use crate::metrics::{CurveMetrics, Iso18571};
 
-pub use execute::{Executor, InProcess, Observer, RunOutcome, Runner, Silent, Worker};
+pub use execute::{InProcess, ModelRuns, Observer, RunOutcome, Silent, SolverRuns};
 pub use m1::{M1, Verdict};
 pub use options::{StudyOptions, ValidStudyOptions};
 pub use plan::{StudyShapes, estimated_peak};
@@ -104,14 +104,14 @@ pub fn run_model<M: Model>(
 /// The fingerprint of a study: a hash of the model's description, its space, the options,
 /// the CFC class, the channel map and the test's values.
 pub fn fingerprint(
-    executor: &dyn Executor,
+    model_runs: &dyn ModelRuns,
     description: &str,
     test: TestData<'_>,
     options: &StudyOptions,
 ) -> String {
     let mut bytes = Vec::new();
     bytes.extend_from_slice(description.as_bytes());
-    bytes.extend(serde_json::to_vec(executor.space()).unwrap_or_default());
+    bytes.extend(serde_json::to_vec(model_runs.space()).unwrap_or_default());
     bytes.extend(serde_json::to_vec(options).unwrap_or_default());
     bytes.extend(format!("{:?}", test.cfc.map(Cfc::class)).as_bytes());
     if let Some(m) = test.map {
@@ -127,21 +127,21 @@ pub fn fingerprint(
     impactcal_runner::fingerprint(&bytes)
 }
 
-/// [`run_model`] with any [`Executor`].
+/// [`run_model`] with the runs any [`ModelRuns`] makes.
 ///
 /// # Errors
 /// As [`run_model`].
 pub fn run(
-    executor: &dyn Executor,
+    model_runs: &dyn ModelRuns,
     description: &str,
     test: TestData<'_>,
     options: &ValidStudyOptions,
     dir: &Path,
     observer: &dyn Observer,
 ) -> Result<StudyResult> {
-    let space = executor.space().clone();
-    let fp = fingerprint(executor, description, test, options);
-    let runs = Runs::open(executor, dir, &fp, observer)?;
+    let space = model_runs.space().clone();
+    let fp = fingerprint(model_runs, description, test, options);
+    let runs = Runs::open(model_runs, dir, &fp, observer)?;
     let prep = |h: &Histories| -> Result<Histories> {
         Ok(match test.cfc {
             Some(c) => h.filtered(c)?,
@@ -171,7 +171,7 @@ pub fn run(
             sensors: options.sensors,
             parameters: space.dim(),
             sobol_rows: options.sensitivity_samples,
-            threads: if executor.model().is_some() {
+            threads: if model_runs.model().is_some() {
                 rayon::current_num_threads()
             } else {
                 0
