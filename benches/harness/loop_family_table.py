@@ -2,7 +2,7 @@
 """The family's records (one JSON line per case, benches/harness/loop_family.sh) as the
 markdown table of docs/validation.md, "The closed loop over a family of hidden effects".
 
-    python3 benches/harness/loop_family_table.py RECORDS
+    python3 benches/harness/loop_family_table.py RECORDS [RECORDS...]
 """
 import json
 import sys
@@ -45,5 +45,29 @@ print("| case | seed | hidden | ranked first | added (truth inside its 95 % inte
       "| calibration nominal -> calibrated -> enriched | holdout | chi2_red final (threshold) "
       "| runs |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|")
-for line in open(sys.argv[1]):
-    print(row(json.loads(line)))
+records = [json.loads(line) for path in sys.argv[1:] for line in open(path)]
+for r in records:
+    print(row(r))
+
+
+def share(hits, cases):
+    return f"{sum(hits)}/{len(hits)} of {cases}" if hits else f"0/0 of {cases}"
+
+
+# The issue's targets over the finished cases (a failed case counts against every target).
+hidden = [r for r in records if r.get("failed") or r.get("hidden")]
+control = [r for r in records if not r.get("failed") and not r.get("hidden")]
+ok = [r for r in hidden if not r.get("failed")]
+found = [r.get("hidden_rank") == 1 and r.get("truth_inside") is not None for r in hidden]
+inside = [bool(r["truth_inside"]) for r in ok if r.get("truth_inside") is not None]
+nuisance = [abs(r["gain"] / r["gain_true"] - 1) <= 0.03
+            and abs(r["tau"] - r["tau_true"]) <= 0.2 * r["dt"] for r in ok + control]
+cut = [r["calibration"][2] <= 0.7 * r["calibration"][0]
+       and (r.get("holdout") is None or r["holdout"][2] < r["holdout"][0]) for r in ok]
+print()
+print(f"ranked first and added: {share(found, 'cases with a hidden effect')}; "
+      f"truth inside its 95 % interval: {share(inside, 'cases where it was added')}; "
+      f"gain within 3 % and trigger within a fifth of a sample: {share(nuisance, 'cases')}; "
+      f"calibration error cut by 30 % and the holdout's lowered: {share(cut, 'cases')}; "
+      f"attributed: {share([r['verdict'] == 'attributed' for r in ok], 'cases')}; "
+      f"control silent: {share([r['verdict'] == 'no-model-form-error' for r in control], 'seeds')}")
