@@ -157,10 +157,7 @@ fn hidden_damping_on_the_airframe_is_found_and_the_error_falls() {
     let r = close(&test, &holdout, &dir);
     let summary = format!(
         "{:?}\n{:?}\n{:?}\n{:?}\n{:?}",
-        r.candidates
-            .iter()
-            .map(|c| (&c.name, c.kappa, c.explained_fraction, &c.status))
-            .collect::<Vec<_>>(),
+        ranking(&r),
         r.added,
         r.errors,
         r.nuisance,
@@ -274,10 +271,7 @@ fn a_hidden_mass_with_a_wrong_gain_is_found_and_the_gain_recovered() {
     .unwrap();
     let summary = format!(
         "{:?}\n{:?}\n{:?}\n{:?}\n{}",
-        r.candidates
-            .iter()
-            .map(|c| (&c.name, c.kappa, c.explained_fraction, &c.status))
-            .collect::<Vec<_>>(),
+        ranking(&r),
         r.added,
         r.errors,
         r.nuisance.gains.get(&wrong),
@@ -311,6 +305,15 @@ fn a_hidden_mass_with_a_wrong_gain_is_found_and_the_gain_recovered() {
 
 /// Asserts that the enriched model's error is under `calibration` times the calibrated
 /// one's on the calibration test and under `holdout` times it on the holdout.
+/// Each candidate's name, kappa, explained fraction and status, in rank order (for the
+/// printed summary of a loop).
+fn ranking(r: &LoopResult) -> Vec<(&String, f64, f64, &String)> {
+    r.candidates
+        .iter()
+        .map(|c| (&c.name, c.kappa, c.explained_fraction, &c.status))
+        .collect()
+}
+
 fn errors_fall(r: &LoopResult, calibration: f64, holdout: f64, summary: &str) {
     let e = &r.errors;
     assert!(
