@@ -195,13 +195,15 @@ pub(crate) fn calibrate<M: Model>(
         .cloned()
         .ok_or_else(|| CalibrateError::study(prefix, "no starting point"))?;
     let mut y = ctx.y_of(&outcomes.histories(0, "the starting point")?)?;
-    // The best of the starting points, the local continuation a polish may also go on from.
-    let mut warm = (point.clone(), y.clone(), ctx.profile(&y).1);
-    for (k, x) in start.iter().enumerate().skip(1) {
-        let yk = ctx.y_of(&outcomes.histories(k, "a starting point")?)?;
-        let rk = ctx.profile(&yk).1;
-        if rk < warm.2 {
-            warm = (x.clone(), yk, rk);
+    // The best of the starting points (its index and residual), the local continuation a
+    // polish may also go on from; its response is read again only if that polish runs.
+    let mut warm = (0, ctx.profile(&y).1);
+    for k in 1..start.len() {
+        let rk = ctx
+            .profile(&ctx.y_of(&outcomes.histories(k, "a starting point")?)?)
+            .1;
+        if rk < warm.1 {
+            warm = (k, rk);
         }
     }
     if budget > 0 {
@@ -224,7 +226,7 @@ pub(crate) fn calibrate<M: Model>(
         point = best.summary.calibrated_point;
         y = ctx.y_of(&best.histories)?;
     }
-    let searched = point != warm.0;
+    let searched = point != start[warm.0];
     let mut fit = polish_from(ctx, model, prefix, point, y, polish)?;
     // A search of a few runs over the whole box may put its best point in another basin
     // than the starts' (on the airframe: a thinner belly with the right mass, chi2_red 2.4
@@ -232,7 +234,8 @@ pub(crate) fn calibrate<M: Model>(
     // search moved away from the best start, the polish also goes on from that start, and
     // the lower residual is the fit.
     if searched && polish > 0 {
-        let (x, yw, _) = warm;
+        let yw = ctx.y_of(&outcomes.histories(warm.0, "the best starting point")?)?;
+        let x = start[warm.0].clone();
         let other = polish_from(ctx, model, &format!("{prefix}-warm"), x, yw, polish)?;
         if other.rss < fit.rss {
             fit = other;
