@@ -14,10 +14,10 @@
 //!   at a time;
 //! - held for the whole loop, beside what the caller holds: the nominal run (`R`), the test
 //!   on the model's time base, the frame's test and weights, the spread, the nominal on the
-//!   loop's channels and the working vectors of the fits (`8 n`), and up to four fits alive
-//!   at once (the first calibration, the current one, a recalibration and its control),
-//!   each its response, residual and factored Jacobian (`q + 2` vectors): `R + (8 + 4 (q +
-//!   4)) n`;
+//!   loop's channels and the working vectors of the fits (`8 n`), and up to five fits alive
+//!   at once (the first calibration, the current one, a recalibration, its second polish
+//!   from the best start and its control), each its response, residual and factored
+//!   Jacobian (`q + 2` vectors): `R + (8 + 5 (q + 4)) n`;
 //! - a Gauss-Newton Jacobian: its dense columns, their copy for the factorisation, the
 //!   SVD's basis and work space, the nuisance columns and their orthonormal bases, the
 //!   residual and the shifted responses: `(3 q + 8) n`, or `(q + 1) n` plus a run read back
@@ -67,7 +67,7 @@ impl Stages for LoopShapes {
     const WHO: &'static str = "the loop";
 
     fn held(&self) -> u64 {
-        self.run_values as u64 + (8 + 4 * (self.dense as u64 + 4)) * self.n()
+        self.run_values as u64 + (8 + 5 * (self.dense as u64 + 4)) * self.n()
     }
 
     fn stages(&self) -> Vec<(&'static str, u64)> {
