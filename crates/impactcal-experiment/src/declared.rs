@@ -165,9 +165,10 @@ impl Model for DeclaredModel {
                 let result = Simulation::new(&model)
                     .and_then(|mut s| s.run())
                     .map_err(CoreError::simulation)?;
-                result.histories(*quantity).cloned().ok_or_else(|| {
-                    CoreError::Invalid("the run produced no nodal histories".into())
-                })
+                result
+                    .histories(*quantity)
+                    .cloned()
+                    .ok_or_else(|| CoreError::Invalid("the run produced no nodal histories".into()))
             }
             Runs::Solver(runner) => one_run(runner, &self.space, params, &self.values),
         }
@@ -278,4 +279,3 @@ impl Enrichable for DeclaredModel {
             .map(|c| (GROUP.to_string(), c.description.clone()))
     }
 }
-

@@ -49,8 +49,8 @@ use impactcal_runner::{
 use serde::Serialize;
 
 pub use builtin::BuiltInSolver;
-pub use error::{ExperimentError, Result};
 pub use declared::DeclaredModel;
+pub use error::{ExperimentError, Result};
 pub use model::{Built, Declarations, ExperimentModel, ModelSpec};
 pub use schema::ExperimentFile;
 

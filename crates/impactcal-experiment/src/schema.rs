@@ -341,7 +341,10 @@ fn check_declared(f: &ExperimentFile, doc: &DeTable<'_>, text: &str, file: &str)
     for (name, c) in &f.candidates {
         for (k, v) in [("lower", c.lower), ("upper", c.upper), ("held", c.held)] {
             if !v.is_finite() {
-                return Err(key(&["candidates", name, k], format!("{v}: must be finite")));
+                return Err(key(
+                    &["candidates", name, k],
+                    format!("{v}: must be finite"),
+                ));
             }
         }
         if c.lower >= c.upper {
