@@ -1,7 +1,7 @@
 //! Experiment files: a calibration study or a closed loop described in one TOML file, run
 //! through the library.
 //!
-//! One schema ([`schema`]) covers every section (`[model] [parameters] [space] [test]
+//! One schema ([`schema`]) covers every section (`[model] [parameters] [space] [candidates] [held] [test]
 //! [holdout] [solver] [executor] [study] [loop]`), parsed in one place with errors that
 //! name the file, the line and the key. [`model`] turns the model sections into one
 //! [`ExperimentModel`] (airframe, deck, drop tower) or an external solver; [`Experiment`]
