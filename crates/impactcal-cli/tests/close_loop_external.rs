@@ -93,15 +93,14 @@ fn loop_json(out: &Path) -> (serde_json::Value, String) {
     (v, model)
 }
 
-fn close_loop(config: &Path, out: &Path) {
-    let o = impactcal(&[
+fn close_loop(config: &Path, out: &Path) -> std::process::Output {
+    impactcal(&[
         "close-loop",
         "--config",
         config.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    ])
 }
 
 #[test]
@@ -119,8 +118,10 @@ fn an_external_solvers_loop_on_a_process_pool_attributes_the_hidden_damping() {
     );
     let deck = configured(dir.path(), "deck.toml", "", "");
     let (a, b) = (dir.path().join("external"), dir.path().join("deck"));
-    close_loop(&external, &a);
-    close_loop(&deck, &b);
+    for (config, out) in [(&external, &a), (&deck, &b)] {
+        let o = close_loop(config, out);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
     let ((ext, ext_model), (inp, inp_model)) = (loop_json(&a), loop_json(&b));
     assert!(ext_model.starts_with("solver "), "{ext_model}");
     assert!(inp_model.starts_with("deck "), "{inp_model}");
@@ -227,13 +228,7 @@ fn declarations_that_do_not_fit_are_refused_naming_file_and_key() {
         )
         .unwrap();
         let out = dir.path().join("out");
-        let o = impactcal(&[
-            "close-loop",
-            "--config",
-            config.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let o = close_loop(&config, &out);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{needle}: {err}");
         assert!(err.contains("loop.toml"), "{needle}: {err}");
