@@ -377,7 +377,8 @@ fn check_declared(f: &ExperimentFile, doc: &DeTable<'_>, text: &str, file: &str)
             return Err(key(&["held", name], format!("{v}: must be finite")));
         }
     }
-    let declares = !f.candidates.is_empty() || !f.held.is_empty() || f.solver.is_some();
+    let declares =
+        !f.candidates.is_empty() || !f.held.is_empty() || (f.solver.is_some() && f.model.is_none());
     if let (true, Some(h)) = (declares, &f.holdout) {
         let known: Vec<&str> = f
             .candidates
@@ -391,11 +392,11 @@ fn check_declared(f: &ExperimentFile, doc: &DeTable<'_>, text: &str, file: &str)
                     &["holdout", "set"],
                     format!(
                         "`{name}` is neither a [candidates] entry nor a [held] quantity, so no \
-                         run can hold it at another value; closest declared: {}",
+                         run can hold it at another value; {}",
                         if known.is_empty() {
-                            "none".to_string()
+                            "declare it in [held] with its value in the calibration test".into()
                         } else {
-                            closest(name, &known)
+                            format!("closest declared: {}", closest(name, &known))
                         }
                     ),
                 ));
