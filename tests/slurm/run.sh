@@ -15,7 +15,11 @@
 #      the same study run uninterrupted on the local process pool;
 #   5. a small closed loop (examples/loop/slurm.toml, the drop tower): every stage of the
 #      loop a job array of `impactcal point` tasks, the holdout's runs at their
-#      condition; the same loop.json as the same loop in process.
+#      condition; the same loop.json as the same loop in process;
+#   6. the closed loop on an external solver (examples/loop/external/processes.toml: the
+#      deck template drop.k, each run `impactcal simulate` as a program in a job array):
+#      the same loop.json as the same deck run in process as a built-in model (deck.toml),
+#      apart from the line naming the model.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 REPO=$(pwd)
@@ -180,6 +184,33 @@ echo "loop on Slurm: $arrays job arrays in $(( $(date +%s) - start )) s"
 grep -q '"v0": 5' "$L/slurm/runs/holdout-enriched/0/params.json" || fail "the holdout's condition"
 grep -q 'contact_damping' "$L/slurm/runs/holdout-enriched/0/params.json" || fail "the added candidate"
 cmp "$L/reference/loop.json" "$L/slurm/loop.json" || fail "the loop on Slurm differs from the loop in process"
+
+echo "== 6. a closed loop on an external solver on Slurm: the same loop.json as the deck in process"
+X="$W/external"
+mkdir -p "$X"
+cp examples/loop/external/drop.k examples/loop/external/bounds.csv examples/loop/external/test.csv \
+  examples/loop/external/holdout.csv examples/loop/external/deck.toml "$X/"
+# The shipped file with a Slurm executor (its [executor] table is the last) and the solver
+# named as a program: `impactcal simulate` on the rendered deck.
+sed -e '/^\[executor\]/,$d' \
+  -e "s|^template = .*|template = \"drop.k\"\ncommand = [\"$IMPACTCAL\", \"simulate\", \"--deck\", \"drop.k\", \"--out\", \"out.csv\"]|" \
+  examples/loop/external/processes.toml > "$X/slurm.toml"
+printf '[executor]\nkind = "slurm"\npoll = 0.5\nretries = 1\n' >> "$X/slurm.toml"
+"$IMPACTCAL" close-loop --config "$X/deck.toml" --out "$X/reference" 2> "$X/reference.err" \
+  || { cat "$X/reference.err"; fail "the deck's loop in process"; }
+start=$(date +%s)
+"$IMPACTCAL" close-loop --config "$X/slurm.toml" --out "$X/slurm" 2> "$X/slurm.err" \
+  || { cat "$X/slurm.err"; fail "the external solver's loop on Slurm"; }
+arrays=$(cat "$X"/slurm/runs/*/journal.jsonl | grep -c '"event":"slurm_job"')
+echo "external solver's loop on Slurm: $arrays job arrays in $(( $(date +%s) - start )) s"
+grep -q '^R vz,-4$' "$X/slurm/runs/holdout-enriched/0/drop.k" || fail "the holdout's drop speed in the deck"
+python3 - "$X/reference/loop.json" "$X/slurm/loop.json" <<'PY'
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+assert a.pop("model").startswith("deck ") and b.pop("model").startswith("solver "), "model lines"
+assert a == b, "the external solver's loop on Slurm differs from the deck's loop in process"
+assert b["verdict"] == "attributed" and b["added"][0]["name"] == "damp", (b["verdict"], b["added"])
+PY
 
 if [ "$OVERHEAD" -gt 0 ]; then
   echo "== overhead: $OVERHEAD trivial tasks"

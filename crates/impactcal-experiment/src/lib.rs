@@ -1,7 +1,7 @@
 //! Experiment files: a calibration study or a closed loop described in one TOML file, run
 //! through the library.
 //!
-//! One schema ([`schema`]) covers every section (`[model] [parameters] [space] [test]
+//! One schema ([`schema`]) covers every section (`[model] [parameters] [space] [candidates] [held] [test]
 //! [holdout] [solver] [executor] [study] [loop]`), parsed in one place with errors that
 //! name the file, the line and the key. [`model`] turns the model sections into one
 //! [`ExperimentModel`] (airframe, deck, drop tower) or an external solver; [`Experiment`]
@@ -25,6 +25,7 @@
 //! answers `point`; a program of one's own answers it by calling [`Experiment::point`]).
 
 pub mod builtin;
+pub mod declared;
 pub mod error;
 pub mod model;
 pub mod schema;
@@ -40,7 +41,7 @@ use impactcal_calibrate::study::{
 };
 use impactcal_core::enrich::rebuild;
 use impactcal_core::{Cfc, ChannelMap, Histories, IsoMme, Model, ParamGuard, TestRecord};
-use impactcal_runner::config::ExecutorTable;
+use impactcal_runner::config::{ExecutorTable, SolverSection};
 use impactcal_runner::workdir::{PARAMS, RunRecord};
 use impactcal_runner::{
     Cancel, Executor, InProcessSolver, OutputSpec, Runner, Solver, SolverCommand,
@@ -48,8 +49,9 @@ use impactcal_runner::{
 use serde::Serialize;
 
 pub use builtin::BuiltInSolver;
+pub use declared::DeclaredModel;
 pub use error::{ExperimentError, Result};
-pub use model::{Built, ExperimentModel, ModelSpec};
+pub use model::{Built, Declarations, ExperimentModel, ModelSpec};
 pub use schema::ExperimentFile;
 
 use error::io;
@@ -294,15 +296,7 @@ impl Experiment {
     fn study_runner(&self, built: &Built) -> Result<Option<SolverRuns>> {
         let table = self.executor_table();
         let (solver, in_process) = match (&self.file.solver, &table.executor) {
-            (Some(s), executor) => {
-                let program = self.program()?;
-                let solver = s
-                    .solver(self.base(), &self.path, executor, Some(&program))
-                    .map_err(|e| ExperimentError::from(e).in_section(&self.name, "solver"))?;
-                let builtin: Arc<dyn InProcessSolver + Send> =
-                    Arc::new(BuiltInSolver::new(s.quantity));
-                (solver, Some(builtin))
-            }
+            (Some(s), executor) => self.external_solver(s, executor)?,
             (None, Executor::Local) => return Ok(None),
             (None, _) => (self.point_solver(Some("velocity"))?, None),
         };
@@ -314,6 +308,26 @@ impl Experiment {
             space: built.space.clone(),
             runner,
         }))
+    }
+
+    /// The solver of `[solver]` on `executor`, its templates holding the declared
+    /// candidates and held quantities at their held values, and the built-in solver for a
+    /// run without a `command` in this process.
+    fn external_solver(
+        &self,
+        s: &SolverSection,
+        executor: &Executor,
+    ) -> Result<(Solver, Option<Arc<dyn InProcessSolver + Send>>)> {
+        let program = self.program()?;
+        let solver = s
+            .solver(self.base(), &self.path, executor, Some(&program))
+            .map_err(|e| ExperimentError::from(e).in_section(&self.name, "solver"))?;
+        let declared = Declarations {
+            candidates: self.file.candidates.clone(),
+            held: self.file.held.clone(),
+        };
+        let builtin: Arc<dyn InProcessSolver + Send> = Arc::new(BuiltInSolver::new(s.quantity));
+        Ok((declared::holding(solver, &declared.values()), Some(builtin)))
     }
 
     /// `[executor]` (default: in this process, 2 retries).
@@ -373,10 +387,13 @@ impl Experiment {
 
     /// [`Experiment::close_loop`] telling `observer` about its stages and notes.
     ///
+    /// An external solver's loop runs every stage through the runner on `[executor]` (in
+    /// process by default), its candidates and held quantities those of `[candidates]` and
+    /// `[held]`.
+    ///
     /// # Errors
-    /// [`ExperimentError::File`] for an external solver (the loop needs a model that lists
-    /// its candidate effects); the model's, the test's and the loop's errors
-    /// ([`run_loop_on`]); I/O errors writing the results.
+    /// The model's, the test's and the loop's errors ([`run_loop_on`]); I/O errors writing
+    /// the results.
     pub fn close_loop_with(
         &self,
         out: &Path,
@@ -386,9 +403,7 @@ impl Experiment {
         let Some(model) = &built.model else {
             return Err(ExperimentError::File {
                 file: self.name.clone(),
-                message: "[solver]: the closed loop needs a model that lists its candidate \
-                          effects"
-                    .into(),
+                message: "the closed loop needs a model that lists its candidate effects".into(),
             });
         };
         let measured = self.measured()?;
@@ -418,10 +433,19 @@ impl Experiment {
         write_loop(result, out)
     }
 
-    /// The worker of a loop whose `[executor]` runs processes: `point` on this file in each
-    /// run's directory. `None` in process.
+    /// The worker of a loop: for an external solver, the solver on `[executor]` (any
+    /// executor, the local one included); for a built-in model on a process pool or Slurm,
+    /// `point` on this file in each run's directory. `None` for a built-in model in
+    /// process.
     fn worker(&self) -> Result<Option<Runner>> {
         let table = self.executor_table();
+        if let Some(s) = &self.file.solver {
+            let (solver, in_process) = self.external_solver(s, &table.executor)?;
+            return Ok(Some(Runner {
+                in_process,
+                ..self.runner(table, solver)?
+            }));
+        }
         if table.executor == Executor::Local {
             return Ok(None);
         }
@@ -454,7 +478,7 @@ impl Experiment {
     /// condition it cannot hold; the model's own errors.
     pub fn point_at(&self, record: &RunRecord) -> Result<Histories> {
         let built = self.build()?;
-        let Some(model) = &built.model else {
+        let (Some(model), None) = (&built.model, &self.file.solver) else {
             return Err(ExperimentError::File {
                 file: self.name.clone(),
                 message: "`point` runs the built-in model of a file; this one names a [solver]"

@@ -9,8 +9,12 @@
 //!   `[parameters]` may give other names; the space a bounds file or `[parameters]` (each
 //!   quantity +-20 % about the deck's value);
 //! - the drop tower (`kind = "drop-tower"`) at the condition `set`;
-//! - an external solver (`[solver]`): no model in this process, the space a bounds file
-//!   naming the template's parameters.
+//! - an external solver (`[solver]`): the space a bounds file naming the template's
+//!   parameters, the candidates and held quantities those of `[candidates]` and `[held]`
+//!   ([`DeclaredModel`], its runs the runner's);
+//! - a parameterised deck with `[candidates]` or `[held]`: the same declared model, run in
+//!   this process on the deck's `*PARAMETER` cards (the in-process twin of the deck as a
+//!   template).
 //!
 //! Every built-in model is one [`ExperimentModel`], which implements [`Model`] and
 //! [`Enrichable`] by delegating to the model it holds, so that the study, the loop and a
@@ -28,7 +32,7 @@ use impactcal_core::{
     CoreError, Enrichable, Histories, Model, Parameter, ParameterSpace, Result as CoreResult,
 };
 use impactcal_runner::config::SolverSection;
-use impactcal_runner::fingerprint;
+use impactcal_runner::{Executor, Runner, Template, fingerprint};
 use impactcal_shell::DeckModel;
 use impactcal_shell::airframe::{
     Airframe, AirframeModel, AirframeOptions, AirframeValues, MeshDensity, Preset, catalogue,
@@ -36,8 +40,61 @@ use impactcal_shell::airframe::{
 };
 use impactcal_shell::keyword::read_deck;
 
+use crate::builtin::BuiltInSolver;
+use crate::declared::{DeclaredModel, Runs, candidates_of, holding};
 use crate::error::{ExperimentError, Result, io};
-use crate::schema::{ExperimentFile, SpaceSection};
+use crate::schema::{CandidateSection, ExperimentFile, SpaceSection};
+
+/// `[candidates]` and `[held]`: the quantities a deck template (or a parameterised deck)
+/// holds, the candidates with their admissible ranges.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Declarations {
+    /// `[candidates.<name>]`.
+    pub candidates: BTreeMap<String, CandidateSection>,
+    /// `[held]`.
+    pub held: BTreeMap<String, f64>,
+}
+
+impl Declarations {
+    /// Whether nothing is declared.
+    pub fn is_empty(&self) -> bool {
+        self.candidates.is_empty() && self.held.is_empty()
+    }
+
+    /// Every declared quantity at its held value.
+    pub fn values(&self) -> BTreeMap<String, f64> {
+        self.candidates
+            .iter()
+            .map(|(n, c)| (n.clone(), c.held))
+            .chain(self.held.iter().map(|(n, v)| (n.clone(), *v)))
+            .collect()
+    }
+
+    /// The names declared, candidates first.
+    fn names(&self) -> impl Iterator<Item = (&str, String)> {
+        self.candidates
+            .keys()
+            .map(|n| (n.as_str(), format!("candidates.{n}")))
+            .chain(self.held.keys().map(|n| (n.as_str(), "held".to_string())))
+    }
+
+    /// Refuses a declared name that is also a parameter of `space`.
+    fn check_against(&self, space: &ParameterSpace, name: &str) -> Result<()> {
+        for (n, section) in self.names() {
+            if space.index_of(n).is_some() {
+                return Err(fault(
+                    name,
+                    &section,
+                    format!(
+                        "`{n}` is also a parameter of [space]: a quantity is calibrated or \
+                         held, not both"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
 
 /// What the model sections of a file describe, before anything is read.
 #[derive(Debug, Clone)]
@@ -62,6 +119,9 @@ pub enum ModelSpec {
         parameters: BTreeMap<String, String>,
         /// The declared parameters.
         space: SpaceSection,
+        /// Candidates and held quantities among the deck's `*PARAMETER`s (none: the deck
+        /// lists its own).
+        declared: Declarations,
     },
     /// The built-in drop tower at a condition.
     DropTower {
@@ -74,6 +134,8 @@ pub enum ModelSpec {
         solver: Box<SolverSection>,
         /// The declared parameters (a bounds file naming the template's parameters).
         space: SpaceSection,
+        /// The template's candidates and held quantities.
+        declared: Declarations,
     },
 }
 
@@ -87,6 +149,8 @@ pub enum ExperimentModel {
     Deck(Box<Subspace<DeckModel>>),
     /// The drop tower.
     DropTower(DropTower),
+    /// A deck template or parameterised deck with declared candidates and held quantities.
+    Declared(Box<DeclaredModel>),
 }
 
 /// Calls `$body` with `$m` bound to the model inside `$self`, whatever its kind; `$wrap`
@@ -97,6 +161,7 @@ macro_rules! each {
             ExperimentModel::Airframe($m) => $body,
             ExperimentModel::Deck($m) => $body,
             ExperimentModel::DropTower($m) => $body,
+            ExperimentModel::Declared($m) => $body,
         }
     };
     ($self:expr, $m:ident => $body:expr, wrap) => {
@@ -104,6 +169,7 @@ macro_rules! each {
             ExperimentModel::Airframe($m) => ExperimentModel::Airframe(Box::new($body)),
             ExperimentModel::Deck($m) => ExperimentModel::Deck(Box::new($body)),
             ExperimentModel::DropTower($m) => ExperimentModel::DropTower($body),
+            ExperimentModel::Declared($m) => ExperimentModel::Declared(Box::new($body)),
         }
     };
 }
@@ -143,7 +209,8 @@ impl Enrichable for ExperimentModel {
 /// A model built from its spec.
 #[derive(Debug, Clone)]
 pub struct Built {
-    /// The model (`None` for an external solver).
+    /// The model (for an external solver, a [`DeclaredModel`] whose runs go through the
+    /// runner in this process; a study or loop on an executor runs them there instead).
     pub model: Option<ExperimentModel>,
     /// The declared parameters.
     pub space: ParameterSpace,
@@ -173,6 +240,20 @@ impl ModelSpec {
         let space = file.space.clone();
         let params = &file.parameters;
         let no_space = space.preset.is_none() && space.bounds.is_none();
+        let declared = Declarations {
+            candidates: file.candidates.clone(),
+            held: file.held.clone(),
+        };
+        let declares = |what: &str| -> Result<()> {
+            if declared.is_empty() {
+                Ok(())
+            } else {
+                Err(fault(&format!(
+                    "[candidates] and [held] declare the held quantities of a deck template or \
+                     a parameterised deck; {what} lists its own candidates"
+                )))
+            }
+        };
         match (&m.kind, &m.airframe, &m.deck, &file.solver) {
             (Some(k), None, None, None) if k == "drop-tower" => {
                 if !no_space || !params.is_empty() || m.end_time.is_some() {
@@ -181,6 +262,7 @@ impl ModelSpec {
                          decks; the drop tower declares modulus and k_contact",
                     ));
                 }
+                declares("the drop tower")?;
                 Ok(ModelSpec::DropTower {
                     set: m.set.into_iter().collect(),
                 })
@@ -196,6 +278,7 @@ impl ModelSpec {
                          catalogue's",
                     ));
                 }
+                declares("the airframe")?;
                 Ok(ModelSpec::Airframe {
                     mesh: mesh.clone(),
                     end_time: m.end_time,
@@ -210,10 +293,17 @@ impl ModelSpec {
                          instead",
                     ));
                 }
+                if !declared.is_empty() && !params.is_empty() {
+                    return Err(fault(
+                        "[parameters] renames deck quantities; with [candidates] or [held] the \
+                         deck's *PARAMETER names are the experiment's",
+                    ));
+                }
                 Ok(ModelSpec::Deck {
                     path: deck.clone(),
                     parameters: params.clone(),
                     space,
+                    declared,
                 })
             }
             (None, None, None, Some(solver)) if file.model.is_none() => {
@@ -226,6 +316,7 @@ impl ModelSpec {
                 Ok(ModelSpec::External {
                     solver: Box::new(solver.clone()),
                     space,
+                    declared,
                 })
             }
             _ => Err(fault(
@@ -255,7 +346,14 @@ impl ModelSpec {
                 path,
                 parameters,
                 space,
-            } => deck(&resolve(base, path), parameters, space, base, name),
+                declared,
+            } if declared.is_empty() => deck(&resolve(base, path), parameters, space, base, name),
+            ModelSpec::Deck {
+                path,
+                space,
+                declared,
+                ..
+            } => declared_deck(&resolve(base, path), space, declared, base, name),
             ModelSpec::DropTower { set } => {
                 let model = DropTower::new().at_condition(set)?;
                 Ok(Built {
@@ -266,7 +364,11 @@ impl ModelSpec {
                     notes: Vec::new(),
                 })
             }
-            ModelSpec::External { solver, space } => external(solver, space, base, name),
+            ModelSpec::External {
+                solver,
+                space,
+                declared,
+            } => external(solver, space, declared, base, name),
         }
     }
 }
@@ -442,11 +544,13 @@ fn deck(
     })
 }
 
-/// An external solver: its description fingerprints the `[solver]` table and the text of
-/// its templates, so that a changed deck or command is another study.
+/// An external solver: its description fingerprints the `[solver]` table, the text of its
+/// templates and the declarations, so that a changed deck, command, range or held value is
+/// another study or loop. The model runs the solver through a runner in this process.
 fn external(
     solver: &SolverSection,
     space: &SpaceSection,
+    declared: &Declarations,
     base: &Path,
     name: &str,
 ) -> Result<Built> {
@@ -455,6 +559,9 @@ fn external(
         let p = resolve(base, p);
         bytes.extend(std::fs::read(&p).map_err(io(&p))?);
     }
+    if !declared.is_empty() {
+        bytes.extend(format!("{declared:?}").as_bytes());
+    }
     let Some(space) = declared_space(space, base, name)? else {
         return Err(fault(
             name,
@@ -462,8 +569,24 @@ fn external(
             "an external solver needs `bounds = \"bounds.csv\"` naming its template's parameters",
         ));
     };
+    declared.check_against(&space, name)?;
+    let local = solver
+        .solver(base, Path::new(name), &Executor::Local, None)
+        .map_err(|e| ExperimentError::from(e).in_section(name, "solver"))?;
+    let templates: Vec<&Template> = local.inputs.iter().map(|(t, _)| t).collect();
+    check_template(&templates, &space, declared, name)?;
+    let runner = Runner {
+        in_process: Some(std::sync::Arc::new(BuiltInSolver::new(solver.quantity))),
+        ..Runner::new(holding(local, &declared.values()), Executor::Local)
+    };
+    let model = DeclaredModel::new(
+        space.clone(),
+        candidates_of(&declared.candidates)?,
+        &declared.held,
+        Runs::Solver(Box::new(runner)),
+    )?;
     Ok(Built {
-        model: None,
+        model: Some(ExperimentModel::Declared(Box::new(model))),
         space,
         description: format!(
             "solver {} ({})",
@@ -472,6 +595,120 @@ fn external(
         ),
         geometry: None,
         notes: Vec::new(),
+    })
+}
+
+/// Checks a template against what the file declares: every `<<name>>` placeholder a
+/// parameter of the space, a candidate or a held quantity, and every candidate and held
+/// quantity somewhere in the templates (a placeholder or an `R`/`I` `*PARAMETER` entry).
+fn check_template(
+    templates: &[&Template],
+    space: &ParameterSpace,
+    declared: &Declarations,
+    name: &str,
+) -> Result<()> {
+    let known: Vec<&str> = space
+        .names()
+        .into_iter()
+        .chain(declared.names().map(|(n, _)| n))
+        .collect();
+    for t in templates {
+        if let Some(p) = t
+            .placeholder_names()
+            .into_iter()
+            .find(|p| !known.contains(p))
+        {
+            return Err(fault(
+                name,
+                "solver",
+                format!(
+                    "template {}: `<<{p}>>` is neither a parameter of [space], a [candidates] \
+                     entry nor a [held] quantity; closest: {}",
+                    t.file(),
+                    near(p, &known)
+                ),
+            ));
+        }
+    }
+    for (n, section) in declared.names() {
+        if !templates.iter().any(|t| t.names().contains(n)) {
+            return Err(fault(
+                name,
+                &section,
+                format!(
+                    "`{n}` appears nowhere in the template (neither a <<{n}>> placeholder nor \
+                     an R/I *PARAMETER entry), so no run could write it"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A parameterised deck with declared candidates and held quantities, run in this process:
+/// the space a bounds file naming the deck's real `*PARAMETER`s, every candidate and held
+/// quantity one of them too.
+fn declared_deck(
+    path: &Path,
+    space: &SpaceSection,
+    declared: &Declarations,
+    base: &Path,
+    name: &str,
+) -> Result<Built> {
+    let bytes = std::fs::read(path).map_err(io(path))?;
+    let read = read_deck(path)?;
+    let Some(space) = declared_space(space, base, name)? else {
+        return Err(fault(
+            name,
+            "space",
+            "give `bounds = \"bounds.csv\"` naming the deck's *PARAMETERs",
+        ));
+    };
+    declared.check_against(&space, name)?;
+    let reals: Vec<&str> = read
+        .parameters
+        .iter()
+        .filter(|p| !p.integer && p.expression.is_none())
+        .map(|p| p.name.as_str())
+        .collect();
+    let sections = space
+        .names()
+        .into_iter()
+        .map(|n| (n, "space".to_string()))
+        .collect::<Vec<_>>();
+    for (n, section) in sections.into_iter().chain(declared.names()) {
+        if !reals.iter().any(|r| r.eq_ignore_ascii_case(n)) {
+            return Err(fault(
+                name,
+                &section,
+                format!(
+                    "`{n}` is not a real *PARAMETER of {}; closest: {}",
+                    path.display(),
+                    near(n, &reals)
+                ),
+            ));
+        }
+    }
+    let notes = read.warnings.clone();
+    let model = DeclaredModel::new(
+        space.clone(),
+        candidates_of(&declared.candidates)?,
+        &declared.held,
+        Runs::Deck {
+            deck: Box::new(read),
+            quantity: impactcal_core::NodalQuantity::Velocity,
+        },
+    )?;
+    Ok(Built {
+        model: Some(ExperimentModel::Declared(Box::new(model))),
+        space,
+        description: format!(
+            "deck {} ({}) declaring {declared:?}",
+            path.display(),
+            fingerprint(&bytes)
+        ),
+        geometry: None,
+        notes,
     })
 }
 

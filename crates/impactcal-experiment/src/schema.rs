@@ -25,6 +25,15 @@
 //! [solver]                 # instead of [model]: an external solver (deck template, command)
 //! template = "deck.k"
 //!
+//! [candidates.damp]        # a template's (or parameterised deck's) held quantity the loop may free
+//! lower = 0.0
+//! upper = 1000.0
+//! held = 0.0
+//! description = "mass-proportional damping (1/s)"
+//!
+//! [held]                   # quantities the template holds at one value (test conditions)
+//! vz = -5.0
+//!
 //! [executor]               # where runs happen: "local" (default) | "processes" | "slurm"
 //! kind = "processes"
 //! jobs = 2                 # default: the machine's cores
@@ -79,6 +88,29 @@ pub struct ExperimentFile {
     /// `[loop]`: the closed loop's options.
     #[serde(default, rename = "loop")]
     pub loop_options: LoopOptions,
+    /// `[candidates.<name>]`: the held quantities of a deck template (or a parameterised
+    /// deck) that the closed loop may free, each with its admissible range and held value.
+    #[serde(default)]
+    pub candidates: BTreeMap<String, CandidateSection>,
+    /// `[held]`: quantities the template holds at one value (a test condition such as the
+    /// impact speed), which a holdout's `set` may change.
+    #[serde(default)]
+    pub held: BTreeMap<String, f64>,
+}
+
+/// `[candidates.<name>]`: a held quantity the closed loop may add to the model.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CandidateSection {
+    /// Lower end of its admissible range (where a fitted value is physical).
+    pub lower: f64,
+    /// Upper end of its admissible range.
+    pub upper: f64,
+    /// The value the model holds it at until the loop frees it.
+    pub held: f64,
+    /// What it is (in the loop's report).
+    #[serde(default)]
+    pub description: Option<String>,
 }
 
 /// `[model]`.
@@ -141,6 +173,8 @@ pub const SECTIONS: &[(&str, Option<&[&str]>)] = &[
         Some(&["kind", "airframe", "deck", "end_time", "set"]),
     ),
     ("parameters", None),
+    ("candidates", None),
+    ("held", None),
     ("space", Some(&["preset", "bounds"])),
     ("test", Some(&["data", "map", "cfc", "sigma"])),
     ("holdout", Some(&["data", "set"])),
@@ -267,7 +301,109 @@ pub fn parse(text: &str, file: &str) -> Result<ExperimentFile> {
     if !written("shapes") {
         parsed.study.shapes = parsed.study.shapes.min(parsed.study.sensors);
     }
+    check_declared(&parsed, doc.get_ref(), text, file)?;
     Ok(parsed)
+}
+
+/// The 1-based line of the key `path` (a section, then keys below it) in `doc`, or 0.
+fn line_of(doc: &DeTable<'_>, path: &[&str], text: &str) -> usize {
+    let mut table = doc;
+    let mut line = 0;
+    for key in path {
+        let Some((k, v)) = table.iter().find(|(k, _)| k.get_ref().as_ref() == *key) else {
+            break;
+        };
+        line = line_col(text, k.span().start).0;
+        match v.get_ref().as_table() {
+            Some(t) => table = t,
+            None => break,
+        }
+    }
+    line
+}
+
+/// Checks `[candidates]`, `[held]` and, for a file that declares them or names a
+/// `[solver]`, the holdout's condition: each range `lower < upper` with the held value in
+/// it, every value finite, no name both a candidate and held, and a holdout `set` that
+/// names only candidates and held quantities.
+fn check_declared(f: &ExperimentFile, doc: &DeTable<'_>, text: &str, file: &str) -> Result<()> {
+    let key = |path: &[&str], message: String| ExperimentError::Key {
+        file: file.to_string(),
+        line: line_of(doc, path, text),
+        key: match path {
+            [s, n, k, ..] => format!("[{s}.{n}] {k}"),
+            [s, n] if *s == "candidates" => format!("[{s}.{n}]"),
+            [s, n] => format!("[{s}] {n}"),
+            _ => path.join("."),
+        },
+        message,
+    };
+    for (name, c) in &f.candidates {
+        for (k, v) in [("lower", c.lower), ("upper", c.upper), ("held", c.held)] {
+            if !v.is_finite() {
+                return Err(key(
+                    &["candidates", name, k],
+                    format!("{v}: must be finite"),
+                ));
+            }
+        }
+        if c.lower >= c.upper {
+            return Err(key(
+                &["candidates", name, "upper"],
+                format!(
+                    "{}: must exceed lower = {} (the admissible range is [lower, upper])",
+                    c.upper, c.lower
+                ),
+            ));
+        }
+        if !(c.lower..=c.upper).contains(&c.held) {
+            return Err(key(
+                &["candidates", name, "held"],
+                format!(
+                    "{}: outside the admissible range [{}, {}]",
+                    c.held, c.lower, c.upper
+                ),
+            ));
+        }
+        if f.held.contains_key(name) {
+            return Err(key(
+                &["held", name],
+                format!("`{name}` is also [candidates.{name}]: declare it once"),
+            ));
+        }
+    }
+    for (name, v) in &f.held {
+        if !v.is_finite() {
+            return Err(key(&["held", name], format!("{v}: must be finite")));
+        }
+    }
+    let declares =
+        !f.candidates.is_empty() || !f.held.is_empty() || (f.solver.is_some() && f.model.is_none());
+    if let (true, Some(h)) = (declares, &f.holdout) {
+        let known: Vec<&str> = f
+            .candidates
+            .keys()
+            .chain(f.held.keys())
+            .map(String::as_str)
+            .collect();
+        for name in h.set.keys() {
+            if !known.contains(&name.as_str()) {
+                return Err(key(
+                    &["holdout", "set"],
+                    format!(
+                        "`{name}` is neither a [candidates] entry nor a [held] quantity, so no \
+                         run can hold it at another value; {}",
+                        if known.is_empty() {
+                            "declare it in [held] with its value in the calibration test".into()
+                        } else {
+                            format!("closest declared: {}", closest(name, &known))
+                        }
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The `line L, column C: message` of a TOML error.

@@ -130,13 +130,16 @@ impl Solver {
     }
 
     /// A 64-bit fingerprint (hex) of everything that decides a run's result: the rendered
-    /// form of the templates (their text), the input names, the command and the output
+    /// form of the templates (their text and held values), the input names, the command and the output
     /// spec. A journal written for another fingerprint is not resumed.
     pub fn fingerprint(&self) -> String {
         let mut h = Fnv::default();
         for (t, name) in &self.inputs {
             h.add(name.as_bytes());
             h.add(t.text().as_bytes());
+            for (name, value) in t.held() {
+                h.add(format!("{name}={value:?}").as_bytes());
+            }
         }
         h.add(format!("{:?}", self.command).as_bytes());
         h.add(format!("{:?}", self.output).as_bytes());

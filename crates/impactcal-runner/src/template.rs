@@ -15,8 +15,13 @@
 //! `*PARAMETER` entries that no parameter names keep the template's value. The values
 //! actually written (after rounding to fit a field) are returned so that they can be
 //! recorded with the run.
+//!
+//! A template may also hold quantities at given values ([`Template::holding`]): a name a
+//! run does not give is then written at its held value, as a closed loop needs for the
+//! candidate effects it has not freed and the test conditions (an impact speed) it does not
+//! change.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 use crate::error::{Result, RunnerError};
@@ -54,6 +59,7 @@ pub struct Template {
     file: String,
     lines: Vec<String>,
     fields: Vec<Field>,
+    held: BTreeMap<String, f64>,
 }
 
 impl Template {
@@ -101,7 +107,24 @@ impl Template {
             file: file.to_string(),
             lines,
             fields,
+            held: BTreeMap::new(),
         })
+    }
+
+    /// The same template holding the quantities `held` at their values: a field whose name
+    /// a run does not give (neither a coordinate nor part of its condition) is written at
+    /// the held value, and a placeholder naming a held quantity is not an unknown name.
+    /// Names the template does not use are ignored. A run that gives a held name writes its
+    /// own value.
+    #[must_use]
+    pub fn holding(mut self, held: &BTreeMap<String, f64>) -> Template {
+        self.held = held.clone();
+        self
+    }
+
+    /// The quantities held ([`Template::holding`]).
+    pub fn held(&self) -> &BTreeMap<String, f64> {
+        &self.held
     }
 
     /// The template's text as read.
@@ -120,8 +143,9 @@ impl Template {
         self.fields.iter().map(|f| f.name.as_str()).collect()
     }
 
-    /// The names of the placeholders (which must all be parameters of the batch).
-    fn placeholder_names(&self) -> BTreeSet<&str> {
+    /// The names of the placeholders `<<name>>` (each must be a parameter of a batch or a
+    /// held quantity), sorted.
+    pub fn placeholder_names(&self) -> BTreeSet<&str> {
         self.fields
             .iter()
             .filter(|f| matches!(f.style, Style::Placeholder { .. }))
@@ -138,7 +162,7 @@ impl Template {
         let unknown: Vec<&str> = self
             .placeholder_names()
             .into_iter()
-            .filter(|n| !names.iter().any(|m| m == n))
+            .filter(|n| !names.iter().any(|m| m == n) && !self.held.contains_key(*n))
             .collect();
         if unknown.is_empty() {
             Ok(())
@@ -156,9 +180,10 @@ impl Template {
         }
     }
 
-    /// The text with every field filled from `values` (in the order of `names`), and the
-    /// values as written (after rounding to fit), in the same order. Names the template does
-    /// not use are written nowhere and recorded as given.
+    /// The text with every field filled from `values` (in the order of `names`), or from
+    /// the held values for a name not among `names`, and the values as written (after
+    /// rounding to fit), in the order of `names`. Names the template does not use are
+    /// written nowhere and recorded as given.
     ///
     /// # Errors
     /// [`RunnerError::Value`] for run `run` when a value does not fit its field (an integer
@@ -176,10 +201,13 @@ impl Template {
         let mut order: Vec<&Field> = self.fields.iter().collect();
         order.sort_by(|a, b| (a.line, b.start).cmp(&(b.line, a.start)));
         for f in order {
-            let Some(k) = names.iter().position(|n| *n == f.name) else {
+            let k = names.iter().position(|n| *n == f.name);
+            let Some(value) = k
+                .map(|k| values[k])
+                .or_else(|| self.held.get(&f.name).copied())
+            else {
                 continue;
             };
-            let value = values[k];
             let fail = |message: String| RunnerError::Value {
                 run,
                 name: f.name.clone(),
@@ -194,7 +222,9 @@ impl Template {
                 }
             }
             .map_err(fail)?;
-            written[k] = as_written;
+            if let Some(k) = k {
+                written[k] = as_written;
+            }
             let text = match f.style {
                 Style::Placeholder { width: Some(w) } => format!("{text:>w$}"),
                 Style::Parameter { fixed: true, .. } => format!("{text:>10}"),
@@ -473,6 +503,30 @@ mod tests {
         assert_eq!(written, vec![0.0031, 5.0, 2.0e11]);
         // Untouched lines are kept byte for byte.
         assert_eq!(lines[2], "$ name     value");
+    }
+
+    #[test]
+    fn held_quantities_fill_what_a_run_does_not_give() {
+        let deck = "<<a>> <<damp>>\n*PARAMETER\nR fric,0.3\nR v,-5.0\n";
+        let held: BTreeMap<String, f64> = [("damp".to_string(), 0.0), ("fric".to_string(), 0.25)]
+            .into_iter()
+            .collect();
+        let t = Template::parse(deck, "d.k").unwrap().holding(&held);
+        // `damp` is no unknown placeholder once held.
+        check_names(&[&t], &names(&["a"])).unwrap();
+        let (text, written) = t.render(0, &names(&["a"]), &[1.5]).unwrap();
+        assert_eq!(text, "1.5 0\n*PARAMETER\nR fric,0.25\nR v,-5.0\n");
+        assert_eq!(written, vec![1.5]);
+        // A run that gives a held name (a freed candidate, a condition) writes its own value.
+        let (text, written) = t
+            .render(0, &names(&["a", "damp", "v"]), &[1.5, 40.25, -4.5])
+            .unwrap();
+        assert_eq!(text, "1.5 40.25\n*PARAMETER\nR fric,0.25\nR v,-4.5\n");
+        assert_eq!(written, vec![1.5, 40.25, -4.5]);
+        // Without holding, `damp` names nothing.
+        let bare = Template::parse(deck, "d.k").unwrap();
+        let e = check_names(&[&bare], &names(&["a"])).unwrap_err();
+        assert!(e.to_string().contains("`damp` names no parameter"), "{e}");
     }
 
     #[test]
