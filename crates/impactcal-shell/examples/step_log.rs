@@ -176,7 +176,10 @@ fn main() -> ExitCode {
             let p = s.nodes.map(|n| x[index[&n]]);
             let (a, side, diag) = lengths(&p, tri);
             let flat_side = lengths_in(&p, tri, true).1;
-            for (k, l) in rule_lengths(a, side, diag, flat_side, tri).iter().enumerate() {
+            for (k, l) in rule_lengths(a, side, diag, flat_side, tri)
+                .iter()
+                .enumerate()
+            {
                 let dte = l / c;
                 if dte < best[k].0 {
                     best[k] = (dte, e);

@@ -333,3 +333,73 @@ fn results_do_not_depend_on_the_thread_count() {
         assert_eq!(a.energies.data(), b.energies.data());
     }
 }
+
+/// The internal energy over the kinetic energy after a warped, distorted plate read from
+/// `deck` has spun rigidly about an in-plane axis through 0.01 rad.
+fn strain_of_a_rigid_spin(deck: &str) -> f64 {
+    let mut m = impactcal_shell::keyword::parse_deck(deck, "warped.k")
+        .unwrap()
+        .model;
+    let c = m.nodes.iter().fold([0.0; 3], |a, p| {
+        [0, 1, 2].map(|k| a[k] + p.x[k] / m.nodes.len() as f64)
+    });
+    let mut spin = InitialVelocity::translation(VelocityTarget::All, [0.0; 3]);
+    spin.omega = 50.0;
+    spin.centre = c;
+    spin.axis = [0.6, 0.8, 0.0];
+    m.initial_velocities = vec![spin];
+    m.control.end_time = 1.0;
+    let mut sim = Simulation::new(&m).unwrap();
+    while sim.time() < 0.01 / 50.0 {
+        sim.step().unwrap();
+    }
+    let e = sim.energies();
+    e.internal / e.kinetic
+}
+
+/// `*CONTROL_SHELL` BWC 1 with PROJ 1 is the full projection: a warped plate read with it
+/// spins rigidly without straining (to the second-order stretch of the central-difference
+/// rotation); read without the keyword (BWC 2, LS-DYNA's Belytschko-Tsay shell without a
+/// warping treatment) the same spin strains it; the drill projection is refused.
+#[test]
+fn control_shell_bwc_and_proj_choose_the_warping_projection() {
+    let mut m = random_plate(5, 4, 0.15);
+    m.initial_velocities.clear();
+    let projected = impactcal_shell::keyword::write_deck(&m).unwrap();
+    assert!(projected.contains("*CONTROL_SHELL"));
+    let read = |d: &str| {
+        impactcal_shell::keyword::parse_deck(d, "warped.k")
+            .unwrap()
+            .model
+            .control
+            .warping_projection
+    };
+    assert!(read(&projected));
+    let card = format!("{}{:>10}{:>10}{:>10}", " ".repeat(50), 1, 0, 1);
+    assert!(projected.contains(&card));
+    let plain = projected.replace(&format!("*CONTROL_SHELL\n{card}\n"), "");
+    assert!(!plain.contains("*CONTROL_SHELL"));
+    assert!(!read(&plain));
+    let bwc2 = projected.replace(
+        &card,
+        &format!("{}{:>10}{:>10}{:>10}", " ".repeat(50), 2, 0, 1),
+    );
+    assert!(!read(&bwc2));
+
+    let with = strain_of_a_rigid_spin(&projected);
+    let without = strain_of_a_rigid_spin(&plain);
+    eprintln!("internal / kinetic after the spin: projection {with:e}, none {without:e}");
+    assert!(with < 1e-6, "projection on: internal / kinetic {with:e}");
+    assert!(
+        without > 100.0 * with,
+        "projection off: {without:e} against {with:e}"
+    );
+
+    let drill = projected.replace(
+        &card,
+        &format!("{}{:>10}{:>10}{:>10}", " ".repeat(50), 1, 0, 0),
+    );
+    let err = impactcal_shell::keyword::parse_deck(&drill, "warped.k").unwrap_err();
+    let msg = err.to_string();
+    assert!(msg.contains("PROJ") && msg.contains("drill"), "{msg}");
+}

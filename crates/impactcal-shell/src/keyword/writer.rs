@@ -181,6 +181,17 @@ fn write_controls(model: &ShellModel, o: &mut Out) -> Result<()> {
             int_signed(-2, 10)
         ));
     }
+    if c.warping_projection {
+        // BWC 1 with PROJ 1: the full projection (without the keyword a deck reads BWC 2).
+        o.w("*CONTROL_SHELL".into());
+        o.w(format!(
+            "{}{}{}{}",
+            " ".repeat(50),
+            int(1, 10),
+            int(0, 10),
+            int(1, 10)
+        ));
+    }
     if c.invariant_numbering {
         o.w("*CONTROL_ACCURACY".into());
         o.w(format!("{}{}", int(0, 10), int(2, 10)));
