@@ -403,3 +403,138 @@ fn control_shell_bwc_and_proj_choose_the_warping_projection() {
     let msg = err.to_string();
     assert!(msg.contains("PROJ") && msg.contains("drill"), "{msg}");
 }
+
+/// The plain Belytschko-Tsay quad (no warping projection, LS-DYNA's BWC 2) under a rigid
+/// rotation of a mildly warped quad, against its closed form. The element's strain rates
+/// (membrane, curvature, transverse shear) never see the warp, so the section stresses stay
+/// zero; only the two membrane hourglass rates do, through `gamma . z = 4 w`
+/// (`w = h . z / 4`, `z` the corners' heights over the mean plane): a rotation `phi` about
+/// an in-plane axis stores `E_hg = C_m (4 w phi)^2 / 2` with the stiffness-form coefficient
+/// `C_m = r E t A (B . B) / 8 = r E t (|d31|^2 + |d42|^2) / (16 A)`, `A = |d31 x d42| / 2`.
+/// The spurious energy therefore grows as the warp squared and with the hourglass
+/// coefficient, and the full projection removes it.
+#[test]
+fn the_plain_element_strains_a_rotating_warped_quad_only_through_its_membrane_hourglass() {
+    let t = 0.001;
+    let p = props(t, 5);
+    let a = 0.01;
+    let phi = 0.01;
+    let steps = 2000;
+    let rate = 50.0;
+    let dt = phi / rate / steps as f64;
+    let mut last = None;
+    for (case, eps) in [0.01, 0.02, 0.05].into_iter().enumerate() {
+        // A distorted quad warped by eps of its size, about its centroid.
+        let wz = eps * a;
+        let x0 = [
+            [0.0, 0.0, wz],
+            [1.1 * a, 0.1 * a, -wz],
+            [1.0 * a, 0.9 * a, wz],
+            [-0.1 * a, 1.2 * a, -wz],
+        ];
+        let c: [f64; 3] = std::array::from_fn(|k| x0.iter().map(|q| q[k]).sum::<f64>() / 4.0);
+        let x0 = x0.map(|q| [q[0] - c[0], q[1] - c[1], q[2] - c[2]]);
+        // Closed form from the geometry alone.
+        let sub = |i: usize, j: usize| [0, 1, 2].map(|k| x0[i][k] - x0[j][k]);
+        let (d31, d42) = (sub(2, 0), sub(3, 1));
+        let n = cross(d31, d42);
+        let nn = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let e3 = n.map(|c| c / nn);
+        let area = 0.5 * nn;
+        let w = [0, 1, 2]
+            .map(|k| (x0[0][k] - x0[1][k] + x0[2][k] - x0[3][k]) * e3[k])
+            .iter()
+            .sum::<f64>()
+            / 4.0;
+        let sq = |d: [f64; 3]| d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let cm = 0.05 * E * t * (sq(d31) + sq(d42)) / (16.0 * area);
+        // The axis: in the element's plane, skewed.
+        let axis = cross(e3, [0.3, 0.8, 0.5]);
+        let predicted = 0.5 * cm * (4.0 * w * phi).powi(2);
+        for projection in [false, true] {
+            let opts = KernelOptions {
+                projection,
+                isdo_diagonal: false,
+                invariant: false,
+            };
+            let an = sq(axis).sqrt();
+            let om = axis.map(|c| c / an * rate);
+            let mut st = vec![0.0; STATE_HEAD + 5 * STATE_PER_POINT];
+            let (mut hourglass, mut internal) = (0.0, 0.0);
+            for k in 1..=steps {
+                let r = rotation(axis, rate * k as f64 * dt);
+                let x = x0.map(|q| apply(&r, q));
+                let v = x.map(|q| cross(om, q));
+                let out = element::quad(&x, &v, &[om; 4], &p, &mut st, dt, opts).unwrap();
+                hourglass += out.hourglass;
+                internal += out.internal;
+            }
+            let stress = st[STATE_HEAD..].iter().fold(0.0f64, |m, s| m.max(s.abs()));
+            assert!(stress < 1e-15 * E, "case {case}: point stress {stress:e}");
+            assert!(
+                internal.abs() < 1e-12 * predicted,
+                "case {case}: {internal:e}"
+            );
+            if projection {
+                assert!(
+                    hourglass.abs() < 1e-12 * predicted,
+                    "case {case}: {hourglass:e}"
+                );
+            } else {
+                assert!(
+                    (hourglass - predicted).abs() < 1e-6 * predicted,
+                    "case {case}: hourglass {hourglass:e} against {predicted:e}"
+                );
+                if let Some((e0, w0)) = last {
+                    let (e0, w0): (f64, f64) = (e0, w0);
+                    let ratio: f64 = hourglass / e0;
+                    let expect = (w / w0) * (w / w0);
+                    assert!((ratio - expect).abs() < 1e-6 * expect);
+                }
+                last = Some((hourglass, w));
+            }
+        }
+    }
+}
+
+/// A warped plate's rigid spin through 0.01 rad with the plain element: the energy it
+/// stores is fixed by the warp and the hourglass stiffness, not by the spin, so its ratio to
+/// the kinetic energy falls as the spin rate squared; and it grows as the warp squared.
+/// Returns (internal + hourglass) / initial kinetic energy.
+fn plain_spin_share(warp: f64, omega: f64) -> (f64, f64) {
+    let mut m = random_plate(5, 4, warp);
+    m.control.warping_projection = false;
+    let n = m.nodes.len() as f64;
+    let c = m
+        .nodes
+        .iter()
+        .fold([0.0; 3], |a, p| [0, 1, 2].map(|k| a[k] + p.x[k] / n));
+    let mut spin = InitialVelocity::translation(VelocityTarget::All, [0.0; 3]);
+    spin.omega = omega;
+    spin.centre = c;
+    spin.axis = [0.6, 0.8, 0.0];
+    m.initial_velocities = vec![spin];
+    m.control.end_time = 1.0;
+    let mut sim = Simulation::new(&m).unwrap();
+    while sim.time() < 0.01 / omega {
+        sim.step().unwrap();
+    }
+    let e = sim.energies();
+    ((e.internal + e.hourglass) / e.initial, e.hourglass)
+}
+
+#[test]
+fn the_plain_elements_spin_energy_scales_with_the_warp_squared_not_the_spin() {
+    let (mild, hg_mild) = plain_spin_share(0.01, 500.0);
+    let (five, hg_five) = plain_spin_share(0.05, 500.0);
+    let (fast, _) = plain_spin_share(0.05, 5000.0);
+    eprintln!(
+        "share of KE at 500 rad/s: warp 1 % {mild:e}, 5 % {five:e}; 5 % at 5000 rad/s {fast:e}"
+    );
+    // Warp x5: hourglass energy x25 (the nodes' random heights keep the same pattern).
+    let r = hg_five / hg_mild;
+    assert!((20.0..30.0).contains(&r), "hourglass energy ratio {r}");
+    assert!(mild < 1e-3 && five < 1e-2, "{mild:e} {five:e}");
+    // Spin x10: share / 100 (up to the centrifugal stretch of the faster spin).
+    assert!(fast < 0.1 * five, "{fast:e} against {five:e}");
+}
