@@ -3,9 +3,9 @@
 //!
 //! `cargo run --release --example step1_histories`
 
+use impactcal::core::NodalQuantity;
 use impactcal::core::sampling::sample;
 use impactcal::prelude::*;
-use impactcal::shell::Quantity;
 use impactcal::shell::keyword::read_deck;
 
 #[path = "common/impact_model.rs"]
@@ -53,7 +53,7 @@ pub fn main() -> impactcal::Result<()> {
     // The built-in explicit solver gives histories the same way, from an LS-DYNA deck.
     let deck = read_deck("examples/decks/strip_drop.k")?;
     let run = Simulation::new(&deck.model)?.run()?;
-    if let Some(v) = run.histories(Quantity::Velocity) {
+    if let Some(v) = run.histories(NodalQuantity::Velocity) {
         let vz = v.channel_by_label("21.z")?;
         println!(
             "strip drop: node 21 lands at {:.2} m/s and ends at {:.2} m/s",

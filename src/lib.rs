@@ -8,17 +8,30 @@
 //! | [`core`] | `impactcal-core` | histories, test data (CSV, ISO-MME, channel maps), CFC filters, parameter spaces and their unit-cube map, point sets (faer matrices, one point per row), the `Model` trait, sampling, CSV input, test functions, the shared error kinds | nothing |
 //! | [`shapes`] | `impactcal-shapes` | impact shapes (SVD), contributions, M2, pairing, expansion | core |
 //! | [`sensors`] | `impactcal-sensors` | sensor placement by effective independence (Kammer) | core, shapes |
-//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories | core |
+//! | [`erbf`] | `impactcal-erbf` | ERBF and classic RBF surrogates of whole time histories (with a basis of impact shapes) | core, shapes |
 //! | [`sobol`] | `impactcal-sobol` | Sobol' indices of time histories, Saltelli designs, intervals | core |
 //! | [`cors`] | `impactcal-cors` | CORS-RBF optimiser of expensive simulations (ask and tell) | core, erbf |
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe | core |
-//! | [`calibrate`] | `impactcal-calibrate` | curve metrics (Sprague-Geers, Russell, ISO/TS 18571) of a model against a test | core |
-//! | [`runner`] | `impactcal-runner` | where runs happen: in process, a local process pool, a Slurm cluster; external solvers through deck templates; work directories and a run journal | core, shell |
+//! | [`runner`] | `impactcal-runner` | where runs happen: in process, a local process pool, a Slurm cluster; external solvers through deck templates; work directories and a run journal | core (an in-process solver, such as the built-in one, is handed to it from above) |
+//! | [`calibrate`] | `impactcal-calibrate` | curve metrics (Sprague-Geers, Russell, ISO/TS 18571); the calibration study (M1, sensors, M2, surrogates, sensitivity, CORS reconciliation); the closed loop (residual, attribution, enrichment, recalibration, errors before and after); journals and reports | core, shapes, sensors, erbf, sobol, cors, runner |
+//! | [`experiment`] | `impactcal-experiment` | experiment files: one schema for studies and closed loops, model assembly (airframe, deck, drop tower, external solver), `Experiment::study`, `close_loop` and `point` | core, shell, runner, calibrate |
 //!
 //! The calibration path runs through them in this order: histories of an ensemble
 //! ([`core`], [`shell`]) give impact shapes ([`shapes`]), which place sensors ([`sensors`]);
 //! surrogates of the histories ([`erbf`]) make sensitivity ([`sobol`]) and optimisation
-//! ([`cors`]) affordable. The `examples/` directory walks that path step by step.
+//! ([`cors`]) affordable; [`calibrate`] joins them into the study and the closed loop, and
+//! [`experiment`] runs either from a file. The `examples/` directory walks that path step by
+//! step; `examples/experiment.rs` runs a study file and a loop file through the library:
+//!
+//! ```no_run
+//! use impactcal::experiment::Experiment;
+//!
+//! let study = Experiment::from_file("examples/study/deck-processes.toml")?.study("study-out")?;
+//! println!("M1: {}", study.result.m1.verdict.as_str());
+//! let closed = Experiment::from_file("examples/loop/processes.toml")?.close_loop("loop-out")?;
+//! println!("{}", closed.report.lead.join(" "));
+//! # Ok::<(), impactcal::Error>(())
+//! ```
 //!
 //! ```
 //! use impactcal::prelude::*;
@@ -39,6 +52,7 @@ pub use impactcal_calibrate as calibrate;
 pub use impactcal_core as core;
 pub use impactcal_cors as cors;
 pub use impactcal_erbf as erbf;
+pub use impactcal_experiment as experiment;
 pub use impactcal_runner as runner;
 pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
@@ -51,6 +65,7 @@ use impactcal_calibrate::CalibrateError;
 use impactcal_core::CoreError;
 use impactcal_cors::CorsError;
 use impactcal_erbf::ErbfError;
+use impactcal_experiment::ExperimentError;
 use impactcal_runner::RunnerError;
 use impactcal_sensors::SensorsError;
 use impactcal_shapes::ShapesError;
@@ -90,6 +105,16 @@ pub enum Error {
     /// From `impactcal-runner`: solver runs, executors, the run journal.
     #[error(transparent)]
     Runner(#[from] RunnerError),
+    /// From `impactcal-experiment`: experiment files, model assembly, study and loop runs
+    /// (boxed: its messages carry the file, line and key).
+    #[error(transparent)]
+    Experiment(Box<ExperimentError>),
+}
+
+impl From<ExperimentError> for Error {
+    fn from(e: ExperimentError) -> Self {
+        Error::Experiment(Box::new(e))
+    }
 }
 
 impl Error {
@@ -104,28 +129,11 @@ impl Error {
             Error::Erbf(e) => e.kind(),
             Error::Sobol(e) => e.kind(),
             Error::Cors(e) => e.kind(),
-            Error::Shell(e) => shell_kind(e),
+            Error::Shell(e) => e.kind(),
             Error::Calibrate(e) => e.kind(),
             Error::Runner(e) => e.kind(),
+            Error::Experiment(e) => e.kind(),
         }
-    }
-}
-
-/// The kind of a solver error: a deck, model or value that cannot be used is bad input, an
-/// unstable run is a numerical failure, a file is I/O. A variant this classification does
-/// not know yet counts as a failure.
-fn shell_kind(e: &ShellError) -> ErrorKind {
-    match e {
-        ShellError::Core(c) => c.kind(),
-        ShellError::Keyword { .. }
-        | ShellError::UnsupportedKeyword { .. }
-        | ShellError::UnsupportedKeywords { .. }
-        | ShellError::Reference { .. }
-        | ShellError::Element { .. }
-        | ShellError::Value { .. } => ErrorKind::BadInput,
-        ShellError::Io { .. } => ErrorKind::Io,
-        ShellError::Unstable { .. } => ErrorKind::Numerical,
-        _ => ErrorKind::Numerical,
     }
 }
 

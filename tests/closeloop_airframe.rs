@@ -66,18 +66,35 @@ fn tests(hidden: &[(String, f64)], seed: u64) -> (Histories, Histories) {
     let x = true_point(&m);
     let y = truth.simulate(&x).unwrap();
     let labels = loudest(&y);
-    let measure = |y: &Histories, seed: u64| {
-        let m = Measurement {
-            time_shift: TAU,
-            snr_db: Some(40.0),
-            seed,
-            ..Measurement::default()
-        };
-        measured(&y.select(&labels).unwrap(), &m).unwrap()
+    let m = Measurement {
+        time_shift: TAU,
+        snr_db: Some(40.0),
+        seed,
+        ..Measurement::default()
     };
+    measure_both(&truth, &x, &y, &labels, &m, seed + 1)
+}
+
+/// The truth's run `y` at `x` and its run at the holdout's sink speed, measured on `labels`
+/// with `m`, the holdout with the noise seed `holdout_seed`.
+fn measure_both(
+    truth: &AirframeModel,
+    x: &[f64],
+    y: &Histories,
+    labels: &[String],
+    m: &Measurement,
+    holdout_seed: u64,
+) -> (Histories, Histories) {
     let speed = [("impact.vertical".to_string(), HOLDOUT_SPEED)];
-    let yh = truth.at_condition(&speed).unwrap().simulate(&x).unwrap();
-    (measure(&y, seed), measure(&yh, seed + 1))
+    let yh = truth.at_condition(&speed).unwrap().simulate(x).unwrap();
+    let mh = Measurement {
+        seed: holdout_seed,
+        ..m.clone()
+    };
+    (
+        measured(&y.select(labels).unwrap(), m).unwrap(),
+        measured(&yh.select(labels).unwrap(), &mh).unwrap(),
+    )
 }
 
 fn options() -> LoopOptions {
@@ -140,10 +157,7 @@ fn hidden_damping_on_the_airframe_is_found_and_the_error_falls() {
     let r = close(&test, &holdout, &dir);
     let summary = format!(
         "{:?}\n{:?}\n{:?}\n{:?}\n{:?}",
-        r.candidates
-            .iter()
-            .map(|c| (&c.name, c.kappa, c.explained_fraction, &c.status))
-            .collect::<Vec<_>>(),
+        ranking(&r),
         r.added,
         r.errors,
         r.nuisance,
@@ -156,10 +170,9 @@ fn hidden_damping_on_the_airframe_is_found_and_the_error_falls() {
     assert_eq!(r.verdict, Verdict::Attributed, "{}\n{summary}", r.stopped);
     let a = &r.added[0];
     assert_eq!(a.name, "damping");
-    // Its value within 5 % of the truth. (Its 95 % interval, which counts the model's own
-    // noise coherently from the jitter draws, is still narrower than the error: 9.964
-    // [9.943, 9.985] with a model-noise part of 0.0014; the 0.4 % bias is not what a
-    // 1e-4 jitter moves.)
+    // Its value within 5 % of the truth. (Its 95 % interval is not asserted: 9.909
+    // [9.801, 10.016] holds the truth only through the Gauss-Newton step still pending,
+    // 0.051; the model-noise part of a 1e-4 jitter is 0.0018.)
     assert!((a.value - 10.0).abs() < 0.5, "{a:?}");
     // The declared thicknesses recovered within 2 %, and the nuisance terms.
     let x = true_point(&model());
@@ -172,13 +185,7 @@ fn hidden_damping_on_the_airframe_is_found_and_the_error_falls() {
     }
     assert!((r.nuisance.time_shift - TAU).abs() < 2e-5, "{summary}");
     // The error falls on the calibration test and on the holdout, never fitted.
-    let e = &r.errors;
-    assert!(
-        e.calibration.enriched < 0.5 * e.calibration.calibrated,
-        "{summary}"
-    );
-    let h = e.holdout.as_ref().unwrap();
-    assert!(h.enriched < 0.5 * h.calibrated, "{summary}");
+    errors_fall(&r, 0.5, 0.5, &summary);
     // M1: the test leaves the enriched model's predictive envelope less often than the
     // calibrated one's, on both tests.
     for m in [&r.metrics_calibration, r.metrics_holdout.as_ref().unwrap()] {
@@ -211,4 +218,108 @@ fn without_a_hidden_effect_the_loop_on_the_airframe_stays_silent() {
     for m in [&r.metrics_calibration, r.metrics_holdout.as_ref().unwrap()] {
         assert!(m.calibrated.m1_exceedance < 0.05, "{m:?}");
     }
+}
+
+/// The reduced family's mass case (docs/validation.md, "The closed loop over a family of
+/// hidden effects"): the occupants' mass 14 % above what the model holds, a gain of 1.12
+/// on the channel that moves most fitted among the nuisance terms, white noise of 0.5 %,
+/// a trigger offset of three samples, 12 channels. The loop must rank the mass first, add
+/// it near its truth with the truth inside its interval, recover the thicknesses, the gain
+/// and the trigger, cut the error on both tests and end `attributed` (the case the loop once
+/// left with the gain taking up part of the effect, and later in another basin of the
+/// thicknesses).
+#[test]
+fn a_hidden_mass_with_a_wrong_gain_is_found_and_the_gain_recovered() {
+    const MASS: f64 = 0.8;
+    const GAIN: f64 = 1.12;
+    const TAU3: f64 = 3e-4;
+    let m = model();
+    let truth = m.at_condition(&[("mass.occupants".into(), MASS)]).unwrap();
+    let x = true_point(&m);
+    let y = truth.simulate(&x).unwrap();
+    let f = y.filtered(Cfc::from_class(FILTER).unwrap()).unwrap();
+    let vertical: Vec<&String> = f.labels().iter().filter(|l| l.ends_with(".z")).collect();
+    let labels = f.select(&vertical).unwrap().most_varying(12);
+    let wrong = labels[0].clone();
+    let m = Measurement {
+        time_shift: TAU3,
+        gains: vec![(wrong.clone(), GAIN)],
+        snr_db: Some(46.0206),
+        seed: 1,
+        ..Measurement::default()
+    };
+    let (test, holdout) = measure_both(&truth, &x, &y, &labels, &m, 101);
+    let options = LoopOptions {
+        reconcile: 16,
+        polish: 12,
+        fit_gains: true,
+        candidates: Some(
+            ["damping", "ground.friction", "mass.occupants", "rate.c"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
+        ),
+        ..options()
+    };
+    let dir = fresh("hidden-mass");
+    let r = close_with(&test, &holdout, &dir, &options);
+    // The result beside the journal, for a look at a failure.
+    std::fs::write(
+        dir.join("loop.json"),
+        serde_json::to_string_pretty(&r).unwrap(),
+    )
+    .unwrap();
+    let summary = format!(
+        "{:?}\n{:?}\n{:?}\n{:?}\n{}",
+        ranking(&r),
+        r.added,
+        r.errors,
+        r.nuisance.gains.get(&wrong),
+        r.stopped
+    );
+    println!("{summary}");
+    assert_eq!(r.candidates[0].name, "mass.occupants", "{summary}");
+    // What remains after the mass is added is noise: the recalibration must reach the
+    // truth's basin (a search of ten runs once left it at a thinner belly, chi2_red 2.45).
+    assert_eq!(r.verdict, Verdict::Attributed, "{summary}");
+    let a = &r.added[0];
+    assert_eq!(a.name, "mass.occupants", "{summary}");
+    assert!((a.value / MASS - 1.0).abs() < 0.01, "{summary}");
+    assert!(a.lower <= MASS && MASS <= a.upper, "{summary}");
+    // The declared thicknesses recovered within 2 %.
+    for (name, truth) in DECLARED.iter().zip(&x) {
+        let v = r.calibrated[*name];
+        assert!(
+            (v / truth - 1.0).abs() < 0.02,
+            "{name}: {v} against {truth}"
+        );
+    }
+    // The gain within 3 % and the trigger within a fifth of a sample (1e-4 s).
+    assert!(
+        (r.nuisance.gains[&wrong] / GAIN - 1.0).abs() < 0.03,
+        "{summary}"
+    );
+    assert!((r.nuisance.time_shift - TAU3).abs() < 2e-5, "{summary}");
+    errors_fall(&r, 0.7, 1.0, &summary);
+}
+
+/// Asserts that the enriched model's error is under `calibration` times the calibrated
+/// one's on the calibration test and under `holdout` times it on the holdout.
+/// Each candidate's name, kappa, explained fraction and status, in rank order (for the
+/// printed summary of a loop).
+fn ranking(r: &LoopResult) -> Vec<(&String, f64, f64, &String)> {
+    r.candidates
+        .iter()
+        .map(|c| (&c.name, c.kappa, c.explained_fraction, &c.status))
+        .collect()
+}
+
+fn errors_fall(r: &LoopResult, calibration: f64, holdout: f64, summary: &str) {
+    let e = &r.errors;
+    assert!(
+        e.calibration.enriched < calibration * e.calibration.calibrated,
+        "{summary}"
+    );
+    let h = e.holdout.as_ref().unwrap();
+    assert!(h.enriched < holdout * h.calibrated, "{summary}");
 }

@@ -9,6 +9,9 @@
 #[path = "../examples/calibration.rs"]
 #[allow(dead_code)]
 mod calibration;
+#[path = "../examples/experiment.rs"]
+#[allow(dead_code)]
+mod experiment;
 #[path = "../examples/common/impact_model.rs"]
 #[allow(dead_code)]
 mod impact_model;
@@ -66,4 +69,42 @@ fn shipped_data_are_the_model() {
     }
     let measured = Histories::read_csv("examples/data/measured.csv").unwrap();
     assert_eq!(measured, test.select(measured.labels()).unwrap());
+}
+
+/// `examples/experiment.rs` runs the shipped study and loop files through the library: the
+/// study finds the test's drop speed (the test is the strip dropped at vz = -5.2 in/s with
+/// t = 0.0021 in) and the loop adds the contact damping hidden in its test (0.2) and cuts
+/// the error on the test and on the holdout.
+#[test]
+fn the_experiment_example_runs_a_study_file_and_a_loop_file() {
+    let dir = std::env::temp_dir().join(format!("impactcal-experiment-{}", std::process::id()));
+    let (study, closed) = experiment::run(
+        "examples/study/local.toml".as_ref(),
+        "examples/loop/local.toml".as_ref(),
+        &dir,
+    )
+    .unwrap();
+    assert_eq!(
+        study.result.m1.verdict,
+        impactcal::calibrate::study::Verdict::CanExplain
+    );
+    let calibrated = &study.result.reconcile.as_ref().unwrap().calibrated;
+    assert!((calibrated["vz"] + 5.2).abs() < 0.05, "{calibrated:?}");
+    let errors = study.result.errors.as_ref().unwrap();
+    assert!(errors.calibrated.prediction_error < 0.5 * errors.baseline.prediction_error);
+    assert!(study.json.ends_with("study/study.json") && study.json.is_file());
+
+    let r = &closed.result;
+    assert_eq!(
+        r.verdict,
+        impactcal::calibrate::closeloop::Verdict::Attributed
+    );
+    assert_eq!(r.added[0].name, "contact_damping");
+    assert!((r.added[0].value - 0.2).abs() < 0.02, "{:?}", r.added[0]);
+    let holdout = r.errors.holdout.as_ref().unwrap();
+    for e in [&r.errors.calibration, holdout] {
+        assert!(e.enriched < 0.1 * e.calibrated, "{e:?}");
+    }
+    assert!(closed.json.ends_with("loop/loop.json") && closed.json.is_file());
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -7,7 +7,7 @@
 //!
 //! - `test.csv`, `holdout.csv`: the measured histories;
 //! - `loop.toml`: `impactcal close-loop` on them (Table 2 declared, CFC 60, the holdout,
-//!   `[budget]` ensemble 30, reconcile 30, recalibrate 30);
+//!   `[loop]` jitter_runs 30, reconcile_runs 30, recalibrate_runs 30);
 //! - `study.toml`: `impactcal study` on the test (Table 2, CFC 60, ensemble 30, 12 sensors,
 //!   reconciliation 30 runs, every channel kept in the objective: over 50 ms the channels
 //!   that move most are beyond the airframe's predictability horizon, and a study that
@@ -66,7 +66,7 @@ fn main() {
         dir.join("loop.toml"),
         format!(
             "{model_lines}\n[holdout]\ndata = \"holdout.csv\"\nset = {{ \"impact.vertical\" = \
-             {HOLDOUT_SPEED:?} }}\n\n[budget]\nensemble = 30\nreconcile = 30\nrecalibrate = 30\n\
+             {HOLDOUT_SPEED:?} }}\n\n[loop]\njitter_runs = 30\nreconcile_runs = 30\nrecalibrate_runs = 30\n\
              seed = 1\n"
         ),
     )
@@ -74,7 +74,7 @@ fn main() {
     std::fs::write(
         dir.join("study.toml"),
         format!(
-            "{model_lines}\n[study]\nensemble = 30\nsensors = 12\nreconcile_runs = 30\nseed = 1\n\
+            "{model_lines}\n[study]\nhalton_runs = 30\nsensors = 12\nreconcile_runs = 30\nseed = 1\n\
              keep_unpredictable = true\n"
         ),
     )

@@ -4,7 +4,7 @@
 # and 1,215 channels over 0.025 and 0.05 s, the test data of
 # benches/harness/loop_scaling_data.rs (hidden damping, trigger offset, 40 dB noise, one
 # wrong gain; a holdout at another sink speed), then `impactcal close-loop` (Table 2
-# declared, CFC 60, the holdout, [budget] ensemble 30, reconcile 30, recalibrate 30) and
+# declared, CFC 60, the holdout, [loop] jitter_runs 30, reconcile_runs 30, recalibrate_runs 30) and
 # `impactcal study` (ensemble 30, 12 sensors, reconciliation 30), each under a hard cap on
 # its address space (CAP_GB, default 8) so that a regression fails instead of taking the
 # machine. Prints one Markdown row per case: values compared, runs, wall time, peak

@@ -14,7 +14,7 @@
 #      resumed: it re-attaches to the ensemble's array and ends with the same study.json as
 #      the same study run uninterrupted on the local process pool;
 #   5. a small closed loop (examples/loop/slurm.toml, the drop tower): every stage of the
-#      loop a job array of `impactcal loop-point` tasks, the holdout's runs at their
+#      loop a job array of `impactcal point` tasks, the holdout's runs at their
 #      condition; the same loop.json as the same loop in process.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -164,9 +164,11 @@ L="$W/loop"
 mkdir -p "$L"
 cp examples/loop/test.csv examples/loop/holdout.csv "$L/"
 # A shorter Gauss-Newton polish keeps the number of arrays (one per stage) small.
-sed -e 's/^poll = .*/poll = 0.5/' examples/loop/slurm.toml > "$L/slurm.toml"
-printf '\n[loop]\npolish = 2\n' >> "$L/slurm.toml"
-sed -e '/^\[executor\]/,/^\[loop\]/{/^\[loop\]/!d}' "$L/slurm.toml" > "$L/local.toml"
+sed -e 's/^poll = .*/poll = 0.5/' -e 's/^\[loop\]$/[loop]\npolish = 2/' examples/loop/slurm.toml \
+  > "$L/slurm.toml"
+grep -q '^polish = 2$' "$L/slurm.toml" || fail "slurm.toml has no [loop] table to shorten the polish in"
+# The same loop in process: the file without its [executor] table (the last).
+sed -e '/^\[executor\]/,$d' "$L/slurm.toml" > "$L/local.toml"
 grep -q '^\[executor\]' "$L/local.toml" && fail "local.toml still has an executor"
 "$IMPACTCAL" close-loop --config "$L/local.toml" --out "$L/reference" 2> "$L/reference.err" \
   || { cat "$L/reference.err"; fail "the reference loop"; }

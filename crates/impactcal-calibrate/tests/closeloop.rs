@@ -6,7 +6,9 @@
 
 use std::path::Path;
 
-use impactcal_calibrate::closeloop::{Holdout, LoopOptions, LoopResult, Verdict, run_loop};
+use impactcal_calibrate::closeloop::{
+    Errors, Holdout, LoopOptions, LoopResult, Stages, Verdict, run_loop,
+};
 use impactcal_calibrate::study::{Silent, TestData};
 use impactcal_core::drop_tower::DropTower;
 use impactcal_core::synthetic::{Measurement, measured};
@@ -73,12 +75,70 @@ fn holdout_of(truth: &DropTower, seed: u64) -> Histories {
     )
 }
 
+/// One line of the figures docs/validation.md records for a loop (printed with
+/// `--nocapture`).
+fn summary(case: &str, r: &LoopResult) -> String {
+    let d = &r.detection;
+    let f = &r.detection_final;
+    let top = r
+        .candidates
+        .first()
+        .map(|c| {
+            format!(
+                "{} (explained {:.2}, kappa {:.2})",
+                c.name, c.explained_fraction, c.kappa
+            )
+        })
+        .unwrap_or_default();
+    let added: Vec<String> = r
+        .added
+        .iter()
+        .map(|a| format!("{} {:.5} [{:.5}, {:.5}]", a.name, a.value, a.lower, a.upper))
+        .collect();
+    let stage = |m: &Stages<Errors>| {
+        format!(
+            "L2 {:.4} -> {:.4} -> {:.4}, C {:.4} -> {:.4}, R {:.3} -> {:.3}, chi2_red {:.2}",
+            m.nominal.rel_l2,
+            m.calibrated.rel_l2,
+            m.enriched.rel_l2,
+            m.calibrated.sprague_geers_c,
+            m.enriched.sprague_geers_c,
+            m.calibrated.iso18571_r,
+            m.enriched.iso18571_r,
+            m.enriched.chi2_red
+        )
+    };
+    format!(
+        "{case}: {:?}; chi2_red {:.4} (threshold {:.3}), sigma1 {:.1} (edge {:.1}); first {top}; \
+         added {added:?}; tau {:.4e}, gains {:?}; after chi2_red {:.3} (threshold {:.3}); \
+         calibration {}; holdout {}; BIC {:?}; runs {}",
+        r.verdict,
+        d.chi2_red,
+        d.threshold,
+        d.sigma1,
+        d.noise_edge,
+        r.nuisance.time_shift,
+        r.nuisance.gains,
+        f.chi2_red,
+        f.threshold,
+        stage(&r.metrics_calibration),
+        r.metrics_holdout.as_ref().map(stage).unwrap_or_default(),
+        r.models
+            .iter()
+            .filter(|m| m.kept)
+            .map(|m| m.bic.round())
+            .collect::<Vec<_>>(),
+        r.runs
+    )
+}
+
 #[test]
 fn hidden_damping_is_found_added_and_the_error_falls_on_calibration_and_holdout() {
     let t = truth(&[("damping", 0.03)]);
     let dir = tempfile::tempdir().unwrap();
     let holdout = holdout_of(&t, 1);
     let r = run(&t, 1, dir.path(), Some(&holdout));
+    println!("{}", summary("hidden damping", &r));
     // Detection.
     assert!(r.detection.model_form_error);
     assert!(r.detection.chi2_red > r.detection.threshold && r.detection.coherent);
@@ -143,6 +203,7 @@ fn negative_control_at_most_one_false_alarm_in_ten_seeds() {
     for seed in 0..10 {
         let dir = tempfile::tempdir().unwrap();
         let r = run(&t, 100 + seed, dir.path(), None);
+        println!("{}", summary(&format!("negative control, seed {seed}"), &r));
         if r.verdict != Verdict::NoModelFormError {
             alarms += 1;
         }
@@ -162,6 +223,7 @@ fn a_stiffness_scale_confounded_with_the_modulus_is_not_identifiable_nor_attribu
     let t = truth(&[("stiffness_scale", 1.2)]);
     let dir = tempfile::tempdir().unwrap();
     let r = run(&t, 2, dir.path(), None);
+    println!("{}", summary("stiffness_scale 1.2", &r));
     let s = r
         .candidates
         .iter()
@@ -181,6 +243,7 @@ fn two_hidden_effects_are_both_added_each_lowering_bic() {
     let t = truth(&[("damping", 0.03), ("added_mass", 0.3)]);
     let dir = tempfile::tempdir().unwrap();
     let r = run(&t, 3, dir.path(), None);
+    println!("{}", summary("damping and added_mass", &r));
     let mut names: Vec<&str> = r.added.iter().map(|a| a.name.as_str()).collect();
     names.sort_unstable();
     assert_eq!(names, ["added_mass", "damping"], "{:?}", r.stopped);
@@ -202,6 +265,7 @@ fn an_effect_outside_the_candidate_list_ends_unattributed() {
     let t = truth(&[]).with_appendage(0.05, 400.0).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let r = run(&t, 4, dir.path(), None);
+    println!("{}", summary("appendage", &r));
     assert_eq!(r.verdict, Verdict::Unattributed);
     assert!(r.added.is_empty());
     let d = r.unattributed.as_ref().unwrap();
@@ -414,4 +478,89 @@ fn ranked_first_over_twenty_seeds() {
         );
         assert!(first >= 18, "{name}: ranked first {first}/20");
     }
+}
+
+/// `h` with `lead` samples of each channel's initial value recorded before its start (the
+/// drop tower falls freely before the impact: a pre-trigger).
+fn with_pre_trigger(h: &Histories, lead: usize) -> Histories {
+    let channels = (0..h.channels())
+        .map(|c| {
+            let ch = h.channel(c);
+            std::iter::repeat_n(ch[0], lead)
+                .chain(ch.iter().copied())
+                .collect()
+        })
+        .collect();
+    Histories::from_channels(
+        h.labels().to_vec(),
+        channels,
+        h.dt(),
+        h.start() - lead as f64 * h.dt(),
+        h.unit(),
+    )
+    .unwrap()
+}
+
+/// A test recorded as labs do, with a pre-trigger (40 ms before the model's start), under
+/// AR(1) noise of lag-one correlation 0.8: the loop measures the noise on the record before
+/// the model's start with the window's quiet start (about 445 samples instead of 45), reads
+/// each channel's level within 20 % of the noise added and its colour within 0.15, and a
+/// right model's reduced chi-square stays under its threshold.
+#[test]
+fn a_pre_trigger_record_gives_the_noise_level_under_coloured_noise() {
+    let y = truth(&[]).simulate(&TRUE_POINT).unwrap();
+    let long = with_pre_trigger(&y, 400);
+    let mut chi2 = Vec::new();
+    for seed in 0..5 {
+        let m = Measurement {
+            time_shift: TAU,
+            gains: vec![("a2".into(), GAIN)],
+            snr_db: Some(40.0),
+            ar1: 0.8,
+            seed: 600 + seed,
+            ..Measurement::default()
+        };
+        let test = measured(&long, &m).unwrap();
+        let clean = measured(&long, &Measurement { snr_db: None, ..m }).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let r = run_on(&test, dir.path(), None);
+        println!("{}", summary(&format!("pre-trigger, seed {seed}"), &r));
+        assert_eq!(r.test_preparation.pre_trigger_samples, 400);
+        assert!(
+            r.noise_floor.pre_impact_samples >= 440,
+            "{:?}",
+            r.noise_floor
+        );
+        for c in &r.noise_floor.channels {
+            let (a, b) = (
+                test.channel_by_label(&c.label).unwrap(),
+                clean.channel_by_label(&c.label).unwrap(),
+            );
+            let e: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
+            let truth = (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
+            println!(
+                "  {}: sigma {:.4} for {truth:.4}, lag-one {:.3}",
+                c.label, c.sigma, c.lag1
+            );
+            assert_eq!(
+                c.source,
+                impactcal_calibrate::closeloop::noise_floor::NoiseSource::PreImpact
+            );
+            assert!(
+                (c.sigma / truth - 1.0).abs() < 0.2,
+                "seed {seed} {}: {} for {truth}",
+                c.label,
+                c.sigma
+            );
+            assert!((c.lag1 - 0.8).abs() < 0.15, "seed {seed}: {c:?}");
+        }
+        assert_eq!(
+            r.verdict,
+            Verdict::NoModelFormError,
+            "seed {seed}: {}",
+            r.stopped
+        );
+        chi2.push(r.detection_final.chi2_red);
+    }
+    println!("pre-trigger: chi2_red {chi2:?}");
 }

@@ -7,11 +7,13 @@
 
 use impactcal_calibrate::CalibrateError;
 use impactcal_calibrate::closeloop::{LoopOptions, run_loop, run_loop_on};
-use impactcal_calibrate::study::{Silent, TestData, Worker};
+use impactcal_calibrate::study::{Silent, TestData};
 use impactcal_core::drop_tower::DropTower;
 use impactcal_core::synthetic::{Measurement, measured};
 use impactcal_core::{Enrichable, Model};
-use impactcal_runner::{Cancel, Executor, OutputSpec, ProcessOptions, Solver, SolverCommand};
+use impactcal_runner::{
+    Cancel, Executor, OutputSpec, ProcessOptions, Runner, Solver, SolverCommand,
+};
 
 #[test]
 fn a_failing_worker_is_reported_with_its_exit_status_and_loses_nothing() {
@@ -39,7 +41,7 @@ fn a_failing_worker_is_reported_with_its_exit_status_and_loses_nothing() {
         recalibrate: 16,
         ..LoopOptions::default()
     };
-    let failing = Worker {
+    let failing = Runner {
         solver: Solver {
             inputs: Vec::new(),
             command: SolverCommand::Argv(vec![
@@ -53,6 +55,7 @@ fn a_failing_worker_is_reported_with_its_exit_status_and_loses_nothing() {
             jobs: 2,
             timeout: None,
         }),
+        in_process: None,
         retries: 1,
         cancel: Cancel::new(),
     };

@@ -89,14 +89,14 @@ impl Model for Drop {
 
 fn options(ensemble: usize, reconcile: usize) -> StudyOptions {
     StudyOptions {
-        ensemble,
+        halton_runs: ensemble,
         sensors: 4,
         shapes: 3,
         sensitivity_samples: 256,
         reconcile_runs: reconcile,
-        reconcile_batch: 2,
+        cors_batch: 2,
         seed: 3,
-        noise_runs: 4,
+        jitter_runs: 4,
         ..StudyOptions::default()
     }
 }

@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use clap::Args as ClapArgs;
 use impactcal::ErrorKind;
 use impactcal::core::{Table, TableOptions};
-use impactcal::runner::{Batch, BatchConfig, Cancel, run_batch};
+use impactcal::experiment::BuiltInSolver;
+use impactcal::runner::{Batch, BatchConfig, Cancel, Hooks, run_batch_with};
 use serde::Serialize;
 
 use crate::error::CliError;
@@ -14,7 +15,7 @@ use crate::error::CliError;
 /// Arguments of `impactcal batch`.
 #[derive(ClapArgs, Debug)]
 pub struct Args {
-    /// The batch configuration (TOML: [batch], [solver], [executor]).
+    /// The batch configuration (TOML: [batch], [solver], [executor] with its retries).
     #[arg(long)]
     pub config: PathBuf,
     /// The points: a CSV whose header names the parameters, one run per row.
@@ -60,13 +61,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let solver = config.solver(Some(&exe))?;
     let batch = Batch::new(&args.out, &config.batch.study, solver, names, table.rows())
         .map_err(|e| CliError::from(e).context(args.config.display()))?
-        .with_retries(config.batch.retries);
+        .with_retries(config.executor.retries);
     let cancel = Cancel::new();
     let handler = cancel.clone();
     // A second handler cannot be installed (tests call `run` more than once): then Ctrl-C
     // keeps its default action, which loses nothing either (the journal is on disk).
     let _ = ctrlc::set_handler(move || handler.cancel());
-    let report = run_batch(&batch, &config.executor(), &cancel)?;
+    // Without a command on the local executor, the built-in solver runs in this process.
+    let builtin = BuiltInSolver::new(config.solver.quantity);
+    let hooks = Hooks {
+        in_process: Some(&builtin),
+        ..Hooks::default()
+    };
+    let report = run_batch_with(&batch, &config.executor(), &cancel, hooks)?;
     let root = batch.root().strip_prefix(&args.out).unwrap_or(batch.root());
     let results: Vec<RunSummary> = report
         .runs

@@ -4,8 +4,9 @@
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
+use impactcal::core::NodalQuantity;
 use impactcal::core::{Histories, IsoMme, TestRecord};
-use impactcal::runner::{Binout, NodalQuantity, read_nodout};
+use impactcal::runner::{Binout, read_nodout};
 
 use crate::error::CliError;
 

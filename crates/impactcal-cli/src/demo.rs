@@ -3,14 +3,18 @@
 //! screened with M1 on 150 runs, then Table 2's is studied in full (50 runs, sensors, M2,
 //! surrogates, sensitivity, 60 CORS-RBF runs), and the report ends with the reveal.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args as ClapArgs;
 use impactcal::calibrate::report::{Block, Plot, Report};
-use impactcal::calibrate::study::document::{Revealed, report, reveal_section};
-use impactcal::calibrate::study::{StudyOptions, StudyResult, Subspace};
+use impactcal::calibrate::study::document::{Geometry, Revealed, report, reveal_section};
+use impactcal::calibrate::study::{
+    StudyOptions, StudyResult, Subspace, TestData, ValidStudyOptions, run_model,
+};
 use impactcal::core::{Cfc, Model, ParamGuard};
+use impactcal::experiment::model::geometry_of;
+use impactcal::experiment::write_study;
 use impactcal::shell::airframe::{
     Airframe, AirframeModel, AirframeOptions, MeshDensity, Preset, catalogue, space_of,
 };
@@ -19,7 +23,7 @@ use serde::Serialize;
 use crate::error::CliError;
 use crate::output::write_text;
 use crate::simulate::thread_pool;
-use crate::study::{Built, Setup, execute, finish, geometry_of};
+use crate::study::Progress;
 
 /// The demo's window (s): the airframe is predictable over it (docs/airframe.md,
 /// "Predictability"); later, its own noise grows by e every 4 ms.
@@ -140,25 +144,34 @@ pub fn run(args: Args) -> Result<(), CliError> {
     test.write_csv(args.out.join("test.csv"))?;
     let cfc = Some(Cfc::from_class(60)?);
     let geometry = geometry_of(&airframe);
-    let setup = |preset: Preset| -> Result<Setup, CliError> {
+    let study = |preset: Preset,
+                 options: &ValidStudyOptions,
+                 dir: &Path|
+     -> Result<StudyResult, CliError> {
         let sub = Subspace::new(model.clone(), preset.space()?)?;
-        Ok(Setup {
-            model: Built::Airframe(Box::new(sub), geometry.clone()),
-            description: format!("built-in airframe, coarse mesh, {END_TIME} s, {preset:?}"),
-            test: test.clone(),
+        let description = format!("built-in airframe, coarse mesh, {END_TIME} s, {preset:?}");
+        std::fs::create_dir_all(dir)
+            .map_err(|e| CliError::io(format!("{}: {e}", dir.display())))?;
+        let test = TestData {
+            histories: &test,
             map: None,
             cfc,
-            runner: None,
-        })
+        };
+        let progress = Progress::new();
+        let result = pool.install(|| run_model(&sub, &description, test, options, dir, &progress));
+        progress.done();
+        let done = write_study(result?, Some(&geometry), dir)?;
+        crate::output::print_finished(&done, "");
+        Ok(done.result)
     };
     let table1 = StudyOptions {
-        ensemble: args.table1_runs,
+        halton_runs: args.table1_runs,
         screen_only: true,
         ..StudyOptions::default()
     }
     .check()?;
     let table2 = StudyOptions {
-        ensemble: args.table2_runs,
+        halton_runs: args.table2_runs,
         sensors: args.sensors,
         shapes: 10.min(args.sensors),
         sensitivity_samples: args.sensitivity_samples,
@@ -166,21 +179,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ..StudyOptions::default()
     }
     .check()?;
-    let (s1, s2) = (setup(Preset::Table1)?, setup(Preset::Table2)?);
     eprintln!(
         "impactcal: Table 1 ({} runs): does M1 let this parameter set explain the test?",
-        table1.ensemble
+        table1.halton_runs
     );
     let dir1 = args.out.join("table1");
-    let r1 = pool.install(|| execute(&s1, &table1, &dir1))?;
-    finish(&r1, &s1, &dir1)?;
+    let r1 = study(Preset::Table1, &table1, &dir1)?;
     eprintln!(
         "impactcal: Table 2 ({} runs), sensitivity, reconciliation",
-        table2.ensemble
+        table2.halton_runs
     );
     let dir2 = args.out.join("table2");
-    let r2 = pool.install(|| execute(&s2, &table2, &dir2))?;
-    finish(&r2, &s2, &dir2)?;
+    let r2 = study(Preset::Table2, &table2, &dir2)?;
     let reveal: Vec<Revealed> = r2
         .space
         .parameters()
@@ -198,7 +208,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .map_or(p.nominal, |c| c.calibrated_point[i]),
         })
         .collect();
-    let doc = demo_report(&r1, &r2, &reveal, &s2);
+    let doc = demo_report(&r1, &r2, &reveal, &geometry);
     let e = r2.errors.as_ref();
     let m2 = r2.m2.as_ref();
     let summary = Summary {
@@ -221,7 +231,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let json = serde_json::to_string_pretty(&summary)
         .map_err(|e| CliError::failure(format!("cannot encode the summary: {e}")))?;
     write_text(&(json + "\n"), Some(&args.out.join("demo.json")))?;
-    let files = crate::study::write_report(&doc, &args.out)?;
+    let files = impactcal::calibrate::report::write(&doc, &args.out)?;
     for line in &doc.lead {
         eprintln!("{line}");
     }
@@ -239,14 +249,10 @@ pub fn demo_report(
     t1: &StudyResult,
     t2: &StudyResult,
     reveal: &[Revealed],
-    setup: &Setup,
+    geometry: &Geometry,
 ) -> Report {
-    let geometry = match &setup.model {
-        Built::Airframe(_, g) => Some(g),
-        Built::Deck(_) | Built::Solver => None,
-    };
     let first = report(t1, None);
-    let second = report(t2, geometry);
+    let second = report(t2, Some(geometry));
     let mut screening: Vec<_> = first
         .sections
         .into_iter()

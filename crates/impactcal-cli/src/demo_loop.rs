@@ -9,18 +9,19 @@ use std::path::Path;
 use std::time::Instant;
 
 use impactcal::calibrate::closeloop::document::report;
-use impactcal::calibrate::closeloop::{LoopOptions, LoopResult};
+use impactcal::calibrate::closeloop::{Holdout, LoopOptions, LoopResult, run_loop_on};
 use impactcal::calibrate::report::{Block, Section, Table};
+use impactcal::calibrate::study::TestData;
 use impactcal::core::synthetic::{Measurement, measured};
 use impactcal::core::{Cfc, Enrichable, Histories, Model};
 use impactcal::shell::airframe::{Airframe, AirframeModel, AirframeOptions, MeshDensity, Preset};
 use serde::Serialize;
 
-use crate::close_loop::{close, write_result};
 use crate::demo::Args;
 use crate::error::CliError;
 use crate::output::write_text;
 use crate::simulate::thread_pool;
+use crate::study::Progress;
 
 /// The loop demo's window (s): the window of the coarse-airframe loop test. Over 25 ms
 /// the declared thicknesses, calibrated first, take up more of the damping's signature
@@ -206,29 +207,44 @@ pub fn run(args: &Args) -> Result<(), CliError> {
          {HOLDOUT_SPEED})",
         channels.len()
     );
-    let h = (holdout, speed.to_vec());
-    let result = pool
-        .install(|| {
-            close(
-                &model,
-                &description,
-                &test,
-                None,
-                Some(Cfc::from_class(CFC)?),
-                Some(&h),
-                &options,
-                &args.out,
-                None,
-            )
-        })
-        .map_err(|e| e.context("demo --close-loop"))?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| CliError::io(format!("{}: {e}", args.out.display())))?;
+    let progress = Progress::new();
+    let result = pool.install(|| {
+        let test = TestData {
+            histories: &test,
+            map: None,
+            cfc: Some(Cfc::from_class(CFC)?),
+        };
+        let holdout = Holdout {
+            histories: &holdout,
+            set: &speed,
+        };
+        let (out, observer) = (&args.out, &progress);
+        let r = run_loop_on(
+            &model,
+            &description,
+            test,
+            Some(holdout),
+            &options,
+            out,
+            observer,
+            None,
+        );
+        Ok::<_, CliError>(r?)
+    });
+    progress.done();
+    let result = result.map_err(|e| e.context("demo --close-loop"))?;
 
     let noise = noise_reveal(&result, &channels, &hidden_sd);
     let reveal = reveal(&result, &wrong, args.gain, &noise);
     let mut doc = report(&result);
     doc.title = "Closed loop on the coarse airframe: a test with hidden damping".into();
     doc.sections.push(reveal_section(&reveal));
-    let files = write_result(&result, &doc, &args.out)?;
+    let json = serde_json::to_string_pretty(&result)
+        .map_err(|e| CliError::failure(format!("cannot encode the loop's result: {e}")))?;
+    write_text(&(json + "\n"), Some(&args.out.join("loop.json")))?;
+    let files = impactcal::calibrate::report::write(&doc, &args.out)?;
     let e = &result.errors;
     let summary = Summary {
         wall_time_s: started.elapsed().as_secs_f64(),

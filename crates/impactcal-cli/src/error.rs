@@ -103,7 +103,8 @@ from_library_error!(
     impactcal::cors::CorsError,
     impactcal::shell::ShellError,
     impactcal::calibrate::CalibrateError,
-    impactcal::runner::RunnerError
+    impactcal::runner::RunnerError,
+    impactcal::experiment::ExperimentError
 );
 
 #[cfg(test)]

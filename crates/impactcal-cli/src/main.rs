@@ -85,9 +85,11 @@ enum Command {
     /// The calibration study of a model against a test (M1, sensors, M2, surrogates,
     /// sensitivity, CORS-RBF reconciliation) from a TOML study file; runs are journaled.
     Study(study::Args),
-    /// Runs the built-in model of a study file at the point of a run's `params.json` and
-    /// writes its histories (what the processes and slurm executors run for each point).
-    StudyPoint(study::PointArgs),
+    /// Runs the built-in model of an experiment file at a run's `params.json` (declared
+    /// parameters, candidates a loop added, condition) and writes its histories: what the
+    /// processes and slurm executors run for each of a study's or a loop's runs.
+    #[command(alias = "study-point", alias = "loop-point")]
+    Point(study::PointArgs),
     /// The source paper's study on the coarse airframe against a test with hidden changes:
     /// Table 1 screened by M1, Table 2 studied and reconciled, the changes revealed; with
     /// `--close-loop`, the closed loop against a test with hidden damping.
@@ -98,11 +100,7 @@ enum Command {
     /// The closed loop from a TOML file: nuisance terms, noise floor, detection of
     /// model-form error, attribution to the model's candidate effects, enrichment and
     /// recalibration, errors before and after on the test and a holdout; runs are journaled.
-    CloseLoop(close_loop::Args),
-    /// Runs the model of a loop file at a run's `params.json` (declared parameters, added
-    /// candidates, condition) and writes its histories (what the processes and slurm
-    /// executors run for each of the loop's runs).
-    LoopPoint(study::PointArgs),
+    CloseLoop(study::Args),
 }
 
 fn run(command: Command) -> Result<(), CliError> {
@@ -123,11 +121,10 @@ fn run(command: Command) -> Result<(), CliError> {
         Command::Filter(a) => filter::run(a),
         Command::Metrics(a) => metrics::run(a),
         Command::Study(a) => study::run(a),
-        Command::StudyPoint(a) => study::run_point(a),
+        Command::Point(a) => study::run_point(a),
         Command::Demo(a) => demo::run(a),
         Command::Batch(a) => batch::run(a),
         Command::CloseLoop(a) => close_loop::run(a),
-        Command::LoopPoint(a) => close_loop::run_point(a),
     }
 }
 

@@ -63,7 +63,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let mut options = JitterOptions::new(args.runs, args.eps, args.seed);
     options.cfc = args.cfc.map(Cfc::from_class).transpose()?;
-    options.validate()?;
+    impactcal::core::ParamGuard::check_ref(&options)?;
     let pool = thread_pool(args.threads)?;
     let started = std::time::Instant::now();
     let (noise, group): (SimulationNoise, Grouping) = match &args.source.deck {

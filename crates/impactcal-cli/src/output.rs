@@ -47,3 +47,16 @@ pub fn writer(out: Option<&Path>) -> Result<(Box<dyn Write>, String), CliError> 
         None => Ok((Box::new(std::io::stdout().lock()), "stdout".into())),
     }
 }
+
+/// Prints a finished study's or loop's lead lines (its verdicts in a few sentences) on
+/// standard error, then `<prefix>wrote <json> and <report.html>`.
+pub fn print_finished<R>(done: &impactcal::experiment::Finished<R>, prefix: &str) {
+    for line in &done.report.lead {
+        eprintln!("{line}");
+    }
+    eprintln!(
+        "{prefix}wrote {} and {}",
+        done.json.display(),
+        done.files.html.display()
+    );
+}

@@ -5,9 +5,10 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
+use impactcal::core::NodalQuantity;
 use impactcal::shell::airframe::{Airframe, AirframeOptions, AirframeValues, MeshDensity};
 use impactcal::shell::keyword::{Deck, read_deck};
-use impactcal::shell::{Energies, Quantity, ShellError, ShellModel, Simulation};
+use impactcal::shell::{Energies, ShellError, ShellModel, Simulation};
 
 use crate::error::CliError;
 
@@ -220,9 +221,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let result = result.map_err(|e| CliError::from(e).context(&name))?;
     let wall = started.elapsed().as_secs_f64();
     let q = match args.quantity {
-        QuantityArg::Velocity => Quantity::Velocity,
-        QuantityArg::Displacement => Quantity::Displacement,
-        QuantityArg::Acceleration => Quantity::Acceleration,
+        QuantityArg::Velocity => NodalQuantity::Velocity,
+        QuantityArg::Displacement => NodalQuantity::Displacement,
+        QuantityArg::Acceleration => NodalQuantity::Acceleration,
     };
     if let Some(path) = &args.out {
         let h = result.histories(q).ok_or_else(|| {

@@ -59,7 +59,7 @@ fn processes_and_in_process_agree_and_failures_are_named() {
     let p = points(dir.path(), &format!("{POINTS}-0.001,-5\n"));
     let cfg = config(
         dir.path(),
-        "[executor]\nkind = \"processes\"\njobs = 2\n",
+        "[executor]\nkind = \"processes\"\njobs = 2\nretries = 1\n",
         None,
     );
     let out = dir.path().join("pool");
@@ -139,6 +139,18 @@ fn bad_input_is_typed_and_named() {
         "{e}"
     );
     assert!(!dir.path().join("o1/runs").exists());
+    // The retries of earlier files' [batch] table name their new place, before any run.
+    let old = dir.path().join("old.toml");
+    let text = std::fs::read_to_string(&cfg).unwrap();
+    std::fs::write(&old, text.replace("[batch]\n", "[batch]\nretries = 1\n")).unwrap();
+    let o = run(&old, &points(dir.path(), POINTS), &dir.path().join("o0"));
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("line 4: [batch] retries: renamed: write [executor] retries"),
+        "{e}"
+    );
+    assert!(!dir.path().join("o0").exists());
     // The template names a parameter the points lack, and the reverse.
     let o = run(
         &cfg,
@@ -180,7 +192,7 @@ fn bad_input_is_typed_and_named() {
     // A solver that runs past the time limit is killed, retried, and reported.
     let cfg = config(
         dir.path(),
-        "[executor]\nkind = \"processes\"\njobs = 2\ntimeout = 0.3\n",
+        "[executor]\nkind = \"processes\"\njobs = 2\ntimeout = 0.3\nretries = 1\n",
         Some("[\"sleep\", \"30\"]"),
     );
     let started = Instant::now();

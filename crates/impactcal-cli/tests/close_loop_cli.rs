@@ -56,8 +56,8 @@ fn close_loop(cfg: &str, out: &Path) -> (serde_json::Value, String) {
 }
 
 const GOOD: &str = "[model]\nkind = \"drop-tower\"\n\n[test]\ndata = \"test.csv\"\n\n\
-    [holdout]\ndata = \"holdout.csv\"\nset = { v0 = 5.5 }\n\n[budget]\nensemble = 8\n\
-    reconcile = 24\nrecalibrate = 24\nseed = 1\n";
+    [holdout]\ndata = \"holdout.csv\"\nset = { v0 = 5.5 }\n\n[loop]\njitter_runs = 8\n\
+    reconcile_runs = 24\nrecalibrate_runs = 24\nseed = 1\n";
 
 #[test]
 fn finds_the_hidden_damping_and_writes_the_report() {
@@ -91,11 +91,11 @@ fn bad_input_exits_2_with_one_line() {
     let cases = [
         (GOOD.replace("v0 = 5.5", "v0 = 30.0"), "[holdout] set"),
         (
-            GOOD.replace("seed = 1", "seed = 1\n\n[loop]\ncandidates = []"),
+            GOOD.replace("seed = 1", "seed = 1\ncandidates = []"),
             "candidate list",
         ),
         (
-            GOOD.replace("recalibrate = 24", "recalibrate = 6"),
+            GOOD.replace("recalibrate_runs = 24", "recalibrate_runs = 6"),
             "at least 14",
         ),
         (
@@ -245,7 +245,7 @@ fn stays_silent_on_a_deck_without_a_missing_effect() {
         "[model]\ndeck = \"{}\"\n\n[parameters]\nthickness = \"section.1.t\"\n\n\
          [space]\nbounds = \"bounds.csv\"\n\n[test]\ndata = \"test.csv\"\n\n\
          [holdout]\ndata = \"holdout.csv\"\nset = {{ \"velocity.1.z\" = -4.5 }}\n\n\
-         [budget]\nensemble = 8\nreconcile = 24\nrecalibrate = 24\nseed = 1\n",
+         [loop]\njitter_runs = 8\nreconcile_runs = 24\nrecalibrate_runs = 24\nseed = 1\n",
         deck_path.display()
     );
     let (v, _) = close_loop(&config(dir.path(), &text), &dir.path().join("out"));

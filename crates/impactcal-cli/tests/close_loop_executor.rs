@@ -230,7 +230,7 @@ fn executors_and_tables_the_loop_cannot_use_are_refused() {
             "[executor]\nkind = \"processes\"\njobs = 2\nthreads = 3\n",
             "threads",
         ),
-        ("[batch]\nstudy = \"mine\"\n", "[batch] study"),
+        ("[batch]\nstudy = \"mine\"\n", "[batch]: this table is gone"),
         (
             "[solver]\ntemplate = \"deck.k\"\ncommand = [\"ls-dyna\"]\n",
             "solver",
@@ -288,7 +288,7 @@ fn a_deck_loop_on_a_process_pool_equals_the_loop_in_process() {
         "[model]\ndeck = {deck_path:?}\n\n[parameters]\nthickness = \"section.1.t\"\n\n\
          [space]\nbounds = \"bounds.csv\"\n\n[test]\ndata = \"test.csv\"\n\n\
          [holdout]\ndata = \"holdout.csv\"\nset = {{ \"velocity.1.z\" = -4.5 }}\n\n\
-         [budget]\nensemble = 4\nreconcile = 12\nrecalibrate = 16\nseed = 1\n"
+         [loop]\njitter_runs = 4\nreconcile_runs = 12\nrecalibrate_runs = 16\nseed = 1\n"
     );
     let outs = [dir.path().join("local"), dir.path().join("processes")];
     for (out, executor) in outs

@@ -69,10 +69,10 @@ fn results_in(journal: &Path) -> usize {
 }
 
 /// A study of four runs without reconciliation.
-const SMALL: &str = "ensemble = 4\nsensors = 2\nshapes = 1\nreconcile_runs = 0\nnoise_runs = 2";
+const SMALL: &str = "halton_runs = 4\nsensors = 2\nshapes = 1\nreconcile_runs = 0\njitter_runs = 2";
 
-const STRIP: &str = "ensemble = 160\nsensors = 3\nshapes = 2\nsensitivity_samples = 64\n\
-                     reconcile_runs = 6\nnoise_runs = 3";
+const STRIP: &str = "halton_runs = 160\nsensors = 3\nshapes = 2\nsensitivity_samples = 64\n\
+                     reconcile_runs = 6\njitter_runs = 3";
 
 #[test]
 fn a_killed_study_resumes_to_the_uninterrupted_result() {
@@ -156,8 +156,8 @@ fn the_coarse_airframe_end_to_end_with_a_small_budget() {
     std::fs::write(
         &config,
         "[model]\nairframe = \"coarse\"\nend_time = 0.01\n\n[space]\npreset = \"table2\"\n\n\
-         [test]\ndata = \"test.csv\"\ncfc = 60\n\n[study]\nensemble = 8\nsensors = 8\nshapes = 3\n\
-         sensitivity_samples = 32\nreconcile_runs = 2\nnoise_runs = 2\n",
+         [test]\ndata = \"test.csv\"\ncfc = 60\n\n[study]\nhalton_runs = 8\nsensors = 8\nshapes = 3\n\
+         sensitivity_samples = 32\nreconcile_runs = 2\njitter_runs = 2\n",
     )
     .unwrap();
     let out = study(&config, &dir.path().join("out"));
@@ -241,19 +241,19 @@ fn bad_input_exits_with_code_two_and_writes_nothing() {
     let c = variant("other.toml", "\"test.csv\"", "\"other.csv\"");
     refused(&c, &d.join("o3"), "no channel in common");
     // A budget of 0.
-    let c = variant("zero.toml", "ensemble = 4", "ensemble = 0");
-    refused(&c, &d.join("o4"), "study.ensemble");
+    let c = variant("zero.toml", "halton_runs = 4", "halton_runs = 0");
+    refused(&c, &d.join("o4"), "study.halton_runs");
     // More sensors than channels (6).
     let c = variant("many.toml", "sensors = 2", "sensors = 7");
     refused(&c, &d.join("o5"), "7 sensors");
     // A malformed study file names its line.
-    let c = variant("syntax.toml", "ensemble = 4", "ensemble = four");
+    let c = variant("syntax.toml", "halton_runs = 4", "halton_runs = four");
     refused(&c, &d.join("o6"), "line");
     // A folder holding another study's journal: nothing is overwritten.
     let out = d.join("o7");
     assert!(study(&config, &out).status.success());
     let before = std::fs::read(out.join("study.json")).unwrap();
-    let c = variant("seed.toml", "ensemble = 4", "ensemble = 4\nseed = 9");
+    let c = variant("seed.toml", "halton_runs = 4", "halton_runs = 4\nseed = 9");
     refused(&c, &out, "another study");
     assert_eq!(std::fs::read(out.join("study.json")).unwrap(), before);
 }
@@ -418,7 +418,7 @@ fn a_built_in_model_on_the_process_pool_equals_the_in_process_study() {
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
-        e.contains("thick") && e.contains("study's model takes"),
+        e.contains("thick") && e.contains("must start with the model's own parameters"),
         "{e}"
     );
 }

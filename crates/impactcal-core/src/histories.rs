@@ -6,6 +6,32 @@ use std::path::Path;
 use crate::error::{CoreError, Result};
 use crate::table::{Table, TableOptions};
 
+/// Which nodal quantity a set of nodal histories holds: what the built-in solver records at
+/// its history nodes and what is read from LS-DYNA's `nodout` (in files: `displacement`,
+/// `velocity`, `acceleration`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NodalQuantity {
+    /// Displacement from the initial position.
+    Displacement,
+    /// Velocity (the default).
+    #[default]
+    Velocity,
+    /// Acceleration.
+    Acceleration,
+}
+
+impl NodalQuantity {
+    /// The name used in files and on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            NodalQuantity::Displacement => "displacement",
+            NodalQuantity::Velocity => "velocity",
+            NodalQuantity::Acceleration => "acceleration",
+        }
+    }
+}
+
 /// Relative tolerance on the spacing of time stamps read from a file: a step may differ from
 /// the mean step by this fraction of it (CSV files from other tools round their times).
 pub const TIME_STEP_TOLERANCE: f64 = 1e-6;

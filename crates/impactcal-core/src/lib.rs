@@ -62,7 +62,7 @@ pub mod testdata;
 
 pub use enrich::{Candidate, Enrichable};
 pub use error::{CoreError, ErrorKind, ParamGuard, Result, check_finite, check_finite_mat};
-pub use histories::{Histories, norm_history_of};
+pub use histories::{Histories, NodalQuantity, norm_history_of};
 pub use model::{BatchResults, Model, RunFailure};
 pub use noise::{GroupHorizon, JitterOptions, SimulationNoise};
 pub use points::PointRows;

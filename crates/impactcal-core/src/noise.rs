@@ -54,7 +54,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{CoreError, Result};
+use crate::error::{CoreError, ParamGuard, Result};
 use crate::histories::Histories;
 use crate::model::Model;
 use crate::signal::Cfc;
@@ -90,12 +90,17 @@ impl JitterOptions {
         self.cfc = Some(cfc);
         self
     }
+}
+
+impl ParamGuard for JitterOptions {
+    /// The options themselves.
+    type Checked = JitterOptions;
 
     /// Checks the options.
     ///
     /// # Errors
     /// [`CoreError::InvalidOption`] for fewer than 2 runs or `eps` outside `(0, 0.1]`.
-    pub fn validate(&self) -> Result<()> {
+    fn check_ref(&self) -> Result<()> {
         if self.runs < 2 {
             return Err(CoreError::invalid_option(
                 "jitter runs",
@@ -111,6 +116,11 @@ impl JitterOptions {
             ));
         }
         Ok(())
+    }
+
+    fn check(self) -> Result<JitterOptions> {
+        self.check_ref()?;
+        Ok(self)
     }
 }
 
@@ -132,7 +142,7 @@ pub fn jitter_points(
     point: &[f64],
     options: &JitterOptions,
 ) -> Result<Vec<Vec<f64>>> {
-    options.validate()?;
+    options.check_ref()?;
     space.to_unit(point)?;
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let scales: Vec<f64> = space

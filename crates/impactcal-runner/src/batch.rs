@@ -230,6 +230,11 @@ impl Batch {
         &self.solver
     }
 
+    /// The names of the points' coordinates.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
     /// The coordinates of run `index`.
     pub(crate) fn point(&self, index: usize) -> &[f64] {
         &self.points[index]
@@ -326,8 +331,8 @@ pub type OnFinished<'a> = dyn Fn(usize, std::result::Result<Histories, &RunnerEr
 /// What a caller hooks into [`run_batch_with`](crate::run_batch_with).
 #[derive(Clone, Copy, Default)]
 pub struct Hooks<'a> {
-    /// The model that [`SolverCommand::InProcess`] runs.
-    pub model: Option<&'a dyn impactcal_core::Model>,
+    /// The solver that [`SolverCommand::InProcess`] runs.
+    pub in_process: Option<&'a dyn crate::solver::InProcessSolver>,
     /// Called once the journal is read, before any run: the number of runs the journal
     /// holds as finished (they are reused unless their result file no longer reads).
     pub opened: Option<&'a (dyn Fn(usize) + Sync)>,
@@ -338,7 +343,7 @@ pub struct Hooks<'a> {
 impl std::fmt::Debug for Hooks<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Hooks")
-            .field("model", &self.model.is_some())
+            .field("in_process", &self.in_process.is_some())
             .field("opened", &self.opened.is_some())
             .field("finished", &self.finished.is_some())
             .finish()
@@ -503,7 +508,7 @@ impl<'a> Driver<'a> {
                         stop_orphan(pid, ticks);
                     }
                     // Ended while no driver watched: its exit status is on disk (an
-                    // in-process model is run again: its unit was not kept).
+                    // in-process solver is run again: its unit was not kept).
                     if !in_process && read_exit_status(&run_dir(&batch.root, i)).is_some() {
                         let outcome = driver.collect(i, f.attempt, None);
                         if !driver.settle(i, f.attempt, outcome)? {

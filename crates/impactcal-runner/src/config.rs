@@ -3,15 +3,14 @@
 //! ```toml
 //! [batch]
 //! study = "strip"          # runs go to <out>/runs/strip/<index>/
-//! retries = 2              # further attempts of a run that fails (default 2)
 //!
 //! [solver]
 //! template = "strip.k"     # the deck template, relative to this file
 //! deck = "deck.k"          # its name in each run's directory (default: the template's)
 //! inputs = []              # further templated text inputs, written under their own names
 //! # The solver command, run without a shell in the run's directory. Absent: the built-in
-//! # solver (in process for kind = "local", else `impactcal simulate --deck <deck> --out
-//! # <output>`).
+//! # solver (in process for kind = "local", handed to the runner by the caller as an
+//! # `InProcessSolver`; else `impactcal simulate --deck <deck> --out <output>`).
 //! command = ["impactcal", "simulate", "--deck", "deck.k", "--out", "out.csv"]
 //! quantity = "velocity"    # built-in solver: the nodal quantity written
 //!
@@ -25,16 +24,22 @@
 //! kind = "processes"       # "local" | "processes" | "slurm"
 //! jobs = 4
 //! timeout = 600
+//! retries = 2              # further attempts of a run that fails (default 2)
 //! ```
+//!
+//! The `[executor]` table ([`ExecutorTable`]) is the one an experiment file has too: the
+//! [`Executor`] by `kind` with its options, and the runner's retries. `[batch] retries` of
+//! earlier files is an error naming `[executor] retries`.
 
 use std::path::{Path, PathBuf};
 
-use impactcal_shell::Quantity;
+use impactcal_core::NodalQuantity;
 use serde::{Deserialize, Serialize};
+use toml::de::DeTable;
 
 use crate::error::{Result, RunnerError, io};
-use crate::executor::{Executor, ProcessOptions, SlurmOptions};
-use crate::outputs::{NodalQuantity, OutputSpec};
+use crate::executor::Executor;
+use crate::outputs::OutputSpec;
 use crate::solver::{Solver, SolverCommand};
 use crate::template::Template;
 
@@ -45,9 +50,6 @@ pub struct BatchSection {
     /// The study name (the runs' directory under `<out>/runs/`).
     #[serde(default = "default_study")]
     pub study: String,
-    /// Further attempts per failing run.
-    #[serde(default = "default_retries")]
-    pub retries: u32,
 }
 
 fn default_study() -> String {
@@ -62,7 +64,6 @@ impl Default for BatchSection {
     fn default() -> Self {
         BatchSection {
             study: default_study(),
-            retries: default_retries(),
         }
     }
 }
@@ -82,7 +83,7 @@ pub struct SolverSection {
     /// The command (argv); absent for the built-in solver.
     #[serde(default)]
     pub command: Option<Vec<String>>,
-    /// The built-in solver's nodal quantity.
+    /// The built-in solver's nodal quantity (written in the fingerprint of its runs).
     #[serde(default)]
     pub quantity: NodalQuantity,
     /// The output.
@@ -94,16 +95,25 @@ fn default_output() -> OutputSpec {
     OutputSpec::csv("out.csv")
 }
 
-/// The `[executor]` table, by `kind`.
+/// The `[executor]` table of a batch file and of an experiment file: where the runs happen
+/// (`kind` and its options) and the runner's retries.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "lowercase")]
-pub enum ExecutorSection {
-    /// In process.
-    Local,
-    /// A local process pool.
-    Processes(ProcessOptions),
-    /// Slurm.
-    Slurm(SlurmOptions),
+pub struct ExecutorTable {
+    /// Further attempts of a run that fails in a way another attempt may cure (default 2).
+    #[serde(default = "default_retries")]
+    pub retries: u32,
+    /// Where the runs happen.
+    #[serde(flatten)]
+    pub executor: Executor,
+}
+
+impl Default for ExecutorTable {
+    fn default() -> Self {
+        ExecutorTable {
+            retries: default_retries(),
+            executor: Executor::Local,
+        }
+    }
 }
 
 /// A batch configuration file.
@@ -116,7 +126,7 @@ pub struct BatchConfig {
     /// `[solver]`.
     pub solver: SolverSection,
     /// `[executor]`.
-    pub executor: ExecutorSection,
+    pub executor: ExecutorTable,
     /// The file it was read from (paths are relative to its directory).
     #[serde(skip)]
     pub source: PathBuf,
@@ -127,7 +137,8 @@ impl BatchConfig {
     ///
     /// # Errors
     /// [`RunnerError::Io`] when it cannot be read; [`RunnerError::Config`] naming the file,
-    /// line and column of a TOML or schema fault (an unknown key, a wrong type).
+    /// line and column of a TOML or schema fault (an unknown key, a wrong type), and the
+    /// line of `[batch] retries` (now `[executor] retries`).
     pub fn read(path: &Path) -> Result<BatchConfig> {
         let text = std::fs::read_to_string(path).map_err(io(path))?;
         let mut c = BatchConfig::parse(&text, &path.display().to_string())?;
@@ -140,6 +151,7 @@ impl BatchConfig {
     /// # Errors
     /// As [`BatchConfig::read`].
     pub fn parse(text: &str, name: &str) -> Result<BatchConfig> {
+        check_renamed(text, name)?;
         toml::from_str(text).map_err(|e| {
             let place = e
                 .span()
@@ -165,7 +177,7 @@ impl BatchConfig {
 
     /// The executor.
     pub fn executor(&self) -> Executor {
-        self.executor.executor()
+        self.executor.executor.clone()
     }
 
     /// The solver: [`SolverSection::solver`] with this file's directory and executor.
@@ -173,28 +185,47 @@ impl BatchConfig {
     /// # Errors
     /// As [`SolverSection::solver`].
     pub fn solver(&self, impactcal: Option<&Path>) -> Result<Solver> {
-        self.solver
-            .solver(&self.base(), &self.source, &self.executor, impactcal)
+        self.solver.solver(
+            &self.base(),
+            &self.source,
+            &self.executor.executor,
+            impactcal,
+        )
     }
 }
 
-impl ExecutorSection {
-    /// The executor this table describes.
-    pub fn executor(&self) -> Executor {
-        match self {
-            ExecutorSection::Local => Executor::Local,
-            ExecutorSection::Processes(p) => Executor::Processes(p.clone()),
-            ExecutorSection::Slurm(s) => Executor::Slurm(s.clone()),
+/// `[batch] retries` of earlier files: an error naming its line and new place. TOML that
+/// does not parse is left to the typed parse, which places the fault.
+fn check_renamed(text: &str, name: &str) -> Result<()> {
+    let Ok(doc) = DeTable::parse(text) else {
+        return Ok(());
+    };
+    let batch = doc.get_ref().get("batch").map(|v| v.get_ref());
+    let Some(table) = batch.and_then(|b| b.as_table()) else {
+        return Ok(());
+    };
+    match table
+        .iter()
+        .find(|(k, _)| k.get_ref().as_ref() == "retries")
+    {
+        Some((k, _)) => {
+            let line = text[..k.span().start.min(text.len())].matches('\n').count() + 1;
+            Err(RunnerError::Config {
+                file: name.to_string(),
+                message: format!("line {line}: [batch] retries: renamed: write [executor] retries"),
+            })
         }
+        None => Ok(()),
     }
 }
 
 impl SolverSection {
     /// The solver: the templates read (relative to `base`), the command resolved. Without a
-    /// `command`, the local executor runs the built-in solver in process and the others run
-    /// `<impactcal> simulate --deck <deck> --out <output> --quantity <q>`, `impactcal` being
-    /// the program given (the running `impactcal` binary). `source` names the
-    /// configuration file in messages.
+    /// `command`, the local executor runs the built-in solver in process
+    /// ([`SolverCommand::InProcess`], described as `built-in solver, <quantity>`: the caller
+    /// hands the runner the solver itself) and the others run `<impactcal> simulate --deck
+    /// <deck> --out <output> --quantity <q>`, `impactcal` being the program given (the
+    /// running `impactcal` binary). `source` names the configuration file in messages.
     ///
     /// # Errors
     /// [`RunnerError::Io`] / [`RunnerError::Template`] for a template that cannot be read
@@ -204,7 +235,7 @@ impl SolverSection {
         &self,
         base: &Path,
         source: &Path,
-        executor: &ExecutorSection,
+        executor: &Executor,
         impactcal: Option<&Path>,
     ) -> Result<Solver> {
         let s = self;
@@ -225,25 +256,17 @@ impl SolverSection {
                 .unwrap_or_default();
             inputs.push((Template::read(&base.join(p))?, name));
         }
-        let quantity = match s.quantity {
-            NodalQuantity::Displacement => Quantity::Displacement,
-            NodalQuantity::Velocity => Quantity::Velocity,
-            NodalQuantity::Acceleration => Quantity::Acceleration,
-        };
         let command = match (&s.command, executor) {
             (Some(argv), _) => SolverCommand::Argv(argv.clone()),
-            (None, ExecutorSection::Local) => SolverCommand::BuiltIn { quantity },
+            (None, Executor::Local) => SolverCommand::InProcess {
+                description: format!("built-in solver, {}", s.quantity.as_str()),
+            },
             (None, _) => {
                 let Some(exe) = impactcal else {
                     return Err(RunnerError::Config {
                         file: source.display().to_string(),
                         message: "solver.command is required for this executor".into(),
                     });
-                };
-                let q = match s.quantity {
-                    NodalQuantity::Displacement => "displacement",
-                    NodalQuantity::Velocity => "velocity",
-                    NodalQuantity::Acceleration => "acceleration",
                 };
                 SolverCommand::Argv(vec![
                     exe.display().to_string(),
@@ -253,7 +276,7 @@ impl SolverSection {
                     "--out".into(),
                     s.output.file.clone(),
                     "--quantity".into(),
-                    q.into(),
+                    s.quantity.as_str().into(),
                 ])
             }
         };
@@ -279,7 +302,8 @@ mod tests {
         )
         .unwrap();
         assert_eq!(c.batch, BatchSection::default());
-        let ExecutorSection::Slurm(s) = &c.executor else {
+        assert_eq!(c.executor.retries, 2);
+        let Executor::Slurm(s) = &c.executor.executor else {
             panic!("{:?}", c.executor)
         };
         assert_eq!(s.partition.as_deref(), Some("debug"));
@@ -298,5 +322,31 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("cloud"), "{e}");
+    }
+
+    #[test]
+    fn retries_are_an_executor_key_and_the_old_place_is_named() {
+        let c = BatchConfig::parse(
+            "[solver]\ntemplate = \"d.k\"\n[executor]\nkind = \"processes\"\njobs = 2\nretries = 5\n",
+            "b.toml",
+        )
+        .unwrap();
+        assert_eq!(c.executor.retries, 5);
+        assert_eq!(
+            c.executor(),
+            Executor::Processes(crate::ProcessOptions {
+                jobs: 2,
+                timeout: None
+            })
+        );
+        let e = BatchConfig::parse(
+            "[batch]\nstudy = \"s\"\nretries = 1\n[solver]\ntemplate = \"d.k\"\n[executor]\nkind = \"local\"\n",
+            "b.toml",
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "b.toml: line 3: [batch] retries: renamed: write [executor] retries"
+        );
     }
 }

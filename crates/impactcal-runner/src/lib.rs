@@ -13,6 +13,11 @@
 //! running it again, with the same results. [`SolverModel`] makes a solver an
 //! [`impactcal_core::Model`] for code written against that trait.
 //!
+//! The runner knows only that a run is a directory with its inputs and an output: a solver
+//! that runs in this process (the built-in shell solver, a [`Model`](impactcal_core::Model))
+//! is handed to it as an [`InProcessSolver`] by the layer above. A [`Runner`] bundles a
+//! solver, its [`Executor`], retries and cancel token for code that submits batches.
+//!
 //! ```
 //! use impactcal_runner::{Batch, Cancel, Executor, OutputSpec, Solver, SolverCommand, Template, run_batch};
 //!
@@ -45,16 +50,18 @@ pub mod journal;
 pub mod lsda;
 pub mod model;
 pub mod outputs;
+pub mod runner;
 pub mod solver;
 pub mod template;
 pub mod workdir;
 
 pub use batch::{Batch, BatchReport, Cancel, Hooks, OnFinished, RunResult};
 pub use binout::Binout;
-pub use config::BatchConfig;
+pub use config::{BatchConfig, ExecutorTable};
 pub use error::{Result, RunnerError};
 pub use executor::{Executor, ProcessOptions, SlurmOptions, run_batch, run_batch_with};
 pub use model::SolverModel;
-pub use outputs::{NodalQuantity, OutputFormat, OutputSpec, read_nodout};
-pub use solver::{Solver, SolverCommand, fingerprint};
+pub use outputs::{OutputFormat, OutputSpec, read_nodout};
+pub use runner::Runner;
+pub use solver::{InProcessRun, InProcessSolver, ModelSolver, Solver, SolverCommand, fingerprint};
 pub use template::Template;

@@ -18,7 +18,7 @@
 
 use std::path::{Path, PathBuf};
 
-use impactcal_core::{CoreError, Histories, Table, TableOptions};
+use impactcal_core::{CoreError, Histories, NodalQuantity, Table, TableOptions};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, RunnerError};
@@ -37,19 +37,6 @@ pub enum OutputFormat {
     Binout,
     /// A CSV with a header, its time column and channel columns named in the configuration.
     UserCsv,
-}
-
-/// The nodal quantity taken from a `nodout` file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum NodalQuantity {
-    /// Displacement (columns 1-3).
-    Displacement,
-    /// Velocity (columns 4-6).
-    #[default]
-    Velocity,
-    /// Acceleration (columns 7-9).
-    Acceleration,
 }
 
 /// Where a run's output is and how to read it.

@@ -2,8 +2,7 @@
 
 use std::path::Path;
 
-use impactcal_core::Histories;
-use impactcal_shell::Quantity;
+use impactcal_core::{Histories, Model};
 
 use crate::error::{Result, RunnerError};
 use crate::outputs::{OutputFormat, OutputSpec};
@@ -12,27 +11,74 @@ use crate::template::Template;
 /// How the solver is run.
 #[derive(Debug, Clone, PartialEq)]
 pub enum SolverCommand {
-    /// The built-in shell solver, in this process, on the rendered deck; it writes the
-    /// nodal `quantity` of the deck's history nodes as our CSV to the output file. Only the
-    /// in-process executor runs it; the other executors run `impactcal simulate` through
-    /// [`SolverCommand::Argv`].
-    BuiltIn {
-        /// The nodal quantity written.
-        quantity: Quantity,
-    },
-    /// A [`Model`](impactcal_core::Model) in this process: the one handed to
-    /// [`run_batch_with`](crate::run_batch_with) in [`Hooks::model`](crate::Hooks::model),
-    /// called with the run's point; its histories are written to the output file as our CSV
-    /// (a failure's message to `stderr.txt`, exit status 1), as if it were a process. Only
-    /// the in-process executor runs it. `description` names the model in the fingerprint.
+    /// A solver in this process: the [`InProcessSolver`] handed to
+    /// [`run_batch_with`](crate::run_batch_with) in [`Hooks::in_process`](crate::Hooks)
+    /// (the built-in shell solver on the run's deck, a [`Model`] at the run's point through
+    /// [`ModelSolver`], ...). Its histories are written to the output file as our CSV (a
+    /// failure's message to `stderr.txt`, exit status 1), as if it were a process. Only the
+    /// in-process executor runs it. `description` names it in the fingerprint.
     InProcess {
-        /// What the model is (enters the solver's fingerprint).
+        /// What runs (enters the solver's fingerprint).
         description: String,
     },
     /// An external program: `argv[0]` (a path, or a name looked up on `PATH`) with the
     /// arguments `argv[1..]`, started without a shell in the run's directory. Nothing is
     /// substituted into it: the inputs and outputs have fixed names inside the directory.
     Argv(Vec<String>),
+}
+
+/// One run as an [`InProcessSolver`] sees it: its directory, with the rendered inputs and
+/// `params.json` written, and its point.
+#[derive(Debug, Clone, Copy)]
+pub struct InProcessRun<'a> {
+    /// The run's index in its batch.
+    pub index: usize,
+    /// The run's work directory.
+    pub dir: &'a Path,
+    /// The names of the rendered inputs in `dir`, the deck first (empty for a solver
+    /// without templates).
+    pub inputs: &'a [String],
+    /// The point's coordinate names.
+    pub names: &'a [String],
+    /// The point's values, in the order of `names`.
+    pub values: &'a [f64],
+}
+
+/// A solver that runs in this process: what [`SolverCommand::InProcess`] runs. The runner
+/// knows only that a run is a directory with its inputs and an output; what computes the
+/// output is handed to it from above (the built-in shell solver by the experiment layer, a
+/// [`Model`] through [`ModelSolver`]).
+pub trait InProcessSolver: Sync {
+    /// Runs `run` and returns its histories, or the failure's message (written to the run's
+    /// `stderr.txt`, as a process's would be). The histories' unit is kept; histories
+    /// without one take the output specification's (as a program writing our CSV, which
+    /// carries no unit).
+    ///
+    /// # Errors
+    /// A message saying why the run failed; it fails the run, not the batch.
+    fn solve(&self, run: &InProcessRun<'_>) -> std::result::Result<Histories, String>;
+}
+
+/// A [`Model`] as an in-process solver: each run is `model.simulate` at the run's values
+/// (checked against the model's space first), its histories keeping the model's unit.
+#[derive(Clone, Copy)]
+pub struct ModelSolver<'a>(pub &'a dyn Model);
+
+impl std::fmt::Debug for ModelSolver<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_tuple("ModelSolver").field(&self.0.space()).finish()
+    }
+}
+
+impl InProcessSolver for ModelSolver<'_> {
+    fn solve(&self, run: &InProcessRun<'_>) -> std::result::Result<Histories, String> {
+        let model = self.0;
+        model
+            .space()
+            .to_unit(run.values)
+            .and_then(|_| model.simulate(run.values))
+            .map_err(|e| e.to_string())
+    }
 }
 
 /// A solver: templated inputs (the deck first), the command, and the output to read back.
@@ -51,9 +97,8 @@ pub struct Solver {
 }
 
 impl Solver {
-    /// Checks the solver: input names that are plain file names (and a deck for the
-    /// built-in solver), a non-empty command, an output spec inside the directory (and our
-    /// CSV for the built-in solver and an in-process model).
+    /// Checks the solver: input names that are plain file names, a non-empty command, an
+    /// output spec inside the directory (and our CSV for an in-process solver).
     ///
     /// # Errors
     /// [`RunnerError::Config`] naming what is wrong.
@@ -62,9 +107,6 @@ impl Solver {
             file: file.to_string(),
             message,
         };
-        if self.inputs.is_empty() && matches!(self.command, SolverCommand::BuiltIn { .. }) {
-            return Err(config("the built-in solver needs a deck template".into()));
-        }
         for (_, name) in &self.inputs {
             let p = Path::new(name);
             if name.is_empty() || p.components().count() != 1 || p.file_name().is_none() {
@@ -77,11 +119,9 @@ impl Solver {
             SolverCommand::Argv(argv) if argv.is_empty() || argv[0].is_empty() => {
                 return Err(config("the solver command is empty".into()));
             }
-            SolverCommand::BuiltIn { .. } | SolverCommand::InProcess { .. }
-                if self.output.format != OutputFormat::Csv =>
-            {
+            SolverCommand::InProcess { .. } if self.output.format != OutputFormat::Csv => {
                 return Err(config(
-                    "the built-in solver writes our CSV: the output format must be `csv`".into(),
+                    "an in-process solver writes our CSV: the output format must be `csv`".into(),
                 ));
             }
             _ => {}
@@ -103,68 +143,33 @@ impl Solver {
         format!("{:016x}", h.0)
     }
 
-    /// Runs `model` in this process at `values` and writes its histories to the output file
-    /// in `dir` (our CSV); on failure the message goes to `stderr.txt` and the exit status
-    /// is 1, as if the model had been a process. Returns the exit status and the unit of
-    /// the histories (our CSV does not carry it).
-    pub(crate) fn run_model(
+    /// Runs `solver` in this process on `run` and writes its histories to the output file
+    /// in the run's directory (our CSV); on failure the message goes to `stderr.txt` and
+    /// the exit status is 1, as if the solver had been a process. Returns the exit status
+    /// and the unit of the histories when they have one (our CSV does not carry it).
+    pub(crate) fn run_in_process(
         &self,
-        run: usize,
-        dir: &Path,
-        model: &dyn impactcal_core::Model,
-        values: &[f64],
+        solver: &dyn InProcessSolver,
+        run: &InProcessRun<'_>,
     ) -> Result<(i32, Option<String>)> {
-        let outcome = model
-            .space()
-            .to_unit(values)
-            .and_then(|_| model.simulate(values))
-            .map_err(|e| e.to_string());
-        let unit = outcome.as_ref().ok().map(|h| h.unit().to_string());
-        Ok((self.write_outcome(run, dir, outcome)?, unit))
-    }
-
-    /// Writes an in-process outcome as a process would leave it: the histories to the
-    /// output file, the message of a failure to `stderr.txt`; returns the exit status.
-    fn write_outcome(
-        &self,
-        run: usize,
-        dir: &Path,
-        outcome: std::result::Result<Histories, String>,
-    ) -> Result<i32> {
-        let io = crate::error::run_io(run, dir.join(crate::workdir::STDERR));
-        match outcome {
+        let (index, dir) = (run.index, run.dir);
+        let io = crate::error::run_io(index, dir.join(crate::workdir::STDERR));
+        match solver.solve(run) {
             Ok(h) => {
                 let mut text = Vec::new();
                 h.write_csv_to(&mut text, &self.output.file)?;
                 let out = dir.join(&self.output.file);
                 crate::workdir::write_atomic(&out, &text)
-                    .map_err(crate::error::run_io(run, out))?;
+                    .map_err(crate::error::run_io(index, out))?;
                 std::fs::write(dir.join(crate::workdir::STDERR), "").map_err(io)?;
-                Ok(0)
+                let unit = Some(h.unit().to_string()).filter(|u| !u.is_empty());
+                Ok((0, unit))
             }
             Err(message) => {
                 std::fs::write(dir.join(crate::workdir::STDERR), message + "\n").map_err(io)?;
-                Ok(1)
+                Ok((1, None))
             }
         }
-    }
-
-    /// Runs the built-in solver in this process on the deck in `dir` and writes the output.
-    /// On failure the message is written to the run's `stderr.txt` and the exit status is
-    /// 1, as if the solver had been a process.
-    pub(crate) fn run_builtin(&self, run: usize, dir: &Path, quantity: Quantity) -> Result<i32> {
-        let deck = dir.join(&self.inputs[0].1);
-        let outcome = (|| -> std::result::Result<Histories, String> {
-            let deck = impactcal_shell::keyword::read_deck(&deck).map_err(|e| e.to_string())?;
-            let mut sim =
-                impactcal_shell::Simulation::new(&deck.model).map_err(|e| e.to_string())?;
-            let result = sim.run().map_err(|e| e.to_string())?;
-            result
-                .histories(quantity)
-                .cloned()
-                .ok_or_else(|| "the deck has no history nodes (*DATABASE_HISTORY_NODE)".to_string())
-        })();
-        self.write_outcome(run, dir, outcome)
     }
 }
 

@@ -8,7 +8,8 @@ use std::sync::Mutex;
 
 use impactcal_core::{CoreError, Histories, Model, Parameter, ParameterSpace};
 use impactcal_runner::{
-    Batch, Cancel, Executor, Hooks, OutputSpec, Solver, SolverCommand, run_batch_with,
+    Batch, Cancel, Executor, Hooks, InProcessRun, InProcessSolver, ModelSolver, OutputSpec, Solver,
+    SolverCommand, Template, run_batch_with,
 };
 
 /// `y(t) = a sin(b t) / 3` on 50 samples (thirds and sines do not print short), failing
@@ -60,8 +61,9 @@ fn run(batch: &Batch, model: &Wave) -> (usize, Outcomes) {
         seen.lock().unwrap().push((i, o.map_err(|e| e.to_string())));
     };
     let on_open = |n: usize| *opened.lock().unwrap() = n;
+    let solver = ModelSolver(model);
     let hooks = Hooks {
-        model: Some(model),
+        in_process: Some(&solver),
         opened: Some(&on_open),
         finished: Some(&finished),
     };
@@ -141,7 +143,7 @@ fn streamed_results_equal_the_resumed_ones_bit_for_bit() {
 }
 
 #[test]
-fn an_in_process_solver_needs_its_model_and_the_local_executor() {
+fn an_in_process_solver_must_be_given_and_runs_on_the_local_executor_only() {
     let dir = tempfile::tempdir().unwrap();
     let points = vec![vec![1.0, 100.0]];
     let batch = Batch::new(
@@ -153,10 +155,14 @@ fn an_in_process_solver_needs_its_model_and_the_local_executor() {
     )
     .unwrap();
     let e = run_batch_with(&batch, &Executor::Local, &Cancel::new(), Hooks::default()).unwrap_err();
-    assert!(e.to_string().contains("no model was given"), "{e}");
+    assert!(
+        e.to_string().contains("no in-process solver was given"),
+        "{e}"
+    );
     let model = wave();
+    let solver = ModelSolver(&model);
     let hooks = Hooks {
-        model: Some(&model),
+        in_process: Some(&solver),
         ..Hooks::default()
     };
     let processes = Executor::Processes(impactcal_runner::ProcessOptions {
@@ -164,5 +170,61 @@ fn an_in_process_solver_needs_its_model_and_the_local_executor() {
         timeout: None,
     });
     let e = run_batch_with(&batch, &processes, &Cancel::new(), hooks).unwrap_err();
-    assert!(e.to_string().contains("run in process only"), "{e}");
+    assert!(e.to_string().contains("runs in process only"), "{e}");
+}
+
+/// An in-process solver that is not a model: it reads the deck the runner rendered into the
+/// run's directory (a CSV history whose amplitude is the parameter `a`) and returns it, as
+/// the built-in shell solver reads its deck.
+struct ReadDeck;
+
+impl InProcessSolver for ReadDeck {
+    fn solve(&self, run: &InProcessRun<'_>) -> Result<Histories, String> {
+        assert_eq!(run.names, ["a"]);
+        let deck = run.dir.join(&run.inputs[0]);
+        let h = Histories::read_csv(&deck).map_err(|e| e.to_string())?;
+        if run.values[0] < 0.0 {
+            return Err(format!("run {}: negative amplitude", run.index));
+        }
+        Ok(h)
+    }
+}
+
+#[test]
+fn an_in_process_solver_runs_on_the_rendered_deck_in_the_run_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let template = Template::parse("time,y\n0,0\n1,<<a>>\n2,0\n", "deck.csv").unwrap();
+    let mut output = OutputSpec::csv("out.csv");
+    output.unit = Some("mm".into());
+    let solver = Solver {
+        inputs: vec![(template, "deck.csv".into())],
+        command: SolverCommand::InProcess {
+            description: "read the deck".into(),
+        },
+        output,
+    };
+    let points = vec![vec![1.5], vec![-2.0], vec![0.25]];
+    let batch = Batch::new(dir.path(), "deck", solver, vec!["a".into()], &points).unwrap();
+    let hooks = Hooks {
+        in_process: Some(&ReadDeck),
+        ..Hooks::default()
+    };
+    let report = run_batch_with(&batch, &Executor::Local, &Cancel::new(), hooks).unwrap();
+    for (i, a) in [(0, 1.5), (2, 0.25)] {
+        let h = report.histories(i).unwrap();
+        assert_eq!(h.channel(0), [0.0, a, 0.0]);
+        // Histories without a unit take the output specification's.
+        assert_eq!(h.unit(), "mm");
+    }
+    let e = report.runs[1].as_ref().unwrap_err().to_string();
+    assert!(e.contains("exit"), "{e}");
+    let stderr = std::fs::read_to_string(batch.root().join("1").join("stderr.txt")).unwrap();
+    assert_eq!(stderr, "run 1: negative amplitude\n");
+    // The runner's own executor type carries the solver to any caller.
+    let runner = impactcal_runner::Runner {
+        in_process: Some(std::sync::Arc::new(ReadDeck)),
+        ..impactcal_runner::Runner::new(batch.solver().clone(), Executor::Local)
+    };
+    let again = runner.run(&batch, Hooks::default()).unwrap();
+    assert_eq!(again.reused, [true, false, true]);
 }

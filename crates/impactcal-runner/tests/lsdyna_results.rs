@@ -8,7 +8,8 @@
 
 use std::path::PathBuf;
 
-use impactcal_runner::{Binout, NodalQuantity, OutputFormat, OutputSpec, read_nodout};
+use impactcal_core::NodalQuantity;
+use impactcal_runner::{Binout, OutputFormat, OutputSpec, read_nodout};
 
 fn data(p: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -60,12 +60,12 @@
 //! ```
 
 use impactcal_core::enrich::{Candidate, Enrichable};
-use impactcal_core::{CoreError, Histories, Model, Parameter, ParameterSpace};
+use impactcal_core::{CoreError, Histories, Model, NodalQuantity, Parameter, ParameterSpace};
 
 use crate::error::{Result, ShellError};
 use crate::keyword::Deck;
 use crate::model::{MaterialLaw, ShellModel};
-use crate::simulation::{Quantity, Simulation};
+use crate::simulation::Simulation;
 
 /// Where a quantity of a [`DeckModel`] goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -333,7 +333,7 @@ pub struct DeckModel {
     targets: Vec<Target>,
     /// Every quantity the model knows, with its admissible range.
     quantities: Vec<DeckQuantity>,
-    quantity: Quantity,
+    quantity: NodalQuantity,
     /// A parameterised deck: its parameters are the quantities, in the order of `space`.
     deck: Option<Deck>,
     /// A parameterised deck's real parameters not in `space`, at their held values.
@@ -362,7 +362,7 @@ impl DeckModel {
             base: model,
             targets,
             quantities,
-            quantity: Quantity::Velocity,
+            quantity: NodalQuantity::Velocity,
             deck: None,
             held: Vec::new(),
         })
@@ -440,7 +440,7 @@ impl DeckModel {
             quantities: deck_quantities(&deck),
             space,
             base: deck.model.clone(),
-            quantity: Quantity::Velocity,
+            quantity: NodalQuantity::Velocity,
             deck: Some(deck),
             held,
         })
@@ -481,7 +481,7 @@ impl DeckModel {
 
     /// The same model returning another nodal quantity.
     #[must_use]
-    pub fn with_quantity(mut self, quantity: Quantity) -> Self {
+    pub fn with_quantity(mut self, quantity: NodalQuantity) -> Self {
         self.quantity = quantity;
         self
     }

@@ -121,3 +121,22 @@ fn list_unsupported(found: &[UnsupportedAt]) -> String {
         .collect();
     parts.join(", ")
 }
+
+impl ShellError {
+    /// What kind of fault this is: a deck, model or value that cannot be used is bad input,
+    /// an unstable run a numerical failure, a file I/O.
+    pub fn kind(&self) -> impactcal_core::ErrorKind {
+        use impactcal_core::ErrorKind;
+        match self {
+            ShellError::Core(c) => c.kind(),
+            ShellError::Keyword { .. }
+            | ShellError::UnsupportedKeyword { .. }
+            | ShellError::UnsupportedKeywords { .. }
+            | ShellError::Reference { .. }
+            | ShellError::Element { .. }
+            | ShellError::Value { .. } => ErrorKind::BadInput,
+            ShellError::Io { .. } => ErrorKind::Io,
+            ShellError::Unstable { .. } => ErrorKind::Numerical,
+        }
+    }
+}

@@ -97,6 +97,4 @@ pub use model::{
     PointMass, PrescribedMotion, RigidConstraints, RigidWall, Section, Shell, ShellModel, Spc,
     SpotWeld, ThicknessRule, VelocityTarget, WallMethod, WallShape, WeldNodes,
 };
-pub use simulation::{
-    Energies, PartEnergies, Progress, Quantity, RunResult, RunSummary, Simulation,
-};
+pub use simulation::{Energies, PartEnergies, Progress, RunResult, RunSummary, Simulation};

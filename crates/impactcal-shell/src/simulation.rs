@@ -18,7 +18,7 @@
 //!
 //! The run starts stress-free with `a^0 = f_ext / m` and `v^{1/2} = v^0 + dt^{1/2}/2 a^0`.
 
-use impactcal_core::Histories;
+use impactcal_core::{Histories, NodalQuantity};
 use rayon::prelude::*;
 
 use crate::contact::{ContactNodes, ContactState};
@@ -74,18 +74,6 @@ impl Energies {
         let r = self.initial + self.external_work;
         if r.abs() > 0.0 { self.total() / r } else { 1.0 }
     }
-}
-
-/// Which nodal quantity a history holds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Quantity {
-    /// Displacement from the initial position.
-    Displacement,
-    /// Velocity (the default).
-    #[default]
-    Velocity,
-    /// Acceleration.
-    Acceleration,
 }
 
 /// A summary of a completed run.
@@ -186,11 +174,11 @@ pub struct RunResult {
 
 impl RunResult {
     /// The nodal histories of one quantity, if history nodes were requested.
-    pub fn histories(&self, q: Quantity) -> Option<&Histories> {
+    pub fn histories(&self, q: NodalQuantity) -> Option<&Histories> {
         match q {
-            Quantity::Displacement => self.displacement.as_ref(),
-            Quantity::Velocity => self.velocity.as_ref(),
-            Quantity::Acceleration => self.acceleration.as_ref(),
+            NodalQuantity::Displacement => self.displacement.as_ref(),
+            NodalQuantity::Velocity => self.velocity.as_ref(),
+            NodalQuantity::Acceleration => self.acceleration.as_ref(),
         }
     }
 }

@@ -15,6 +15,7 @@ use crate::estimators::{
     needs_full_moments, total,
 };
 use crate::stats::{percentile_sorted, sample_sd};
+use impactcal_core::ParamGuard;
 use impactcal_core::error::{dimension_mismatch, invalid_option};
 
 /// How to estimate: estimators, bootstrap, the low-variance threshold and names.
@@ -53,6 +54,48 @@ impl Default for SobolOptions {
             parameter_names: None,
             output_names: None,
         }
+    }
+}
+
+impl ParamGuard for SobolOptions {
+    /// The options themselves: the names are checked against the design and the outputs
+    /// when the indices are computed.
+    type Checked = SobolOptions;
+
+    /// Checks the confidence level in (0, 1), a bootstrap of 0 or at least 2 resamples and
+    /// a finite non-negative low-variance tolerance.
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) naming the
+    /// option.
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        if !(self.confidence > 0.0 && self.confidence < 1.0) {
+            return Err(invalid_option(
+                "confidence",
+                self.confidence,
+                "the confidence level must lie in (0, 1)",
+            ));
+        }
+        if self.bootstrap == 1 {
+            return Err(invalid_option(
+                "bootstrap",
+                self.bootstrap,
+                "a bootstrap needs at least 2 resamples (or 0 for none)",
+            ));
+        }
+        if !(self.low_variance_tolerance >= 0.0 && self.low_variance_tolerance.is_finite()) {
+            return Err(invalid_option(
+                "low_variance_tolerance",
+                self.low_variance_tolerance,
+                "the low-variance tolerance must be finite and non-negative",
+            ));
+        }
+        Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<SobolOptions> {
+        self.check_ref()?;
+        Ok(self)
     }
 }
 
@@ -191,27 +234,7 @@ fn validate(layout: &DesignLayout, outputs: MatRef<'_, f64>, o: &SobolOptions) -
     if outputs.ncols() == 0 {
         return Err(dimension_mismatch("output columns, at least", 1, 0));
     }
-    if !(o.confidence > 0.0 && o.confidence < 1.0) {
-        return Err(invalid_option(
-            "confidence",
-            o.confidence,
-            "the confidence level must lie in (0, 1)",
-        ));
-    }
-    if o.bootstrap == 1 {
-        return Err(invalid_option(
-            "bootstrap",
-            o.bootstrap,
-            "a bootstrap needs at least 2 resamples (or 0 for none)",
-        ));
-    }
-    if !(o.low_variance_tolerance >= 0.0 && o.low_variance_tolerance.is_finite()) {
-        return Err(invalid_option(
-            "low_variance_tolerance",
-            o.low_variance_tolerance,
-            "the low-variance tolerance must be finite and non-negative",
-        ));
-    }
+    o.check_ref()?;
     if let Some(names) = &o.parameter_names
         && names.len() != layout.d()
     {

@@ -243,10 +243,17 @@ impl Jacobian {
     }
 
     /// The diagonal of `[(J^T J)^+]_AA = V_a S_a^-2 V_a^T`: the variances of the dense
-    /// coefficients for unit white noise.
+    /// coefficients for unit white noise. A coefficient the data do not determine (one with
+    /// a part in the null space of `A~`, `1 - ||V_a[i, :]||^2 > 1e-8`: a parameter without
+    /// effect, or one whose column lies in the span of the others) has variance `+inf`, not
+    /// the pseudo-inverse's finite value.
     pub fn variances(&self) -> Vec<f64> {
         (0..self.va.nrows())
             .map(|i| {
+                let in_range: f64 = (0..self.sa.len()).map(|j| self.va[(i, j)].powi(2)).sum();
+                if 1.0 - in_range > 1e-8 {
+                    return f64::INFINITY;
+                }
                 (0..self.sa.len())
                     .map(|j| (self.va[(i, j)] / self.sa[j]).powi(2))
                     .sum()
@@ -456,8 +463,11 @@ mod tests {
         assert_eq!(j.rank(), 2 + 2 * channels - 1);
         let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
         close(&j.project(&y), &reference.project(&y), 1e-11);
-        // The parameter without effect has no variance (the pseudo-inverse's zero).
-        assert!(j.variances()[2].abs() < 1e-300);
+        // The parameter without effect is not determined: infinite variance, where the
+        // pseudo-inverse would say 0; the others keep theirs.
+        let v = j.variances();
+        assert!(v[2].is_infinite());
+        assert!(v[0].is_finite() && v[1].is_finite() && v[0] > 0.0);
         close(&j.solve(&y)[..2], &reference.solve(&y)[..2], 1e-10);
     }
 

@@ -84,7 +84,8 @@ use crate::memory::Guard;
 use crate::metrics::{CurveMetrics, Iso18571};
 use crate::study::TestData;
 use crate::study::channels::prepared_test;
-use crate::study::execute::{Observer, Worker};
+use crate::study::execute::Observer;
+use impactcal_runner::Runner;
 
 pub use attribution::{Amplitude, Attribution, Score};
 pub use detection::Detection;
@@ -141,7 +142,7 @@ pub fn run_loop<M: Enrichable>(
     )
 }
 
-/// [`run_loop`] with the model's runs on a [`Worker`] (a process pool, a Slurm cluster)
+/// [`run_loop`] with the model's runs on a worker [`Runner`] (a process pool, a Slurm cluster)
 /// instead of this process (`worker = None`). Each run's `params.json` names the model's
 /// parameters (declared, then added candidates, in the order of [`Enrichable::enrich`]) and
 /// the condition `set` of a holdout run; the worker must rebuild exactly that model (as
@@ -161,7 +162,7 @@ pub fn run_loop_on<M: Enrichable>(
     options: &LoopOptions,
     dir: &Path,
     observer: &dyn Observer,
-    worker: Option<&Worker>,
+    worker: Option<&Runner>,
 ) -> Result<LoopResult> {
     let space = model.space().clone();
     let d0 = space.dim();
@@ -284,6 +285,7 @@ pub fn run_loop_on<M: Enrichable>(
         options,
         (test.cfc, band),
         unit_gains.as_deref(),
+        preparation.pre_trigger.as_ref(),
     )?;
     noise_model(&mut frame, &masks, &floor)?;
     let ctx = Ctx {
@@ -356,23 +358,33 @@ pub fn run_loop_on<M: Enrichable>(
     } else {
         None
     };
-    let noise_var = ctx
-        .model_noise
-        .stats(fit, &ctx.frame, None, None)?
-        .parameter_variances(fit.point.len());
+    let draws = ctx.model_noise.stats(fit, &ctx.frame, None, None)?;
+    let noise_var = draws.parameter_variances(fit.point.len());
+    let roughness = draws.objective_noise();
     let added: Vec<Added> = outcome
         .added
         .iter()
         .enumerate()
         .map(|(i, p)| {
             let v = fit.point[d0 + i];
-            let se = (fit.se[d0 + i].powi(2) + noise_var[d0 + i]).sqrt();
+            let pending = fit.pending[d0 + i];
+            let rough_var = fit.se[d0 + i].powi(2) * roughness;
+            let se =
+                (fit.se[d0 + i].powi(2) + noise_var[d0 + i] + rough_var + pending * pending).sqrt();
+            // Not determined by the data at the end point: the interval is the whole range.
+            let (lower, upper, roughness_sd) = if se.is_finite() {
+                (v - 1.96 * se, v + 1.96 * se, rough_var.sqrt())
+            } else {
+                (p.lower, p.upper, 0.0)
+            };
             Added {
                 name: p.name.clone(),
                 value: v,
-                lower: v - 1.96 * se,
-                upper: v + 1.96 * se,
+                lower,
+                upper,
                 model_noise_sd: noise_var[d0 + i].sqrt(),
+                roughness_sd,
+                pending_step: pending,
             }
         })
         .collect();
@@ -422,7 +434,7 @@ pub fn run_loop_on<M: Enrichable>(
                 )?
                 .histories(0, "the holdout's nominal run")?;
             check_covered(h.histories, test.map, &nominal_h, "holdout")?;
-            let (test_h, masks_h, _) =
+            let (test_h, masks_h, preparation_h) =
                 prepared_test(h.histories, test.map, test.cfc, &nominal_h, None)?;
             let calibrated_h = runner
                 .at(h.set)
@@ -464,6 +476,7 @@ pub fn run_loop_on<M: Enrichable>(
                 options,
                 (test.cfc, band),
                 Some(&gains),
+                preparation_h.pre_trigger.as_ref(),
             )?;
             noise_model(&mut frame_h, &masks_h, &floor_h)?;
             let profile = |y: &[f64]| nuisance::profile(y, &frame_h, max_shift, Some(&gains)).0;
@@ -587,7 +600,8 @@ fn model_spread<M: Model>(
 /// jitter runs of `model_noise` (read one at a time, only when a channel's noise comes
 /// from the band) are the model ensemble whose bandwidth bounds the noise's band;
 /// `filters` the test's CFC (the one the test and the runs went through) and the class of
-/// the high band.
+/// the high band; `lead` the test's record before the model's start
+/// (`study::channels::pre_trigger`), measured with the window's quiet start.
 #[allow(clippy::too_many_arguments)]
 fn frame_of(
     labels: &[String],
@@ -601,6 +615,7 @@ fn frame_of(
     options: &LoopOptions,
     filters: (Option<Cfc>, Cfc),
     fixed_gains: Option<&[f64]>,
+    lead: Option<&Histories>,
 ) -> Result<(Frame, NoiseFloor)> {
     let mut frame = Frame {
         labels: labels.to_vec(),
@@ -613,6 +628,14 @@ fn frame_of(
     let (terms, _) = nuisance::profile(y_nominal, &frame, max_shift, fixed_gains);
     let onset = noise_floor::onset(y_nominal, samples) as f64 + terms.tau / dt;
     let pre = (onset - 3.0).floor().max(0.0) as usize;
+    // A test that departs before the model's start leaves its record's last samples out.
+    let lead: Vec<f64> = lead.map_or_else(Vec::new, |h| {
+        let late = (3.0 - onset).ceil().max(0.0) as usize;
+        let keep = h.samples().saturating_sub(late);
+        (0..h.channels())
+            .flat_map(|c| h.channel(c)[..keep].iter().copied())
+            .collect()
+    });
     let members = || {
         let runs = (0..model_noise.len()).map(|j| Ok(model_noise.run(j)?.data().to_vec()));
         noise_floor::envelopes_of(
@@ -627,6 +650,7 @@ fn frame_of(
         &members,
         samples,
         dt,
+        &lead,
         pre.min(samples),
         spread,
         options.sigma,

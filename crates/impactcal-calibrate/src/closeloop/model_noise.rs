@@ -24,14 +24,28 @@
 //! it, and its variance `sum_j a_j^2 / m` widens the candidate's interval and its
 //! significance test (`closeloop::attribution`).
 //!
-//! With a smooth model (the drop tower) each `d_j` is its first-order response `J s_j`, so
-//! `v_i` and `a_j` vanish and nothing changes; on a crash model they are what keeps the loop
-//! from adding a quantity whose change the model's own noise can produce.
+//! The part of a draw no parameter absorbs, `u_j = (I - P_J) d_j`, does not move the
+//! linearised optimum but makes the objective rough: at a nearby point the profiled
+//! chi-square is `||e - u_j||^2` instead of `||e||^2` (`e` the whitened residual at the fit),
+//! a jump `dS_j = ||u_j||^2 - 2 <e, u_j>` that no smooth trend explains. An optimiser on a
+//! function with noise of size `eps_f` locates its minimum only to where the smooth rise,
+//! `delta^2 / C_ii` for parameter `i` with the others re-tuned (`C = (J^T J)^+`, so `C_ii =
+//! se_i^2`), reaches `eps_f`: `|delta_i| ~ se_i sqrt(eps_f)`. With `eps_f` the draws' RMS
+//! jump `R = sqrt(sum_j dS_j^2 / m)` this is one more standard deviation, `se_i sqrt(R)`,
+//! in the interval of an added quantity: the spread of the optimiser's end point, which
+//! the linearised error does not count (docs/closed-loop.md, "Intervals").
+//!
+//! With a smooth model (the drop tower) each `d_j` is its first-order response at the
+//! nominal point, so `v_i`, `a_j` and `R` hold only the change of that response between
+//! the nominal and the fitted point: small, and erring wide; on a crash model they are what keeps the
+//! loop from adding a quantity whose change the model's own noise can produce, and its
+//! intervals from claiming a precision the optimiser cannot reach.
 
 use impactcal_core::{Cfc, Histories};
 
 use super::detection::chi2_red;
 use super::fit::Fit;
+use super::linalg::dot;
 use super::nuisance::{self, Frame};
 use crate::error::Result;
 use crate::study::execute::Outcomes;
@@ -112,7 +126,9 @@ impl ModelNoise {
             drop(d);
             let dw = nuisance::direction(&y, &base, frame, &fit.terms, 1.0);
             let u = fit.jac.unfitted(&dw);
-            out.unfitted.push(u.iter().map(|v| v * v).sum());
+            let uu: f64 = u.iter().map(|v| v * v).sum();
+            out.jumps.push(uu - 2.0 * dot(&fit.residual, &u));
+            out.unfitted.push(uu);
             out.solved.push(fit.jac.solve(&dw));
             if let Some(p) = chi2 {
                 out.chi2.push(chi2_red(&u, p).0);
@@ -136,6 +152,8 @@ pub(crate) struct DrawStats {
     shifts: Vec<Vec<f64>>,
     /// `||(I - P_J) d_j||^2` per draw.
     unfitted: Vec<f64>,
+    /// The objective's jump per draw, `||u_j||^2 - 2 <e, u_j>`.
+    jumps: Vec<f64>,
     /// `J^+ d_j` per draw (the dense coefficients).
     solved: Vec<Vec<f64>>,
     /// The reduced chi-square of each draw's unfitted part (when asked).
@@ -175,6 +193,15 @@ impl DrawStats {
         self.chi2.iter().copied().fold(0.0, f64::max)
     }
 
+    /// The objective's roughness `R = sqrt(sum_j dS_j^2 / m)`, `dS_j = ||u_j||^2 - 2 <e,
+    /// u_j>` (module docs), in units of the whitened chi-square; 0 without draws.
+    pub fn objective_noise(&self) -> f64 {
+        if self.jumps.is_empty() {
+            return 0.0;
+        }
+        (self.jumps.iter().map(|j| j * j).sum::<f64>() / self.jumps.len() as f64).sqrt()
+    }
+
     /// The mean of `||(I - P) d_j||^2` over the draws.
     pub fn unfitted_energy(&self) -> f64 {
         if self.unfitted.is_empty() {
@@ -195,5 +222,30 @@ impl DrawStats {
             .map(|p| (p[k] / gg).powi(2))
             .sum::<f64>()
             / self.products.len() as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The roughness is the RMS of the jumps, and the jump is the change of the profiled
+    /// chi-square when the residual loses a draw's unabsorbed part: `||e - u||^2 - ||e||^2`.
+    #[test]
+    fn roughness_is_the_rms_jump_of_the_objective() {
+        let e = [1.0, -2.0, 0.5];
+        let draws = [[0.3, 0.1, -0.2], [-0.4, 0.0, 0.6]];
+        let jumps: Vec<f64> = draws.iter().map(|u| dot(u, u) - 2.0 * dot(&e, u)).collect();
+        for (u, j) in draws.iter().zip(&jumps) {
+            let after: f64 = e.iter().zip(u).map(|(a, b)| (a - b).powi(2)).sum();
+            assert!((after - dot(&e, &e) - j).abs() < 1e-12);
+        }
+        let stats = DrawStats {
+            jumps: jumps.clone(),
+            ..DrawStats::default()
+        };
+        let rms = ((jumps[0].powi(2) + jumps[1].powi(2)) / 2.0).sqrt();
+        assert!((stats.objective_noise() - rms).abs() < 1e-12);
+        assert!(DrawStats::default().objective_noise().abs() < f64::MIN_POSITIVE);
     }
 }

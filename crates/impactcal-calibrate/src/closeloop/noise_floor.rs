@@ -89,7 +89,8 @@ pub struct ChannelNoise {
 pub struct NoiseFloor {
     /// Per channel.
     pub channels: Vec<ChannelNoise>,
-    /// Pre-impact samples used (0 when the window was too short).
+    /// Quiet samples the noise was measured on: the record's before the model's start and
+    /// the window's before the impact (0 when together fewer than [`MIN_PRE_IMPACT`]).
     pub pre_impact_samples: usize,
 }
 
@@ -134,9 +135,11 @@ pub(crate) fn onset(model: &[f64], samples: usize) -> usize {
 /// Estimates the noise floor (see the module docs). `test` is `S x T` on the model's time
 /// base, `members` gives, per channel, the envelope of the spectra of the model ensemble's
 /// responses on the same channels and samples (called once, and only when some channel
-/// needs the band; [`envelopes_of`]), `pre_impact` the number of leading samples free of
-/// the impact, `spread` the jitter spread (`S x T`), `filters` the test's CFC and the
-/// class of the high band.
+/// needs the band; [`envelopes_of`]), `lead` the test's record before the model's start
+/// (`S x L`, channel-major on the same step, `L >= 0`), `pre_impact` the number of leading
+/// samples of `test` free of the impact (the quiet window of a channel is its `L` lead
+/// samples followed by those), `spread` the jitter spread (`S x T`), `filters` the test's
+/// CFC and the class of the high band.
 ///
 /// # Errors
 /// [`CalibrateError::Study`] when no source gives a positive noise level for a channel
@@ -149,13 +152,16 @@ pub(crate) fn estimate(
     members: &dyn Fn() -> Result<Vec<MemberEnvelope>>,
     samples: usize,
     dt: f64,
+    lead: &[f64],
     pre_impact: usize,
     spread: &[f64],
     user_sigma: Option<f64>,
     filters: (Option<Cfc>, Cfc),
 ) -> Result<NoiseFloor> {
     let (test_cfc, cfc) = filters;
-    let use_pre = pre_impact >= MIN_PRE_IMPACT;
+    let lead_len = lead.len() / labels.len().max(1);
+    let quiet_len = lead_len + pre_impact;
+    let use_pre = quiet_len >= MIN_PRE_IMPACT;
     let mut channels = Vec::new();
     let mut envelopes: Option<Vec<MemberEnvelope>> = None;
     for (s, label) in labels.iter().enumerate() {
@@ -166,7 +172,12 @@ pub(crate) fn estimate(
         let (sigma, source, ar, dof) = if let Some(sigma) = user_sigma {
             (sigma, NoiseSource::User, ArModel::white(sigma), None)
         } else if use_pre {
-            let (sd, ar, dof) = quiet_noise(&ch[..pre_impact], label)?;
+            let quiet: Vec<f64> = lead[s * lead_len..(s + 1) * lead_len]
+                .iter()
+                .chain(&ch[..pre_impact])
+                .copied()
+                .collect();
+            let (sd, ar, dof) = quiet_noise(&quiet, label)?;
             (sd, NoiseSource::PreImpact, ar, Some(dof))
         } else {
             if envelopes.is_none() {
@@ -222,7 +233,7 @@ pub(crate) fn estimate(
     }
     Ok(NoiseFloor {
         channels,
-        pre_impact_samples: if use_pre { pre_impact } else { 0 },
+        pre_impact_samples: if use_pre { quiet_len } else { 0 },
     })
 }
 
@@ -452,7 +463,19 @@ mod tests {
         let labels = vec!["a".to_string()];
         let run = |members: &[Vec<f64>], pre: usize, sigma: Option<f64>| {
             let env = || envelopes_of(members.iter().cloned().map(Ok), 1, t);
-            estimate(&labels, &test, &env, t, 1e-4, pre, &zeros, sigma, filters).unwrap()
+            estimate(
+                &labels,
+                &test,
+                &env,
+                t,
+                1e-4,
+                &[],
+                pre,
+                &zeros,
+                sigma,
+                filters,
+            )
+            .unwrap()
         };
         let pre = run(std::slice::from_ref(&signal), 1000, None);
         assert_eq!(pre.channels[0].source, NoiseSource::PreImpact);
@@ -478,7 +501,21 @@ mod tests {
         let user = run(&[signal], 5, Some(0.5));
         assert!((user.channels[0].sigma - 0.5).abs() < 1e-15);
         let none = || envelopes_of(std::iter::empty(), 1, t);
-        assert!(estimate(&labels, &zeros, &none, t, 1e-4, 1000, &zeros, None, filters).is_err());
+        assert!(
+            estimate(
+                &labels,
+                &zeros,
+                &none,
+                t,
+                1e-4,
+                &[],
+                1000,
+                &zeros,
+                None,
+                filters
+            )
+            .is_err()
+        );
     }
 
     /// The drop tower's three channels as the loop sees them before calibrating: the test
@@ -538,8 +575,19 @@ mod tests {
                 let (test, noise, members, t) = records(phi, seed, 400);
                 let zeros = vec![0.0; test.len()];
                 let env = || envelopes_of(members.iter().cloned().map(Ok), 3, t);
-                let f =
-                    estimate(&labels, &test, &env, t, 1e-4, 440, &zeros, None, filters).unwrap();
+                let f = estimate(
+                    &labels,
+                    &test,
+                    &env,
+                    t,
+                    1e-4,
+                    &[],
+                    440,
+                    &zeros,
+                    None,
+                    filters,
+                )
+                .unwrap();
                 for (s, c) in f.channels.iter().enumerate() {
                     let truth = sd(&noise[s * t..(s + 1) * t]);
                     assert_eq!(c.source, NoiseSource::PreImpact);
@@ -578,8 +626,8 @@ mod tests {
                     let zeros = vec![0.0; test.len()];
                     let filters = (filtered.then_some(cfc), filters.1);
                     let env = || envelopes_of(members.iter().cloned().map(Ok), 3, t);
-                    let f =
-                        estimate(&labels, &test, &env, t, 1e-4, 0, &zeros, None, filters).unwrap();
+                    let f = estimate(&labels, &test, &env, t, 1e-4, &[], 0, &zeros, None, filters)
+                        .unwrap();
                     for (s, c) in f.channels.iter().enumerate() {
                         let ratio = c.sigma / sd(&noise[s * t..(s + 1) * t]);
                         let what = format!("phi {phi} seed {seed} filtered {filtered}: {c:?}");

@@ -14,17 +14,23 @@ pub struct LoopOptions {
     pub min_explained: f64,
     /// Most candidates added (default 3).
     pub max_added: usize,
-    /// Runs of the jitter ensemble measuring the model's own noise (default 8).
+    /// Runs of the jitter ensemble measuring the model's own noise (default 8; in files
+    /// and JSON `jitter_runs`).
+    #[serde(rename = "jitter_runs")]
     pub ensemble: usize,
-    /// Relative jitter of the ensemble (default 1e-4).
+    /// Relative jitter of the ensemble (default 1e-4; `jitter_eps`).
+    #[serde(rename = "jitter_eps")]
     pub jitter: f64,
     /// CORS runs of the first calibration (default 24).
+    #[serde(rename = "reconcile_runs")]
     pub reconcile: usize,
     /// CORS runs of each recalibration after adding a candidate (default 24).
+    #[serde(rename = "recalibrate_runs")]
     pub recalibrate: usize,
     /// Gauss-Newton polish iterations after each CORS search (default 8).
     pub polish: usize,
     /// Points CORS proposes at a time (default 4).
+    #[serde(rename = "cors_batch")]
     pub batch: usize,
     /// Seed of everything random (default 0).
     pub seed: u64,
@@ -118,12 +124,15 @@ impl LoopOptions {
         }
         if self.ensemble < 2 {
             return bad(
-                "ensemble",
+                "jitter_runs",
                 format!("{} runs; the model's noise needs at least 2", self.ensemble),
             );
         }
         if !(self.jitter > 0.0 && self.jitter < 0.1) {
-            return bad("jitter", format!("{} must lie in (0, 0.1)", self.jitter));
+            return bad(
+                "jitter_eps",
+                format!("{} must lie in (0, 0.1)", self.jitter),
+            );
         }
         if self.m1_members < 19 {
             return bad(
@@ -136,7 +145,7 @@ impl LoopOptions {
             );
         }
         if self.batch == 0 {
-            return bad("batch", "must be at least 1".into());
+            return bad("cors_batch", "must be at least 1".into());
         }
         if !(self.candidate_step > 0.0 && self.candidate_step <= 0.5) {
             return bad(
@@ -166,7 +175,7 @@ impl LoopOptions {
         let need = Self::cors_runs_needed(declared);
         if self.reconcile < need {
             return bad(
-                "reconcile",
+                "reconcile_runs",
                 format!(
                     "{} runs cannot calibrate {declared} parameters: CORS needs at least {need} \
                      (an initial design of {} and two steps)",
@@ -179,7 +188,7 @@ impl LoopOptions {
             let need = Self::cors_runs_needed(declared + self.max_added);
             if self.recalibrate < need {
                 return bad(
-                    "recalibrate",
+                    "recalibrate_runs",
                     format!(
                         "{} runs cannot recalibrate up to {} parameters ({declared} declared + \
                          max_added {}): at least {need} are needed; raise it or lower max_added",

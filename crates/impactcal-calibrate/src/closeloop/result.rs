@@ -38,10 +38,24 @@ pub struct Added {
     pub upper: f64,
     /// The part of the standard error the model's own noise contributes, counted
     /// coherently from the jitter ensemble (`closeloop::model_noise`); the interval is
-    /// `value +- 1.96 sqrt(se^2 + model_noise_sd^2)`, `se` the linearised standard error
-    /// under the noise model (`closeloop::prewhiten`).
+    /// `value +- 1.96 sqrt(se^2 + model_noise_sd^2 + roughness_sd^2 + pending_step^2)`,
+    /// `se` the linearised standard error under the noise model (`closeloop::prewhiten`).
     #[serde(default)]
     pub model_noise_sd: f64,
+    /// How far the optimiser's end point can wander on the objective the model's own noise
+    /// makes rough: `se sqrt(R)`, `R` the RMS jump of the whitened chi-square between the
+    /// jitter ensemble's runs, in the part of each draw no parameter absorbs
+    /// (`closeloop::model_noise`). 0 for a smooth model.
+    #[serde(default)]
+    pub roughness_sd: f64,
+    /// The Gauss-Newton step still pending at the calibrated point for this quantity
+    /// (`J^+ e`): the distance from where the polish stopped to the linearised least-squares
+    /// optimum. It enters the interval as one more standard deviation,
+    /// `value +- 1.96 sqrt(se^2 + model_noise_sd^2 + roughness_sd^2 + pending_step^2)`: a polish stopped
+    /// short of its optimum (on its iteration budget, or on a rough residual where no step
+    /// helps) is off by about that much.
+    #[serde(default)]
+    pub pending_step: f64,
 }
 
 /// Information criteria of one model of the sequence (known-noise forms on the prewhitened

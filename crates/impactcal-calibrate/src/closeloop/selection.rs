@@ -232,7 +232,14 @@ pub(crate) fn forward<M: Enrichable>(
         let sd = (fit_n.se[last].powi(2) + noise_var).sqrt();
         let change = (value - p.nominal).abs() * best.response_per_unit;
         let by_itself = draws.largest();
-        let refusal = if trial && (realised.is_nan() || realised < options.min_explained) {
+        let refusal = if !sd.is_finite() {
+            Some(format!(
+                "`{}` recalibrated to {value:.6e} from its held {:.6e}, where the data do not \
+                 determine it: its direction lies in the span of the other fitted quantities \
+                 and nuisance terms (or it has no effect) at that point",
+                p.name, p.nominal
+            ))
+        } else if trial && (realised.is_nan() || realised < options.min_explained) {
             Some(format!(
                 "`{}` scored first but explains too little: {:.3} of the residual linearised, \
                  {:.3} once recalibrated with it, against the recalibration without it \

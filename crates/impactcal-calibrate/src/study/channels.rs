@@ -25,6 +25,80 @@ pub fn test_on_model(
     cfc: Option<Cfc>,
     model: &Histories,
 ) -> Result<Histories> {
+    window_of(&on_model_labels(test, map, cfc, model)?, model)
+}
+
+/// A test already on the model's labels (`on_model_labels`) on the model's time points.
+fn window_of(on_labels: &Histories, model: &Histories) -> Result<Histories> {
+    let what = "the test against the model's window (the test must cover it)";
+    Ok(interpolate_onto(
+        on_labels,
+        model.start(),
+        model.dt(),
+        model.samples(),
+        what,
+    )?)
+}
+
+/// Most samples of the test's record before the model's start that the closed loop
+/// measures the noise on: the level's relative standard error is then about
+/// `sqrt((1 + phi^2) / (2 m (1 - phi^2)))`, under 5 % for AR(1) noise of lag-one
+/// correlation 0.8, and the AR fit's cost stays bounded on records with long pre-triggers.
+pub const MAX_PRE_TRIGGER: usize = 1024;
+
+/// The test's record before the model's start, as [`test_on_model`] prepares the rest
+/// (converted, filtered on its own time base, relabelled, in the model's channel order):
+/// the last `min(most, n)` samples on the model's step before `model.start()`, `n` those
+/// the record holds. `None` when the record starts at or after the model (within a
+/// millionth of a step), or `most == 0`.
+///
+/// # Errors
+/// As [`test_on_model`].
+pub fn pre_trigger(
+    test: &Histories,
+    map: Option<&ChannelMap>,
+    cfc: Option<Cfc>,
+    model: &Histories,
+    most: usize,
+) -> Result<Option<Histories>> {
+    if lead_samples(test, model, most) == 0 {
+        return Ok(None);
+    }
+    lead_of(&on_model_labels(test, map, cfc, model)?, model, most)
+}
+
+/// How many samples of `test`'s record before `model.start()` [`pre_trigger`] keeps.
+fn lead_samples(test: &Histories, model: &Histories, most: usize) -> usize {
+    let room = (model.start() - test.start()) / model.dt();
+    ((room + 1e-6).floor().max(0.0) as usize).min(most)
+}
+
+/// [`pre_trigger`] of a test already on the model's labels (`on_model_labels`).
+fn lead_of(on_labels: &Histories, model: &Histories, most: usize) -> Result<Option<Histories>> {
+    let k = lead_samples(on_labels, model, most);
+    if k == 0 {
+        return Ok(None);
+    }
+    let dt = model.dt();
+    let what = "the test's record before the model's start";
+    Ok(Some(interpolate_onto(
+        on_labels,
+        model.start() - k as f64 * dt,
+        dt,
+        k,
+        what,
+    )?))
+}
+
+/// The test converted, filtered with `cfc` on its own time base, on the channels it shares
+/// with `model` (by label or through `map`, each divided by the map's gain), relabelled
+/// with the model's labels, in the model's channel order.
+fn on_model_labels(
+    test: &Histories,
+    map: Option<&ChannelMap>,
+    cfc: Option<Cfc>,
+    model: &Histories,
+) -> Result<Histories> {
     let converted = match map {
         Some(m) => m.convert(test)?,
         None => test.clone(),
@@ -68,15 +142,12 @@ pub fn test_on_model(
         labels.push(m.clone());
         channels.push(test.channel_by_label(t)?.iter().map(|v| v / gain).collect());
     }
-    let on_labels =
-        Histories::from_channels(labels, channels, test.dt(), test.start(), test.unit())?;
-    let what = "the test against the model's window (the test must cover it)";
-    Ok(interpolate_onto(
-        &on_labels,
-        model.start(),
-        model.dt(),
-        model.samples(),
-        what,
+    Ok(Histories::from_channels(
+        labels,
+        channels,
+        test.dt(),
+        test.start(),
+        test.unit(),
     )?)
 }
 
@@ -168,6 +239,14 @@ pub struct TestPreparation {
     /// (the closed loop's nuisance terms), which takes them out with every sample.
     #[serde(default)]
     pub bias_fitted: bool,
+    /// Samples of the record before the model's start kept in [`Self::pre_trigger`].
+    #[serde(default)]
+    pub pre_trigger_samples: usize,
+    /// The test's record before the model's start ([`pre_trigger`], at most
+    /// [`MAX_PRE_TRIGGER`] samples, clipped runs and spikes bridged like the rest): the
+    /// closed loop measures the noise on it. Not written to files.
+    #[serde(skip)]
+    pub pre_trigger: Option<Histories>,
 }
 
 impl TestPreparation {
@@ -180,7 +259,14 @@ impl TestPreparation {
             self.spikes,
             self.masked_samples,
             if self.bias_fitted {
-                "offsets fitted as a bias per channel with the nuisance terms".to_string()
+                let lead = match self.pre_trigger_samples {
+                    0 => String::new(),
+                    n => format!(
+                        "; the noise measured on {n} samples of the record before the model's start \
+                         with the quiet start of the window"
+                    ),
+                };
+                format!("offsets fitted as a bias per channel with the nuisance terms{lead}")
             } else if self.offsets.is_empty() {
                 "no offset removed (no pre-impact samples in the window)".to_string()
             } else {
@@ -235,7 +321,10 @@ pub fn prepared_test(
         m.entries.iter_mut().for_each(|e| e.conversion = None);
         m
     });
-    let on_model = test_on_model(&repaired, plain.as_ref(), cfc, model)?;
+    // Converted and filtered once; the window and the pre-trigger are both read from it.
+    let on_labels = on_model_labels(&repaired, plain.as_ref(), cfc, model)?;
+    let on_model = window_of(&on_labels, model)?;
+    let lead = lead_of(&on_labels, model, MAX_PRE_TRIGGER)?;
     let test_label = |model_label: &str| -> String {
         map.and_then(|m| {
             m.entries
@@ -288,6 +377,8 @@ pub fn prepared_test(
         offsets,
         pre_impact_samples: removed,
         bias_fitted: pre.is_none(),
+        pre_trigger_samples: lead.as_ref().map_or(0, Histories::samples),
+        pre_trigger: lead,
     };
     Ok((prepared, masks, summary))
 }

@@ -1,6 +1,7 @@
-//! How the study's true-model runs are executed: one small seam ([`Executor`]) between the
-//! study and whatever runs the model, and `Runs` (crate-internal), which runs each stage of
-//! a study as a batch of [`impactcal_runner`] with its journal.
+//! How the study's true-model runs are made: one small seam ([`ModelRuns`]: what a run is)
+//! between the study and whatever runs the model, where the runs happen being the runner's
+//! [`Executor`](impactcal_runner::Executor); and `Runs` (crate-internal), which runs each
+//! stage of a study as a batch of [`impactcal_runner`] with its journal.
 //!
 //! Layout of a study's output folder `<dir>`: `<dir>/runs/fingerprint` holds the study's
 //! fingerprint; each stage of runs is a batch `<dir>/runs/<stage>/` with the runner's
@@ -18,7 +19,8 @@ use std::path::{Path, PathBuf};
 
 use impactcal_core::{CoreError, Histories, Model, ParameterSpace};
 use impactcal_runner::{
-    Batch, Cancel, Hooks, OutputSpec, RunResult, RunnerError, Solver, SolverCommand, run_batch_with,
+    Batch, Cancel, Hooks, InProcessSolver, ModelSolver, OutputSpec, RunResult, Runner, RunnerError,
+    Solver, SolverCommand, run_batch_with,
 };
 
 use crate::error::{CalibrateError, Result};
@@ -26,10 +28,12 @@ use crate::error::{CalibrateError, Result};
 /// The outcome of one run as the study keeps it: the histories or the failure's message.
 pub type RunOutcome = std::result::Result<Histories, String>;
 
-/// Where a study's true-model runs happen: the parameter space, the runner's [`Solver`]
-/// that runs one point, and the runner's executor. [`InProcess`] runs a [`Model`] in this
-/// process; [`Runner`] runs any solver on any executor (a process pool, a Slurm cluster).
-pub trait Executor: Sync {
+/// What a study's true-model run is: the parameter space, the runner's [`Solver`] that runs
+/// one point (and, for a solver run in this process, what runs it), with where the runs
+/// happen (the runner's [`Executor`](impactcal_runner::Executor)). [`InProcess`] runs a
+/// [`Model`] in this process; [`SolverRuns`] runs any solver of a [`Runner`] (an external
+/// solver through deck templates, a worker program, the built-in solver in process).
+pub trait ModelRuns: Sync {
     /// The parameters every point has, in order.
     fn space(&self) -> &ParameterSpace;
 
@@ -41,8 +45,14 @@ pub trait Executor: Sync {
         impactcal_runner::Executor::Local
     }
 
-    /// The model a [`SolverCommand::InProcess`] solver runs (default: none).
+    /// The model a [`SolverCommand::InProcess`] solver runs at each point (default: none).
     fn model(&self) -> Option<&dyn Model> {
+        None
+    }
+
+    /// What a [`SolverCommand::InProcess`] solver runs when it is not a model (default:
+    /// none), such as the built-in shell solver on each run's deck.
+    fn in_process(&self) -> Option<&dyn InProcessSolver> {
         None
     }
 
@@ -69,7 +79,7 @@ pub trait Executor: Sync {
 #[derive(Debug)]
 pub struct InProcess<'m, M>(pub &'m M);
 
-impl<M: Model> Executor for InProcess<'_, M> {
+impl<M: Model> ModelRuns for InProcess<'_, M> {
     fn space(&self) -> &ParameterSpace {
         self.0.space()
     }
@@ -83,69 +93,55 @@ impl<M: Model> Executor for InProcess<'_, M> {
     }
 }
 
-/// Any solver of the runner on any of its executors: an external solver through deck
-/// templates, or a program that reads each run's `params.json` (as `impactcal study-point`
-/// does for the built-in models), on a local process pool or a Slurm cluster.
+/// The runs of a [`Runner`] over a parameter space: an external solver through deck
+/// templates, or a program that reads each run's `params.json` (as `impactcal point` does
+/// for the built-in models), on any executor; or the built-in solver in process, handed in
+/// as the runner's in-process solver.
 #[derive(Debug, Clone)]
-pub struct Runner {
+pub struct SolverRuns {
     /// The parameters.
     pub space: ParameterSpace,
-    /// The solver.
-    pub solver: Solver,
-    /// Where the runs happen.
-    pub executor: impactcal_runner::Executor,
-    /// Further attempts per failing run.
-    pub retries: u32,
-    /// Stops the runs when set (a Ctrl-C handler sets it).
-    pub cancel: Cancel,
+    /// The solver, where it runs, its retries and cancel token.
+    pub runner: Runner,
 }
 
-impl Executor for Runner {
+impl ModelRuns for SolverRuns {
     fn space(&self) -> &ParameterSpace {
         &self.space
     }
     fn solver(&self) -> Solver {
-        self.solver.clone()
+        self.runner.solver.clone()
     }
     fn executor(&self) -> impactcal_runner::Executor {
-        self.executor.clone()
+        self.runner.executor.clone()
+    }
+    fn in_process(&self) -> Option<&dyn InProcessSolver> {
+        self.runner.in_process()
     }
     fn retries(&self) -> u32 {
-        self.retries
+        self.runner.retries
     }
     fn cancel(&self) -> Cancel {
-        self.cancel.clone()
+        self.runner.cancel.clone()
     }
 }
 
-/// A solver command that runs one point of whatever model a caller names per batch: the
-/// program reads each run's `params.json` (the names of the point's coordinates, their
-/// values and the condition `set`) and rebuilds the model from them, as `impactcal
-/// loop-point` does for the closed loop's built-in models, whose space grows as effects are
-/// added and whose holdout runs are at another condition. Runs on any executor.
-#[derive(Debug, Clone)]
-pub struct Worker {
-    /// The solver: a command without templates, writing our CSV.
-    pub solver: Solver,
-    /// Where the runs happen.
-    pub executor: impactcal_runner::Executor,
-    /// Further attempts per failing run.
-    pub retries: u32,
-    /// Stops the runs when set (a Ctrl-C handler sets it).
-    pub cancel: Cancel,
-}
-
-/// The runs of one [`Model`] at one condition: in this process, or through a [`Worker`].
+/// The runs of one [`Model`] at one condition: in this process, or through a [`Runner`]
+/// whose solver command runs one point of whatever model a caller names per batch (the
+/// program reads each run's `params.json`, the names of the point's coordinates, their
+/// values and the condition `set`, and rebuilds the model from them, as `impactcal point`
+/// does for the closed loop's built-in models, whose space grows as effects are added and
+/// whose holdout runs are at another condition).
 pub(crate) struct Dispatch<'a> {
     /// The model (its space names the coordinates; run in process without a worker).
     pub model: &'a dyn Model,
-    /// The worker, if the runs go to one.
-    pub worker: Option<&'a Worker>,
+    /// The runner, if the runs go to a worker program.
+    pub worker: Option<&'a Runner>,
     /// The condition the model is at.
     pub condition: &'a [(String, f64)],
 }
 
-impl Executor for Dispatch<'_> {
+impl ModelRuns for Dispatch<'_> {
     fn space(&self) -> &ParameterSpace {
         self.model.space()
     }
@@ -204,9 +200,9 @@ pub struct Silent;
 
 impl Observer for Silent {}
 
-/// The executor, output folder and observer of one study.
+/// What a run is, the output folder and the observer of one study.
 pub(crate) struct Runs<'a> {
-    executor: &'a dyn Executor,
+    model_runs: &'a dyn ModelRuns,
     root: PathBuf,
     fingerprint: String,
     observer: &'a dyn Observer,
@@ -219,7 +215,7 @@ impl<'a> Runs<'a> {
     /// [`CalibrateError::ForeignJournal`] when `dir` holds another study's runs (nothing is
     /// written then); [`CalibrateError::Journal`] when the folder cannot be written.
     pub fn open(
-        executor: &'a dyn Executor,
+        model_runs: &'a dyn ModelRuns,
         dir: &Path,
         fingerprint: &str,
         observer: &'a dyn Observer,
@@ -242,7 +238,7 @@ impl<'a> Runs<'a> {
             }
         }
         Ok(Runs {
-            executor,
+            model_runs,
             root: dir.to_path_buf(),
             fingerprint: fingerprint.to_string(),
             observer,
@@ -281,16 +277,16 @@ impl<'a> Runs<'a> {
             return Ok(Outcomes { runs: Vec::new() });
         }
         let name = batch_name(stage, first, announce);
-        let space = self.executor.space();
+        let space = self.model_runs.space();
         let batch = Batch::for_space_at(
             &self.root,
             &name,
-            self.executor.solver(),
+            self.model_runs.solver(),
             space,
             points,
-            self.executor.condition(),
+            self.model_runs.condition(),
         )?
-        .with_retries(self.executor.retries())
+        .with_retries(self.model_runs.retries())
         .with_identity(self.fingerprint.clone());
         let opened = |reused: usize| {
             if announce {
@@ -301,15 +297,19 @@ impl<'a> Runs<'a> {
         let finished = |_: usize, _: std::result::Result<Histories, &RunnerError>| {
             self.observer.run_finished();
         };
+        let model = self.model_runs.model().map(ModelSolver);
         let hooks = Hooks {
-            model: self.executor.model(),
+            in_process: match &model {
+                Some(m) => Some(m as &dyn InProcessSolver),
+                None => self.model_runs.in_process(),
+            },
             opened: Some(&opened),
             finished: Some(&finished),
         };
         let report = run_batch_with(
             &batch,
-            &self.executor.executor(),
-            &self.executor.cancel(),
+            &self.model_runs.executor(),
+            &self.model_runs.cancel(),
             hooks,
         )?;
         Ok(Outcomes {

@@ -23,7 +23,7 @@
 //! 9. the before/after table: prediction error, `Q(t)` error, M2 count above 0.9, and per
 //!    sensor relative L2, Sprague-Geers C and ISO/TS 18571 R.
 //!
-//! Every true-model run goes through one [`Executor`] and the runner's journal in the output
+//! Every true-model run is made as one [`ModelRuns`] says, through the runner's journal in the output
 //! folder ([`execute`]: recorded before it starts and after its result is read); running the
 //! same study again, after an interruption at any moment, reuses finished runs, re-attaches
 //! to runs still queued or running and gives the same result, bit for bit. [`StudyResult`] holds every number (`study.json`);
@@ -55,7 +55,7 @@ use crate::error::{CalibrateError, Result};
 use crate::memory::Guard;
 use crate::metrics::{CurveMetrics, Iso18571};
 
-pub use execute::{Executor, InProcess, Observer, RunOutcome, Runner, Silent, Worker};
+pub use execute::{InProcess, ModelRuns, Observer, RunOutcome, Silent, SolverRuns};
 pub use m1::{M1, Verdict};
 pub use options::{StudyOptions, ValidStudyOptions};
 pub use plan::{StudyShapes, estimated_peak};
@@ -104,14 +104,14 @@ pub fn run_model<M: Model>(
 /// The fingerprint of a study: a hash of the model's description, its space, the options,
 /// the CFC class, the channel map and the test's values.
 pub fn fingerprint(
-    executor: &dyn Executor,
+    model_runs: &dyn ModelRuns,
     description: &str,
     test: TestData<'_>,
     options: &StudyOptions,
 ) -> String {
     let mut bytes = Vec::new();
     bytes.extend_from_slice(description.as_bytes());
-    bytes.extend(serde_json::to_vec(executor.space()).unwrap_or_default());
+    bytes.extend(serde_json::to_vec(model_runs.space()).unwrap_or_default());
     bytes.extend(serde_json::to_vec(options).unwrap_or_default());
     bytes.extend(format!("{:?}", test.cfc.map(Cfc::class)).as_bytes());
     if let Some(m) = test.map {
@@ -127,21 +127,21 @@ pub fn fingerprint(
     impactcal_runner::fingerprint(&bytes)
 }
 
-/// [`run_model`] with any [`Executor`].
+/// [`run_model`] with the runs any [`ModelRuns`] makes.
 ///
 /// # Errors
 /// As [`run_model`].
 pub fn run(
-    executor: &dyn Executor,
+    model_runs: &dyn ModelRuns,
     description: &str,
     test: TestData<'_>,
     options: &ValidStudyOptions,
     dir: &Path,
     observer: &dyn Observer,
 ) -> Result<StudyResult> {
-    let space = executor.space().clone();
-    let fp = fingerprint(executor, description, test, options);
-    let runs = Runs::open(executor, dir, &fp, observer)?;
+    let space = model_runs.space().clone();
+    let fp = fingerprint(model_runs, description, test, options);
+    let runs = Runs::open(model_runs, dir, &fp, observer)?;
     let prep = |h: &Histories| -> Result<Histories> {
         Ok(match test.cfc {
             Some(c) => h.filtered(c)?,
@@ -166,12 +166,12 @@ pub fn run(
             run_values: nominal_raw.channels() * nominal_raw.samples(),
             samples: nominal_raw.samples(),
             channels: test_m.channels(),
-            runs: options.ensemble,
+            runs: options.halton_runs,
             shapes: options.shapes,
             sensors: options.sensors,
             parameters: space.dim(),
             sobol_rows: options.sensitivity_samples,
-            threads: if executor.model().is_some() {
+            threads: if model_runs.model().is_some() {
                 rayon::current_num_threads()
             } else {
                 0
@@ -181,7 +181,7 @@ pub fn run(
     };
     plan.check_all()?;
     observer.step(&plan.line());
-    let jitter = JitterOptions::new(options.noise_runs, options.noise_eps, options.seed);
+    let jitter = JitterOptions::new(options.jitter_runs, options.jitter_eps, options.seed);
     let jitter_pts = jitter_points(&space, &nominal_point, &jitter)?;
     let noise_runs = runs.stage("noise", &jitter_pts)?;
     let noise_ok: Vec<usize> = (0..noise_runs.len())
@@ -239,7 +239,7 @@ pub fn run(
     let design = sample(
         &space,
         SamplingMethod::ScrambledHalton,
-        options.ensemble,
+        options.halton_runs,
         options.seed,
     )?;
     let points: Vec<Vec<f64>> = (0..design.points.nrows())
@@ -334,7 +334,7 @@ pub fn run(
         },
         noise: NoiseSummary {
             runs: noise_ok.len(),
-            eps: options.noise_eps,
+            eps: options.jitter_eps,
             fraction: options.noise_fraction,
             relative_spread: noise.relative_spread(window_end, &noise_idx),
             relative_spread_sensors: None,
@@ -380,6 +380,9 @@ pub fn run(
         &base_obj,
         &test_obj,
     )?;
+    if let Some(note) = &sensors.note {
+        observer.step(&format!("note: {note}"));
+    }
     let selected = sensors.selected.clone();
     let sensor_idx: Vec<usize> = selected.iter().filter_map(|l| noise.index_of(l)).collect();
     result.noise.relative_spread_sensors = Some(noise.relative_spread(window_end, &sensor_idx));
@@ -460,7 +463,7 @@ pub fn run(
         &start,
         &start_outcome,
         options.reconcile_runs,
-        options.reconcile_batch,
+        options.cors_batch,
         options.seed,
         &mut run_batch,
         &prediction_error,

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 #[serde(default, deny_unknown_fields)]
 pub struct StudyOptions {
     /// Runs of the Halton ensemble `N` (the paper: 150 for Table 1, 50 for Table 2).
-    pub ensemble: usize,
+    pub halton_runs: usize,
     /// Sensors `K` placed by effective independence on the ensemble's impact shapes.
     pub sensors: usize,
     /// Impact shapes kept for placement and M2 (at most `sensors`).
@@ -22,13 +22,13 @@ pub struct StudyOptions {
     pub reconcile_runs: usize,
     /// Points CORS-RBF proposes at a time (runs of a batch go in parallel); part of the
     /// study's definition, since the sequence of points depends on it.
-    pub reconcile_batch: usize,
+    pub cors_batch: usize,
     /// Seed of the ensemble, the jitter ensemble, the Sobol' design and CORS-RBF.
     pub seed: u64,
     /// Runs `J` of the jitter ensemble that measures the model's own noise.
-    pub noise_runs: usize,
+    pub jitter_runs: usize,
     /// Largest relative perturbation of the jitter ensemble.
-    pub noise_eps: f64,
+    pub jitter_eps: f64,
     /// A channel is predictable while its jitter spread stays within this fraction of its
     /// RMS signal; channels whose horizon ends inside the window leave the objective.
     pub noise_fraction: f64,
@@ -52,15 +52,15 @@ pub struct StudyOptions {
 impl Default for StudyOptions {
     fn default() -> Self {
         StudyOptions {
-            ensemble: 50,
+            halton_runs: 50,
             sensors: 41,
             shapes: 10,
             sensitivity_samples: 1024,
             reconcile_runs: 60,
-            reconcile_batch: 2,
+            cors_batch: 2,
             seed: 1,
-            noise_runs: 8,
-            noise_eps: 1e-4,
+            jitter_runs: 8,
+            jitter_eps: 1e-4,
             noise_fraction: 0.05,
             keep_unpredictable: false,
             screen_only: false,
@@ -79,13 +79,13 @@ impl ParamGuard for StudyOptions {
     /// # Errors
     /// [`CoreError::InvalidOption`] for an ensemble of fewer than 2 runs (a budget of 0
     /// included), 0 sensors or shapes, more shapes than sensors, fewer than 2 sensitivity
-    /// samples, a reconciliation batch of 0, fewer than 2 jitter runs, `noise_eps` outside
+    /// samples, a reconciliation batch of 0, fewer than 2 jitter runs, `jitter_eps` outside
     /// `(0, 0.1]` or `noise_fraction` not positive.
     fn check_ref(&self) -> impactcal_core::Result<()> {
-        if self.ensemble < 2 {
+        if self.halton_runs < 2 {
             return Err(CoreError::invalid_option(
-                "study.ensemble",
-                self.ensemble,
+                "study.halton_runs",
+                self.halton_runs,
                 "an ensemble needs at least 2 runs",
             ));
         }
@@ -110,24 +110,24 @@ impl ParamGuard for StudyOptions {
                 "must be at least 2",
             ));
         }
-        if self.reconcile_batch == 0 {
+        if self.cors_batch == 0 {
             return Err(CoreError::invalid_option(
-                "study.reconcile_batch",
+                "study.cors_batch",
                 0,
                 "must be at least 1",
             ));
         }
-        if self.noise_runs < 2 {
+        if self.jitter_runs < 2 {
             return Err(CoreError::invalid_option(
-                "study.noise_runs",
-                self.noise_runs,
+                "study.jitter_runs",
+                self.jitter_runs,
                 "a jitter ensemble needs at least 2 runs",
             ));
         }
-        if !(self.noise_eps > 0.0 && self.noise_eps <= 0.1) {
+        if !(self.jitter_eps > 0.0 && self.jitter_eps <= 0.1) {
             return Err(CoreError::invalid_option(
-                "study.noise_eps",
-                self.noise_eps,
+                "study.jitter_eps",
+                self.jitter_eps,
                 "must lie in (0, 0.1]",
             ));
         }

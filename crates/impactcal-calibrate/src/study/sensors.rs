@@ -28,6 +28,10 @@ pub struct SensorsResult {
     pub expansion_rel_error: Option<f64>,
     /// Condition number of the expansion's fit.
     pub expansion_condition: Option<f64>,
+    /// Why fewer shapes were kept than the options ask for: the ensemble's data has a lower
+    /// numerical rank (absent when the requested number was kept).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 /// Whether `count` sensors fit on `candidates` channels.
@@ -92,8 +96,21 @@ pub fn place_sensors(
             }
         }
     }
-    let ensemble = ImpactShapes::from_matrix(y.as_ref(), &ShapeOptions::count(shapes))?;
+    // A number of shapes above what the ensemble's data can carry is lowered to its
+    // numerical rank, with a note, rather than ending a study whose runs are done.
+    let (ensemble, note) = match ImpactShapes::from_matrix(y.as_ref(), &ShapeOptions::count(shapes))
+    {
+        Err(impactcal_shapes::ShapesError::TooManyShapes { requested, rank }) if rank > 0 => (
+            ImpactShapes::from_matrix(y.as_ref(), &ShapeOptions::count(rank))?,
+            Some(format!(
+                "{requested} shapes asked for, but the ensemble's data has numerical rank \
+                 {rank}: {rank} shapes kept"
+            )),
+        ),
+        other => (other?, None),
+    };
     drop(y);
+    let shapes = ensemble.len();
     let placement = place(
         &CandidateShapes::new(candidates.to_vec(), ensemble.shapes())?,
         &PlacementOptions::new(count),
@@ -125,5 +142,47 @@ pub fn place_sensors(
         condition_number: placement.condition_number,
         expansion_rel_error,
         expansion_condition,
+        note,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Histories of three proportional channels (`a`, `2 a`, `3 a`) scaled by `k`.
+    fn rank_one(k: f64) -> Histories {
+        let mut text = String::from("time,1.z,2.z,3.z\n");
+        for i in 0..20 {
+            let v = k * (0.3 * f64::from(i)).sin();
+            text.push_str(&format!(
+                "{},{},{},{}\n",
+                f64::from(i) * 0.001,
+                v,
+                2.0 * v,
+                3.0 * v
+            ));
+        }
+        Histories::parse_csv(&text, "rank-one").unwrap()
+    }
+
+    /// An ensemble whose data has numerical rank 1: asking 3 shapes keeps 1, with a note,
+    /// instead of stopping the study after its runs.
+    #[test]
+    fn shapes_above_the_ensembles_rank_are_lowered_with_a_note() {
+        let labels: Vec<String> = ["1.z", "2.z", "3.z"].map(String::from).to_vec();
+        let read = |j: usize| -> Result<Histories> { Ok(rank_one(1.0 + j as f64)) };
+        let base = rank_one(1.0);
+        let r = place_sensors(&read, 4, &labels, 3, 3, &base, &rank_one(1.5)).unwrap();
+        assert_eq!(r.shapes, 1);
+        assert_eq!(r.selected.len(), 3);
+        let note = r.note.unwrap();
+        assert!(
+            note.contains("3 shapes asked for") && note.contains("numerical rank 1"),
+            "{note}"
+        );
+        // Asking what the data carries leaves no note.
+        let r = place_sensors(&read, 4, &labels, 3, 1, &base, &rank_one(1.5)).unwrap();
+        assert_eq!((r.shapes, r.note), (1, None));
+    }
 }

@@ -60,7 +60,7 @@ impl<M: Model> Subspace<M> {
                 ));
             };
             let q = &full.parameters()[i];
-            if p.lower < q.lower || p.upper > q.upper {
+            if !within(p, q) {
                 return Err(CalibrateError::study(
                     format!("parameter `{}`", p.name),
                     format!(
@@ -105,14 +105,25 @@ impl<M: Model> Subspace<M> {
         &self.model
     }
 
-    /// The model's full point for a point of the subspace.
+    /// The model's full point for a point of the subspace. A value beyond the model's own
+    /// bounds by round-off (bounds accepted by [`within`]) is moved onto them.
     pub fn full_point(&self, point: &[f64]) -> Vec<f64> {
         let mut x = self.base.clone();
+        let full = self.model.space().parameters();
         for (&i, &v) in self.slots.iter().zip(point) {
-            x[i] = v;
+            x[i] = full.get(i).map_or(v, |q| v.clamp(q.lower, q.upper));
         }
         x
     }
+}
+
+/// Whether the bounds of `p` lie inside those of `q` up to round-off: a few units in the
+/// last place of the larger bound's magnitude, so that `-20 %` of a deck value of 0.1
+/// (`0.8 * 0.1 = 0.08000000000000002` in the model's range) accepts the user's `0.08`.
+pub fn within(p: &Parameter, q: &Parameter) -> bool {
+    let scale = q.lower.abs().max(q.upper.abs());
+    let tol = 8.0 * f64::EPSILON * scale;
+    p.lower >= q.lower - tol && p.upper <= q.upper + tol
 }
 
 /// Up to three names of `names` closest to `name` (Jaro-Winkler similarity).

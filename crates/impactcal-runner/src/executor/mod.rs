@@ -1,7 +1,7 @@
 //! Executors: where the runs of a batch happen.
 //!
-//! - [`Executor::Local`]: in this process, runs in parallel on rayon's thread pool (the
-//!   built-in solver in process; an external command as a child process per run);
+//! - [`Executor::Local`]: in this process, runs in parallel on rayon's thread pool (an
+//!   in-process solver in process; an external command as a child process per run);
 //! - [`Executor::Processes`]: a pool of at most `jobs` concurrent solver processes, each
 //!   with a time limit after which it is killed;
 //! - [`Executor::Slurm`]: one Slurm job array per batch, each task in its own work
@@ -18,6 +18,7 @@ pub mod slurm;
 
 use std::time::Duration;
 
+use impactcal_core::{CoreError, ParamGuard};
 use serde::{Deserialize, Serialize};
 
 use crate::batch::{Batch, BatchReport, Cancel, Driver, Hooks};
@@ -28,7 +29,9 @@ pub use slurm::SlurmOptions;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProcessOptions {
-    /// Concurrent solver processes (at least 1).
+    /// Concurrent solver processes (at least 1; default: the cores this process may use,
+    /// `std::thread::available_parallelism`).
+    #[serde(default = "machine_cores")]
     pub jobs: usize,
     /// Time limit per run in seconds; a run still going is killed and counts as failed
     /// (and is retried within the batch's limit). None: no limit.
@@ -36,37 +39,59 @@ pub struct ProcessOptions {
     pub timeout: Option<f64>,
 }
 
-impl ProcessOptions {
+/// The cores this process may use (1 when the system cannot say).
+pub fn machine_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+}
+
+impl ParamGuard for ProcessOptions {
+    /// The options themselves: nothing downstream needs a separate checked form.
+    type Checked = ProcessOptions;
+
     /// Checks `jobs >= 1` and a finite positive timeout.
     ///
     /// # Errors
-    /// [`RunnerError::Config`].
-    pub fn check(&self) -> Result<()> {
+    /// [`CoreError::InvalidOption`] naming the key (`executor.jobs`, `executor.timeout`).
+    fn check_ref(&self) -> impactcal_core::Result<()> {
         if self.jobs == 0 {
-            return Err(config("executor.jobs must be at least 1"));
+            return Err(CoreError::invalid_option(
+                "executor.jobs",
+                self.jobs,
+                "must be at least 1",
+            ));
         }
         if let Some(t) = self.timeout {
             if !(t.is_finite() && t > 0.0) {
-                return Err(config(format!("executor.timeout {t} must be positive")));
+                return Err(CoreError::invalid_option(
+                    "executor.timeout",
+                    t,
+                    "must be finite and positive (seconds)",
+                ));
             }
         }
         Ok(())
     }
 
+    fn check(self) -> impactcal_core::Result<ProcessOptions> {
+        self.check_ref()?;
+        Ok(self)
+    }
+}
+
+impl ProcessOptions {
     fn timeout(&self) -> Option<Duration> {
         self.timeout.map(Duration::from_secs_f64)
     }
 }
 
-/// The solver command of an executor that runs processes (the built-in solver runs in
+/// The solver command of an executor that runs processes (an in-process solver runs in
 /// process only).
 fn argv<'d>(driver: &'d Driver<'_>) -> Result<&'d [String]> {
     match &driver.batch.solver().command {
         crate::solver::SolverCommand::Argv(argv) => Ok(argv),
-        crate::solver::SolverCommand::BuiltIn { .. }
-        | crate::solver::SolverCommand::InProcess { .. } => Err(config(
-            "the processes and slurm executors run a solver command; the built-in solver and \
-             an in-process model run in process only (executor kind = \"local\")",
+        crate::solver::SolverCommand::InProcess { .. } => Err(config(
+            "the processes and slurm executors run a solver command; an in-process solver \
+             runs in process only (executor kind = \"local\")",
         )),
     }
 }
@@ -78,8 +103,11 @@ fn config(message: impl Into<String>) -> RunnerError {
     }
 }
 
-/// Where the runs of a batch happen.
-#[derive(Debug, Clone, PartialEq)]
+/// Where the runs of a batch happen. In a configuration file it is the `[executor]` table,
+/// chosen by `kind` (`"local"`, `"processes"`, `"slurm"`) with the variant's options beside
+/// it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
 #[non_exhaustive]
 pub enum Executor {
     /// In this process, in parallel on rayon's pool.
@@ -101,15 +129,16 @@ impl Executor {
     }
 
     /// Checks the executor's options (as [`run_batch`] does before any run), so that a
-    /// caller with many batches can refuse bad options before the first.
+    /// caller with many batches can refuse bad options before the first: the options'
+    /// [`ParamGuard::check_ref`].
     ///
     /// # Errors
-    /// [`RunnerError::Config`] naming the option.
+    /// [`RunnerError::Core`] with the [`CoreError::InvalidOption`] naming the option.
     pub fn check(&self) -> Result<()> {
         match self {
             Executor::Local => Ok(()),
-            Executor::Processes(o) => o.check(),
-            Executor::Slurm(o) => o.check(),
+            Executor::Processes(o) => Ok(o.check_ref()?),
+            Executor::Slurm(o) => Ok(o.check_ref()?),
         }
     }
 }
@@ -122,20 +151,20 @@ impl Executor {
 ///
 /// # Errors
 /// Faults of the batch as a whole: the journal cannot be written or belongs to another
-/// batch; the built-in solver asked of an executor that runs processes; a scheduler that
+/// batch; an in-process solver asked of an executor that runs processes; a scheduler that
 /// cannot be queried; [`RunnerError::Cancelled`] when `cancel` was set (runs in flight are
 /// killed or cancelled; the journal holds the rest).
 pub fn run_batch(batch: &Batch, executor: &Executor, cancel: &Cancel) -> Result<BatchReport> {
     run_batch_with(batch, executor, cancel, Hooks::default())
 }
 
-/// [`run_batch`] with [`Hooks`]: the model an in-process solver runs, and callbacks that
+/// [`run_batch`] with [`Hooks`]: the solver an in-process command runs, and callbacks that
 /// receive each run's histories as it finishes (so that nothing holds every run's
 /// histories unless the caller keeps them).
 ///
 /// # Errors
-/// As [`run_batch`]; [`RunnerError::Config`] when the solver runs an in-process model and
-/// `hooks.model` is `None`.
+/// As [`run_batch`]; [`RunnerError::Config`] when the solver runs in process and
+/// `hooks.in_process` is `None`.
 pub fn run_batch_with(
     batch: &Batch,
     executor: &Executor,
@@ -145,10 +174,10 @@ pub fn run_batch_with(
     if matches!(
         batch.solver().command,
         crate::solver::SolverCommand::InProcess { .. }
-    ) && hooks.model.is_none()
+    ) && hooks.in_process.is_none()
     {
         return Err(config(
-            "the solver runs an in-process model, but no model was given",
+            "the solver runs in process, but no in-process solver was given",
         ));
     }
     let (driver, pending, in_flight) = Driver::open(batch, cancel, executor.name(), hooks)?;
@@ -160,7 +189,7 @@ pub fn run_batch_with(
             local::run(&driver, &pending)?;
         }
         Executor::Processes(options) => {
-            options.check()?;
+            options.check_ref()?;
             let mut pending = pending;
             pending.extend(in_flight.keys());
             pending.sort_unstable();
@@ -169,4 +198,57 @@ pub fn run_batch_with(
         Executor::Slurm(options) => slurm::run(&driver, pending, in_flight, options)?,
     }
     Ok(driver.finish())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The option named by the first fault of `e`'s options, through the executor's check.
+    fn fault(e: Executor) -> String {
+        match e.check() {
+            Err(RunnerError::Core(CoreError::InvalidOption { name, .. })) => name,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn executor_options_are_checked_as_every_option_type_is() {
+        let processes = |jobs, timeout| Executor::Processes(ProcessOptions { jobs, timeout });
+        assert_eq!(fault(processes(0, None)), "executor.jobs");
+        assert_eq!(fault(processes(2, Some(0.0))), "executor.timeout");
+        assert_eq!(fault(processes(2, Some(f64::NAN))), "executor.timeout");
+        assert!(processes(2, Some(600.0)).check().is_ok());
+        let slurm = |f: fn(&mut SlurmOptions)| {
+            let mut o = SlurmOptions::default();
+            f(&mut o);
+            Executor::Slurm(o)
+        };
+        assert_eq!(
+            fault(slurm(|o| o.partition = Some("de bug".into()))),
+            "executor.partition"
+        );
+        assert_eq!(fault(slurm(|o| o.max_array = 0)), "executor.max_array");
+        assert_eq!(
+            fault(slurm(|o| o.max_running = Some(0))),
+            "executor.max_running"
+        );
+        assert_eq!(fault(slurm(|o| o.poll = -1.0)), "executor.poll");
+        assert!(slurm(|o| o.max_running = Some(4)).check().is_ok());
+        // The consuming check hands the options back unchanged.
+        let o = ProcessOptions {
+            jobs: 3,
+            timeout: None,
+        };
+        assert_eq!(o.clone().check().unwrap(), o);
+        let e = RunnerError::from(
+            ProcessOptions {
+                jobs: 0,
+                timeout: None,
+            }
+            .check()
+            .unwrap_err(),
+        );
+        assert_eq!(e.kind(), impactcal_core::ErrorKind::BadInput);
+    }
 }

@@ -19,6 +19,7 @@ use std::path::PathBuf;
 use std::process::Command;
 use std::time::Duration;
 
+use impactcal_core::{CoreError, ParamGuard};
 use serde::{Deserialize, Serialize};
 
 use crate::batch::{Driver, InFlight, cancelled};
@@ -89,16 +90,22 @@ impl Default for SlurmOptions {
     }
 }
 
-impl SlurmOptions {
+impl ParamGuard for SlurmOptions {
+    /// The options themselves: nothing downstream needs a separate checked form.
+    type Checked = SlurmOptions;
+
     /// Checks the options: positive sizes and poll interval, no whitespace in the values
     /// passed to sbatch.
     ///
     /// # Errors
-    /// [`RunnerError::Config`] naming the option.
-    pub fn check(&self) -> Result<()> {
-        let bad = |m: String| RunnerError::Config {
-            file: "configuration".into(),
-            message: m,
+    /// [`CoreError::InvalidOption`] naming the key (`executor.<key>`).
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        let bad = |name: &str, value: &dyn std::fmt::Display, message: &str| {
+            Err(CoreError::invalid_option(
+                format!("executor.{name}"),
+                value,
+                message,
+            ))
         };
         for (name, v) in [
             ("partition", &self.partition),
@@ -108,21 +115,29 @@ impl SlurmOptions {
         ] {
             if let Some(v) = v {
                 if v.is_empty() || v.chars().any(char::is_whitespace) {
-                    return Err(bad(format!("executor.{name} `{v}` must be one word")));
+                    return bad(name, &format!("`{v}`"), "must be one word");
                 }
             }
         }
-        if self.max_array == 0 || self.max_running == Some(0) {
-            return Err(bad(
-                "executor.max_array and max_running must be at least 1".into()
-            ));
+        if self.max_array == 0 {
+            return bad("max_array", &self.max_array, "must be at least 1");
+        }
+        if self.max_running == Some(0) {
+            return bad("max_running", &0, "must be at least 1");
         }
         if !(self.poll.is_finite() && self.poll > 0.0) {
-            return Err(bad(format!("executor.poll {} must be positive", self.poll)));
+            return bad("poll", &self.poll, "must be finite and positive (seconds)");
         }
         Ok(())
     }
 
+    fn check(self) -> impactcal_core::Result<SlurmOptions> {
+        self.check_ref()?;
+        Ok(self)
+    }
+}
+
+impl SlurmOptions {
     fn program(&self, name: &str) -> Command {
         match &self.bin {
             Some(dir) => Command::new(dir.join(name)),
@@ -203,7 +218,7 @@ pub(crate) fn run(
     in_flight: BTreeMap<usize, InFlight>,
     options: &SlurmOptions,
 ) -> Result<()> {
-    options.check()?;
+    options.check_ref()?;
     let argv = super::argv(driver)?;
     let mut watch: Vec<Task> = Vec::new();
     let mut todo: Vec<usize> = pending;

@@ -1,0 +1,481 @@
+//! Model assembly: what an experiment file's `[model]`, `[parameters]`, `[space]` and
+//! `[solver]` describe ([`ModelSpec`]) built into one model ([`ExperimentModel`]), the only
+//! place that knows every model kind.
+//!
+//! - the built-in airframe: its catalogue of quantities, held values `set`, the study's
+//!   space a preset or a bounds file ([`Subspace`] of the whole catalogue);
+//! - a keyword deck: with `*PARAMETER` cards, the deck's real parameters under their own
+//!   names; otherwise its sections, materials and masses (`section.<id>.t`, ...), which
+//!   `[parameters]` may give other names; the space a bounds file or `[parameters]` (each
+//!   quantity +-20 % about the deck's value);
+//! - the drop tower (`kind = "drop-tower"`) at the condition `set`;
+//! - an external solver (`[solver]`): no model in this process, the space a bounds file
+//!   naming the template's parameters.
+//!
+//! Every built-in model is one [`ExperimentModel`], which implements [`Model`] and
+//! [`Enrichable`] by delegating to the model it holds, so that the study, the loop and a
+//! worker process each need one code path.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use impactcal_calibrate::study::Subspace;
+use impactcal_calibrate::study::document::Geometry;
+use impactcal_calibrate::study::subspace::near;
+use impactcal_core::drop_tower::DropTower;
+use impactcal_core::enrich::Candidate;
+use impactcal_core::{
+    CoreError, Enrichable, Histories, Model, Parameter, ParameterSpace, Result as CoreResult,
+};
+use impactcal_runner::config::SolverSection;
+use impactcal_runner::fingerprint;
+use impactcal_shell::DeckModel;
+use impactcal_shell::airframe::{
+    Airframe, AirframeModel, AirframeOptions, AirframeValues, MeshDensity, Preset, catalogue,
+    space_of,
+};
+use impactcal_shell::keyword::read_deck;
+
+use crate::error::{ExperimentError, Result, io};
+use crate::schema::{ExperimentFile, SpaceSection};
+
+/// What the model sections of a file describe, before anything is read.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum ModelSpec {
+    /// The built-in airframe.
+    Airframe {
+        /// Mesh density (`coarse`, `medium`, `fine`).
+        mesh: String,
+        /// Simulated time (s); default: the airframe's.
+        end_time: Option<f64>,
+        /// Held values of catalogue quantities.
+        set: BTreeMap<String, f64>,
+        /// The declared parameters.
+        space: SpaceSection,
+    },
+    /// A keyword deck.
+    Deck {
+        /// The deck file.
+        path: PathBuf,
+        /// Experiment names -> deck quantities.
+        parameters: BTreeMap<String, String>,
+        /// The declared parameters.
+        space: SpaceSection,
+    },
+    /// The built-in drop tower at a condition.
+    DropTower {
+        /// The condition (`v0`, ...).
+        set: Vec<(String, f64)>,
+    },
+    /// An external solver through a deck template.
+    External {
+        /// The `[solver]` table.
+        solver: Box<SolverSection>,
+        /// The declared parameters (a bounds file naming the template's parameters).
+        space: SpaceSection,
+    },
+}
+
+/// A built-in model of an experiment file: every kind, one type.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum ExperimentModel {
+    /// The airframe restricted to the declared quantities.
+    Airframe(Box<Subspace<AirframeModel>>),
+    /// A deck restricted to the declared quantities.
+    Deck(Box<Subspace<DeckModel>>),
+    /// The drop tower.
+    DropTower(DropTower),
+}
+
+/// Calls `$body` with `$m` bound to the model inside `$self`, whatever its kind; `$wrap`
+/// is the variant's constructor where the body returns a model of the same kind.
+macro_rules! each {
+    ($self:expr, $m:ident => $body:expr) => {
+        match $self {
+            ExperimentModel::Airframe($m) => $body,
+            ExperimentModel::Deck($m) => $body,
+            ExperimentModel::DropTower($m) => $body,
+        }
+    };
+    ($self:expr, $m:ident => $body:expr, wrap) => {
+        match $self {
+            ExperimentModel::Airframe($m) => ExperimentModel::Airframe(Box::new($body)),
+            ExperimentModel::Deck($m) => ExperimentModel::Deck(Box::new($body)),
+            ExperimentModel::DropTower($m) => ExperimentModel::DropTower($body),
+        }
+    };
+}
+
+impl Model for ExperimentModel {
+    fn space(&self) -> &ParameterSpace {
+        each!(self, m => m.space())
+    }
+
+    fn simulate(&self, params: &[f64]) -> CoreResult<Histories> {
+        each!(self, m => m.simulate(params))
+    }
+}
+
+impl Enrichable for ExperimentModel {
+    fn candidates(&self) -> Vec<Candidate> {
+        each!(self, m => m.candidates())
+    }
+
+    fn enrich(&self, added: &[Parameter]) -> CoreResult<Self> {
+        Ok(each!(self, m => m.enrich(added)?, wrap))
+    }
+
+    fn at_condition(&self, set: &[(String, f64)]) -> CoreResult<Self> {
+        Ok(each!(self, m => m.at_condition(set)?, wrap))
+    }
+
+    fn describe(&self, name: &str) -> Option<(String, String)> {
+        each!(self, m => m.describe(name))
+    }
+
+    fn check_candidate(&self, p: &Parameter) -> CoreResult<()> {
+        each!(self, m => m.check_candidate(p))
+    }
+}
+
+/// A model built from its spec.
+#[derive(Debug, Clone)]
+pub struct Built {
+    /// The model (`None` for an external solver).
+    pub model: Option<ExperimentModel>,
+    /// The declared parameters.
+    pub space: ParameterSpace,
+    /// What the model is: enters the study's and the loop's fingerprint, so a changed deck
+    /// or template is another experiment.
+    pub description: String,
+    /// Where the airframe's sensors are (for the report's figures).
+    pub geometry: Option<Geometry>,
+    /// Warnings of the deck reader.
+    pub notes: Vec<String>,
+}
+
+impl ModelSpec {
+    /// The spec of a parsed file.
+    ///
+    /// # Errors
+    /// [`ExperimentError::File`] for `[model]` and `[solver]` that do not name exactly one
+    /// model, an unknown `kind`, or keys that do not apply to the model named (`end_time`
+    /// and `set` on a deck, `[space]` or `[parameters]` on the drop tower, `[parameters]`
+    /// on the airframe or an external solver).
+    pub fn of(file: &ExperimentFile, name: &str) -> Result<ModelSpec> {
+        let fault = |message: &str| ExperimentError::File {
+            file: name.to_string(),
+            message: message.to_string(),
+        };
+        let m = file.model.clone().unwrap_or_default();
+        let space = file.space.clone();
+        let params = &file.parameters;
+        let no_space = space.preset.is_none() && space.bounds.is_none();
+        match (&m.kind, &m.airframe, &m.deck, &file.solver) {
+            (Some(k), None, None, None) if k == "drop-tower" => {
+                if !no_space || !params.is_empty() || m.end_time.is_some() {
+                    return Err(fault(
+                        "[space], [parameters] and [model] end_time apply to the airframe and \
+                         decks; the drop tower declares modulus and k_contact",
+                    ));
+                }
+                Ok(ModelSpec::DropTower {
+                    set: m.set.into_iter().collect(),
+                })
+            }
+            (Some(k), None, None, None) => Err(fault(&format!(
+                "[model] kind = \"{k}\": unknown (the built-in model is \"drop-tower\"; the \
+                 airframe and decks are `airframe = \"coarse\"`, `deck = \"model.k\"`)"
+            ))),
+            (None, Some(mesh), None, None) => {
+                if !params.is_empty() {
+                    return Err(fault(
+                        "[parameters] maps deck quantities; the airframe's names are its \
+                         catalogue's",
+                    ));
+                }
+                Ok(ModelSpec::Airframe {
+                    mesh: mesh.clone(),
+                    end_time: m.end_time,
+                    set: m.set,
+                    space,
+                })
+            }
+            (None, None, Some(deck), None) => {
+                if !m.set.is_empty() || m.end_time.is_some() {
+                    return Err(fault(
+                        "[model]: `set` and `end_time` apply to the airframe; edit the deck \
+                         instead",
+                    ));
+                }
+                Ok(ModelSpec::Deck {
+                    path: deck.clone(),
+                    parameters: params.clone(),
+                    space,
+                })
+            }
+            (None, None, None, Some(solver)) if file.model.is_none() => {
+                if !params.is_empty() {
+                    return Err(fault(
+                        "[parameters] maps deck quantities of a built-in deck model; an \
+                         external solver's parameters are its template's",
+                    ));
+                }
+                Ok(ModelSpec::External {
+                    solver: Box::new(solver.clone()),
+                    space,
+                })
+            }
+            _ => Err(fault(
+                "[model]: give one of `airframe = \"coarse\"`, `deck = \"model.k\"` or \
+                 `kind = \"drop-tower\"`, or a [solver] table instead of [model]",
+            )),
+        }
+    }
+
+    /// Builds the model; relative paths start at `base`; `name` names the file in
+    /// messages.
+    ///
+    /// # Errors
+    /// I/O errors of the deck, template or bounds file; the deck reader's and the
+    /// airframe's errors; [`ExperimentError::File`] for a space the model cannot take (a
+    /// name it does not have, with the closest names it has; bounds outside what it accepts
+    /// beyond round-off).
+    pub fn build(&self, base: &Path, name: &str) -> Result<Built> {
+        match self {
+            ModelSpec::Airframe {
+                mesh,
+                end_time,
+                set,
+                space,
+            } => airframe(mesh, *end_time, set, space, base, name),
+            ModelSpec::Deck {
+                path,
+                parameters,
+                space,
+            } => deck(&resolve(base, path), parameters, space, base, name),
+            ModelSpec::DropTower { set } => {
+                let model = DropTower::new().at_condition(set)?;
+                Ok(Built {
+                    space: model.space().clone(),
+                    model: Some(ExperimentModel::DropTower(model)),
+                    description: format!("drop-tower {set:?}"),
+                    geometry: None,
+                    notes: Vec::new(),
+                })
+            }
+            ModelSpec::External { solver, space } => external(solver, space, base, name),
+        }
+    }
+}
+
+/// `p` relative to `base` unless absolute.
+pub fn resolve(base: &Path, p: &Path) -> PathBuf {
+    if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        base.join(p)
+    }
+}
+
+/// A fault of `section` of the file `name`.
+fn fault(name: &str, section: &str, message: impl std::fmt::Display) -> ExperimentError {
+    ExperimentError::File {
+        file: name.to_string(),
+        message: format!("[{section}]: {message}"),
+    }
+}
+
+/// The space a `[space]` table declares, if any.
+fn declared_space(space: &SpaceSection, base: &Path, name: &str) -> Result<Option<ParameterSpace>> {
+    match (&space.preset, &space.bounds) {
+        (Some(p), None) => Ok(Some(
+            Preset::parse(p)
+                .and_then(|p| p.space())
+                .map_err(|e| fault(name, "space", e))?,
+        )),
+        (None, Some(b)) => Ok(Some(ParameterSpace::read_csv(resolve(base, b))?)),
+        (None, None) => Ok(None),
+        (Some(_), Some(_)) => Err(fault(name, "space", "give `preset` or `bounds`, not both")),
+    }
+}
+
+fn airframe(
+    mesh: &str,
+    end_time: Option<f64>,
+    set: &BTreeMap<String, f64>,
+    space: &SpaceSection,
+    base: &Path,
+    name: &str,
+) -> Result<Built> {
+    let mut options =
+        AirframeOptions::new(MeshDensity::parse(mesh).map_err(|e| fault(name, "model", e))?);
+    if let Some(t) = end_time {
+        options.end_time = t;
+        options.output_interval = options.output_interval.min(t);
+    }
+    let airframe = Airframe::new(options).map_err(|e| fault(name, "model", e))?;
+    let mut values = AirframeValues::nominal();
+    for (k, v) in set {
+        values.set(k, *v).map_err(|e| fault(name, "model", e))?;
+    }
+    let Some(space) = declared_space(space, base, name)? else {
+        return Err(fault(
+            name,
+            "space",
+            "give `preset = \"table1\"|\"table2\"` or `bounds = \"bounds.csv\"`",
+        ));
+    };
+    let names: Vec<String> = catalogue().into_iter().map(|a| a.name).collect();
+    let full = space_of(&names).map_err(|e| fault(name, "model", e))?;
+    let base_point: Vec<f64> = names
+        .iter()
+        .map(|n| values.get(n))
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| fault(name, "model", e))?;
+    let geometry = geometry_of(&airframe);
+    let solver = AirframeModel::new(airframe, full).map_err(|e| fault(name, "model", e))?;
+    let sub = Subspace::new(solver, space)?.with_base(base_point)?;
+    Ok(Built {
+        space: sub.space().clone(),
+        model: Some(ExperimentModel::Airframe(Box::new(sub))),
+        description: format!(
+            "built-in airframe, {mesh} mesh, {} s, set {set:?}",
+            options.end_time
+        ),
+        geometry: Some(geometry),
+        notes: Vec::new(),
+    })
+}
+
+/// The airframe's nodes and the position of each sensor channel.
+pub fn geometry_of(airframe: &Airframe) -> Geometry {
+    let nodes = airframe.node_positions();
+    let mut channels = BTreeMap::new();
+    for &n in airframe.sensor_nodes() {
+        if let Some(at) = usize::try_from(n)
+            .ok()
+            .and_then(|i| nodes.get(i.wrapping_sub(1)))
+        {
+            for a in ["x", "y", "z"] {
+                channels.insert(format!("{n}.{a}"), *at);
+            }
+        }
+    }
+    Geometry {
+        points: nodes.to_vec(),
+        unit: "in".into(),
+        channels,
+    }
+}
+
+/// A keyword deck restricted to the declared quantities. A deck with real `*PARAMETER`s
+/// speaks for itself: its quantities are those parameters under the deck's names, as in
+/// `impactcal noise --deck`. The sections, materials and masses of the deck are its
+/// quantities otherwise, and whenever the experiment names one of them.
+fn deck(
+    path: &Path,
+    parameters: &BTreeMap<String, String>,
+    space: &SpaceSection,
+    base: &Path,
+    name: &str,
+) -> Result<Built> {
+    let bytes = std::fs::read(path).map_err(io(path))?;
+    let read = read_deck(path)?;
+    let notes = read.warnings.clone();
+    let field_of = |name: &str| parameters.get(name).cloned().unwrap_or_else(|| name.into());
+    let declared = declared_space(space, base, name)?;
+    let wanted: Vec<String> = match &declared {
+        Some(s) => s.names().iter().map(|n| field_of(n)).collect(),
+        None => parameters.values().cloned().collect(),
+    };
+    let by_parameters = DeckModel::from_deck(read.clone(), None).ok().filter(|m| {
+        !read.parameters.is_empty() && wanted.iter().all(|w| m.space().index_of(w).is_some())
+    });
+    let model = match by_parameters {
+        Some(m) => m,
+        None => DeckModel::new(read.model).map_err(|e| ExperimentError::File {
+            file: path.display().to_string(),
+            message: e.to_string(),
+        })?,
+    };
+    let space = match declared {
+        Some(s) => s,
+        None if !parameters.is_empty() => {
+            let full = model.space();
+            let params = parameters
+                .iter()
+                .map(|(key, field)| {
+                    let q = full.index_of(field).map(|i| full.parameters()[i].clone()).ok_or_else(|| {
+                        fault(
+                            name,
+                            "parameters",
+                            format!(
+                                "`{key}` = `{field}`: the deck has no such quantity; closest: {}",
+                                near(field, &full.names())
+                            ),
+                        )
+                    })?;
+                    Ok(Parameter::new(key.clone(), q.lower, q.upper, q.nominal)?)
+                })
+                .collect::<Result<Vec<_>>>()?;
+            ParameterSpace::new(params)?
+        }
+        None => {
+            return Err(fault(
+                name,
+                "space",
+                "give `bounds = \"bounds.csv\"` or a [parameters] table",
+            ));
+        }
+    };
+    let fields: Vec<String> = space.names().iter().map(|n| field_of(n)).collect();
+    let sub = Subspace::aliased(model, space, &fields)?;
+    Ok(Built {
+        space: sub.space().clone(),
+        model: Some(ExperimentModel::Deck(Box::new(sub))),
+        description: format!("deck {} ({})", path.display(), fingerprint(&bytes)),
+        geometry: None,
+        notes,
+    })
+}
+
+/// An external solver: its description fingerprints the `[solver]` table and the text of
+/// its templates, so that a changed deck or command is another study.
+fn external(
+    solver: &SolverSection,
+    space: &SpaceSection,
+    base: &Path,
+    name: &str,
+) -> Result<Built> {
+    let mut bytes = serde_json::to_vec(solver).unwrap_or_default();
+    for p in std::iter::once(&solver.template).chain(&solver.inputs) {
+        let p = resolve(base, p);
+        bytes.extend(std::fs::read(&p).map_err(io(&p))?);
+    }
+    let Some(space) = declared_space(space, base, name)? else {
+        return Err(fault(
+            name,
+            "space",
+            "an external solver needs `bounds = \"bounds.csv\"` naming its template's parameters",
+        ));
+    };
+    Ok(Built {
+        model: None,
+        space,
+        description: format!(
+            "solver {} ({})",
+            solver.template.display(),
+            fingerprint(&bytes)
+        ),
+        geometry: None,
+        notes: Vec::new(),
+    })
+}
+
+/// A [`CoreError`] for a run record that does not fit the model.
+pub(crate) fn record_error(what: &str, message: String) -> ExperimentError {
+    ExperimentError::Core(CoreError::invalid_option("params.json", what, message))
+}
