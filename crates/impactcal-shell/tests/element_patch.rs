@@ -72,6 +72,7 @@ fn rigid_rotation_residual(projection: bool) -> (f64, f64) {
         projection,
         isdo_diagonal: false,
         invariant: false,
+        distortion_check: true,
     };
     for k in 1..=steps {
         let t = k as f64 * dt;
@@ -144,6 +145,7 @@ fn constant_membrane_and_bending_patches_are_exact() {
                 projection: true,
                 isdo_diagonal: false,
                 invariant: false,
+                distortion_check: true,
             },
         )
         .unwrap();
@@ -188,6 +190,7 @@ fn constant_membrane_and_bending_patches_are_exact() {
                 projection: true,
                 isdo_diagonal: false,
                 invariant: false,
+                distortion_check: true,
             },
         )
         .unwrap();
@@ -365,6 +368,8 @@ fn strain_of_a_rigid_spin(deck: &str) -> f64 {
 fn control_shell_bwc_and_proj_choose_the_warping_projection() {
     let mut m = random_plate(5, 4, 0.15);
     m.initial_velocities.clear();
+    // Card 1 alone (the distortion check has its own test).
+    m.control.distortion_check = false;
     let projected = impactcal_shell::keyword::write_deck(&m).unwrap();
     assert!(projected.contains("*CONTROL_SHELL"));
     let read = |d: &str| {
@@ -456,6 +461,7 @@ fn the_plain_element_strains_a_rotating_warped_quad_only_through_its_membrane_ho
                 projection,
                 isdo_diagonal: false,
                 invariant: false,
+                distortion_check: true,
             };
             let an = sq(axis).sqrt();
             let om = axis.map(|c| c / an * rate);
@@ -537,4 +543,74 @@ fn the_plain_elements_spin_energy_scales_with_the_warp_squared_not_the_spin() {
     assert!(mild < 1e-3 && five < 1e-2, "{mild:e} {five:e}");
     // Spin x10: share / 100 (up to the centrifugal stretch of the faster spin).
     assert!(fast < 0.1 * five, "{fast:e} against {five:e}");
+}
+
+/// A square quad whose corner node 4 is driven at constant velocity towards node 1, nodes
+/// 1 to 3 held, until node 4 has crossed the line through nodes 2 and 3 (a reentrant
+/// corner: a negative corner Jacobian, the centre's still positive).
+fn dart(distortion_check: bool) -> impactcal_shell::ShellModel {
+    use impactcal_shell::{Curve, MotionKind, MotionTarget, PrescribedMotion};
+    let l = 0.1;
+    let mut m = plate(1, 1, l, l, [0.0; 3]);
+    with_section(&mut m, 0.001, aluminium(1));
+    m.curves.push(Curve::new(1, vec![(0.0, 1.0), (1.0, 1.0)]));
+    let hold = |node, dof, scale| PrescribedMotion {
+        target: MotionTarget::Node(node),
+        dof,
+        kind: MotionKind::Velocity,
+        curve: 1,
+        scale,
+        birth: 0.0,
+        death: 1e28,
+    };
+    for node in 1..=3 {
+        for dof in 0..3 {
+            m.prescribed.push(hold(node, dof, 0.0));
+        }
+    }
+    m.prescribed.push(hold(4, 0, -20.0));
+    m.prescribed.push(hold(4, 1, -20.0));
+    m.prescribed.push(hold(4, 2, 0.0));
+    m.initial_velocities = vec![InitialVelocity::translation(
+        VelocityTarget::Node(4),
+        [-20.0, -20.0, 0.0],
+    )];
+    // Node 4 crosses x + y = l at 2.5 ms and stands at (0.02, 0.02) at 4 ms.
+    m.control.end_time = 4e-3;
+    m.control.distortion_check = distortion_check;
+    m
+}
+
+/// The distortion check (`Control::distortion_check`, `*CONTROL_SHELL` NFAIL1 2) stops a
+/// run on a quad with a reentrant corner; without it (LS-DYNA's default for one-point
+/// shells, a deck without NFAIL1) the quad, evaluated at its centre where the Jacobian is
+/// a quarter of its area, carries on: the work of the prescribed motion equals the
+/// internal, hourglass and kinetic energy (energy ratio) and the forces stay finite. A
+/// written deck keeps the choice; NFAIL1 1 (element deletion) is refused.
+#[test]
+fn a_reentrant_quad_stops_the_run_only_with_the_distortion_check() {
+    let err = Simulation::new(&dart(true)).unwrap().run().unwrap_err();
+    assert!(
+        matches!(err, ShellError::Unstable { .. }) && err.to_string().contains("inverted"),
+        "{err}"
+    );
+    let r = Simulation::new(&dart(false)).unwrap().run().unwrap();
+    let e = r.summary.energies;
+    assert!(e.external_work > 0.0 && e.internal > 0.0);
+    assert!(
+        (r.summary.energy_ratio - 1.0).abs() < 0.01,
+        "energy ratio {}",
+        r.summary.energy_ratio
+    );
+
+    let on = impactcal_shell::keyword::write_deck(&dart(true)).unwrap();
+    let read = |d: &str| impactcal_shell::keyword::parse_deck(d, "dart.k").map(|d| d.model);
+    assert!(read(&on).unwrap().control.distortion_check);
+    let off = impactcal_shell::keyword::write_deck(&dart(false)).unwrap();
+    assert!(!read(&off).unwrap().control.distortion_check);
+    let nfail1 = format!("{:>10}", 2);
+    assert!(on.contains(&format!("\n{nfail1}\n")));
+    let deleting = on.replace(&format!("\n{nfail1}\n"), &format!("\n{:>10}\n", 1));
+    let msg = read(&deleting).unwrap_err().to_string();
+    assert!(msg.contains("NFAIL1"), "{msg}");
 }

@@ -443,9 +443,11 @@ fn parse_source(src: Source, overrides: &Params) -> Result<Deck> {
     }
     let (parameters, params) = parameters(&src, &blocks, overrides)?;
     // LS-DYNA's Belytschko-Tsay shell has no warping treatment unless *CONTROL_SHELL asks
-    // for one (BWC 2, its default): a deck starts without the projection.
+    // for one (BWC 2, its default): a deck starts without the projection. Nor does it stop
+    // on a distorted one-point shell unless NFAIL1 asks for the check.
     let mut model = ShellModel::new("");
     model.control.warping_projection = false;
+    model.control.distortion_check = false;
     let mut r = Reader {
         model,
         warnings,

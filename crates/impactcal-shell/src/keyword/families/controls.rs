@@ -80,8 +80,10 @@ pub(crate) fn accuracy(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
 /// (the drill projection) is refused. Refused as well: THEORY other than 0 or 2 (another
 /// element) and ISTUPD other than 0 (thickness update). WRPANG (a warning threshold),
 /// ESORT (degenerate quads are always C0 triangles here), IRNXX (the Hughes-Liu normal
-/// update) and MITER (the plane-stress return is exact here) have no effect; later cards
-/// are ignored with a warning when set.
+/// update) and MITER (the plane-stress return is exact here) have no effect. Card 4's
+/// NFAIL1 chooses the distortion check ([`crate::Control::distortion_check`]): 0 or blank
+/// (LS-DYNA's default) none, 2 stop the run; 1 and above 2 (element deletion) are refused.
+/// Other cards are ignored with a warning when set.
 pub(crate) fn shell(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     let c = kw.take("the card WRPANG, ESORT, IRNXX, ISTUPD, THEORY, BWC, MITER, PROJ")?;
     let f = kw.fields(&c, W10);
@@ -115,11 +117,32 @@ pub(crate) fn shell(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
             )));
         }
     };
+    let mut card = 1;
     while let Some(d) = kw.next() {
-        if !d.text.trim().is_empty() {
+        card += 1;
+        if card == 4 {
+            let f = kw.fields(&d, W10);
+            r.model.control.distortion_check = match f.int(0, "NFAIL1", 0)? {
+                0 => false,
+                2 => true,
+                v => {
+                    return Err(f.err(format!(
+                        "field NFAIL1: {v} is not supported (0 or blank: no distortion check, \
+                         LS-DYNA's default; 2: stop the run; element deletion is not \
+                         implemented)"
+                    )));
+                }
+            };
+            if (1..f.len()).any(|i| matches!(f.raw(i, "card 4"), Ok(Some(_)))) {
+                r.warnings.push(kw.warning(
+                    d.line,
+                    "card 4: only NFAIL1 is read (its other fields have no effect here)",
+                ));
+            }
+        } else if !d.text.trim().is_empty() {
             r.warnings.push(kw.warning(
                 d.line,
-                "cards after the first are ignored (no effect on this solver's \
+                "cards 2, 3 and 5 on are ignored (no effect on this solver's \
                  Belytschko-Tsay shell is read from them)",
             ));
         }
