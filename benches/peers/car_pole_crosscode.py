@@ -100,6 +100,11 @@ CONTROLS = {
                         "*INITIAL_VELOCITY_NODE covers nodes 1-758 only)",
     "ground-frictionless": "the ground wall's FRIC 0.2 set to 0",
     "hourglass-half": "every *HOURGLASS QM 0.02 set to 0.01",
+    "hourglass-viscous": "every *HOURGLASS IHQ 4 (stiffness form) set to 1 (viscous form), "
+                         "QM kept",
+    "warping-projection": "*CONTROL_SHELL BWC 1, PROJ 1 added: the full projection, which "
+                          "in this element only removes the rigid rotation from the "
+                          "membrane hourglass rates (and from their forces)",
 }
 
 
@@ -141,6 +146,22 @@ def control_include(name, text):
         if n != 7:
             raise SystemExit(f"hourglass-half: {n} *HOURGLASS cards changed, 7 expected")
         return "\n".join(out)
+    if name == "hourglass-viscous":
+        out, n = [], 0
+        for k, line in enumerate(lines):
+            if k > 1 and lines[k - 2].startswith("*HOURGLASS") and line[10:20].strip() == "4":
+                line = line[:10] + f"{1:10d}" + line[20:]
+                n += 1
+            out.append(line)
+        if n != 7:
+            raise SystemExit(f"hourglass-viscous: {n} *HOURGLASS cards changed, 7 expected")
+        return "\n".join(out)
+    if name == "warping-projection":
+        if any(line.startswith("*CONTROL_SHELL") for line in lines):
+            raise SystemExit("warping-projection: the model already has *CONTROL_SHELL")
+        i = lines.index("*CONTROL_TERMINATION")
+        card = " " * 50 + f"{1:10d}{0:10d}{1:10d}"
+        return "\n".join(lines[:i] + ["*CONTROL_SHELL", card] + lines[i:])
     raise SystemExit(f"unknown control {name}; known: {', '.join(CONTROLS)}")
 
 
