@@ -14,6 +14,11 @@ Helper of benches/peers/car_pole_crosscode.sh (standard library only). Subcomman
   controls                 names of the controlled reruns at the base design
   control NAME DIR         write DIR/main.k (base design) and DIR/car6_crash_v223.k, the
                            model with the one change NAME (under /tmp, never the project)
+  story DIR                the energy story of a run in DIR (its --energies,
+                           --part-energies and --part-velocities CSV): global kinetic,
+                           internal, hourglass and contact energies and the body's x
+                           velocity every 0.01 s, when the hourglass energy peaks and how
+                           much of it is given back by the end, per part
   selftest                 checks of the metric code against hand-computed values
 
 The study's outputs (dbrizard/GSA-car-crash@477fb05, LSDYNAmodel.py, CAR6model.getGSAoutput)
@@ -205,6 +210,33 @@ def outputs(run):
     return out
 
 
+def story(run):
+    """Prints where a run's energy goes over time (see the module docs, `story`)."""
+    e = read_wide(os.path.join(run, "energies.csv"))
+    v = read_wide(os.path.join(run, "part_velocities.csv"))
+    p = read_wide(os.path.join(run, "part_energies.csv"))
+    t, vx = e["time"], column(v, "1.vx", run)
+    print(f"{'t':>6} {'kinetic':>10} {'internal':>10} {'hourglass':>10} {'contact':>10} "
+          f"{'body vx':>9}")
+    every = max(1, round(0.01 / (t[1] - t[0])))
+    for k in list(range(0, len(t), every)):
+        print(f"{t[k]:6.3f} {e['kinetic'][k]:10.4g} {e['internal'][k]:10.4g} "
+              f"{e['hourglass'][k]:10.4g} {e['contact'][k]:10.4g} {vx[k]:9.1f}")
+    he = e["hourglass"]
+    k = max(range(len(he)), key=lambda j: he[j])
+    print(f"hourglass energy: peak {he[k]:.4g} at t = {t[k]:.4f}, last {he[-1]:.4g} "
+          f"(given back {he[k] - he[-1]:.4g})")
+    turn = next((t[j] for j in range(len(vx)) if vx[j] > 0), None)
+    print(f"body x velocity: last {vx[-1]:.1f}, first positive (rebound) at "
+          f"{'never' if turn is None else f't = {turn:.4f}'}")
+    print(f"{'part':>5} {'HE peak':>10} {'at t':>7} {'HE last':>10} {'IE last':>10}")
+    parts = sorted({c.split(".")[0] for c in p if c != "time"}, key=int)
+    for q in parts:
+        h = p[f"{q}.hourglass"]
+        j = max(range(len(h)), key=lambda i: h[i])
+        print(f"{q:>5} {h[j]:10.4g} {t[j]:7.4f} {h[-1]:10.4g} {p[f'{q}.internal'][-1]:10.4g}")
+
+
 def ranks(v):
     """Ranks 1..n, ties sharing their mean rank."""
     order = sorted(range(len(v)), key=lambda i: v[i])
@@ -382,6 +414,8 @@ def main(argv):
                                             "wall_s"]))
     elif cmd == "compare":
         compare(argv[1], argv[2] if len(argv) > 2 else None)
+    elif cmd == "story":
+        story(argv[1])
     elif cmd == "selftest":
         selftest()
     else:
