@@ -113,6 +113,20 @@ CONTROLS = {
 }
 
 
+def set_hourglass_field(name, lines, col, old, new):
+    """The include with the 10-column field at `col` of every *HOURGLASS data card that reads
+    `old` replaced by `new`; fails unless all seven cards changed."""
+    out, n = [], 0
+    for k, line in enumerate(lines):
+        if k > 1 and lines[k - 2].startswith("*HOURGLASS") and line[col:col + 10].strip() == old:
+            line = line[:col] + new + line[col + 10:]
+            n += 1
+        out.append(line)
+    if n != 7:
+        raise SystemExit(f"{name}: {n} *HOURGLASS cards changed, 7 expected")
+    return "\n".join(out)
+
+
 def control_include(name, text):
     """The model's include text with control `name` applied; fails loudly when the card it
     changes is not where expected."""
@@ -142,25 +156,9 @@ def control_include(name, text):
         lines[k] = lines[k][:60] + f"{0.0:10.1f}" + lines[k][70:]
         return "\n".join(lines)
     if name == "hourglass-half":
-        out, n = [], 0
-        for k, line in enumerate(lines):
-            if k > 1 and lines[k - 2].startswith("*HOURGLASS") and line[20:30].strip() == "0.02":
-                line = line[:20] + f"{0.01:10.2f}" + line[30:]
-                n += 1
-            out.append(line)
-        if n != 7:
-            raise SystemExit(f"hourglass-half: {n} *HOURGLASS cards changed, 7 expected")
-        return "\n".join(out)
+        return set_hourglass_field(name, lines, 20, "0.02", f"{0.01:10.2f}")
     if name == "hourglass-viscous":
-        out, n = [], 0
-        for k, line in enumerate(lines):
-            if k > 1 and lines[k - 2].startswith("*HOURGLASS") and line[10:20].strip() == "4":
-                line = line[:10] + f"{1:10d}" + line[20:]
-                n += 1
-            out.append(line)
-        if n != 7:
-            raise SystemExit(f"hourglass-viscous: {n} *HOURGLASS cards changed, 7 expected")
-        return "\n".join(out)
+        return set_hourglass_field(name, lines, 10, "4", f"{1:10d}")
     if name == "warping-projection":
         if any(line.startswith("*CONTROL_SHELL") for line in lines):
             raise SystemExit("warping-projection: the model already has *CONTROL_SHELL")
