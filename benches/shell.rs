@@ -34,6 +34,7 @@ fn kernel(c: &mut Criterion) {
         projection: true,
         isdo_diagonal: false,
         invariant: false,
+        distortion_check: true,
     };
     let dt = Simulation::new(&m).unwrap().dt();
     for _ in 0..20 {

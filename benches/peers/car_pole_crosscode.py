@@ -14,6 +14,11 @@ Helper of benches/peers/car_pole_crosscode.sh (standard library only). Subcomman
   controls                 names of the controlled reruns at the base design
   control NAME DIR         write DIR/main.k (base design) and DIR/car6_crash_v223.k, the
                            model with the one change NAME (under /tmp, never the project)
+  story DIR                the energy story of a run in DIR (its --energies,
+                           --part-energies and --part-velocities CSV): global kinetic,
+                           internal, hourglass and contact energies and the body's x
+                           velocity every 0.01 s, when the hourglass energy peaks and how
+                           much of it is given back by the end, per part
   selftest                 checks of the metric code against hand-computed values
 
 The study's outputs (dbrizard/GSA-car-crash@477fb05, LSDYNAmodel.py, CAR6model.getGSAoutput)
@@ -100,7 +105,26 @@ CONTROLS = {
                         "*INITIAL_VELOCITY_NODE covers nodes 1-758 only)",
     "ground-frictionless": "the ground wall's FRIC 0.2 set to 0",
     "hourglass-half": "every *HOURGLASS QM 0.02 set to 0.01",
+    "hourglass-viscous": "every *HOURGLASS IHQ 4 (stiffness form) set to 1 (viscous form), "
+                         "QM kept",
+    "warping-projection": "*CONTROL_SHELL BWC 1, PROJ 1 added: the full projection, which "
+                          "in this element only removes the rigid rotation from the "
+                          "membrane hourglass rates (and from their forces)",
 }
+
+
+def set_hourglass_field(name, lines, col, old, new):
+    """The include with the 10-column field at `col` of every *HOURGLASS data card that reads
+    `old` replaced by `new`; fails unless all seven cards changed."""
+    out, n = [], 0
+    for k, line in enumerate(lines):
+        if k > 1 and lines[k - 2].startswith("*HOURGLASS") and line[col:col + 10].strip() == old:
+            line = line[:col] + new + line[col + 10:]
+            n += 1
+        out.append(line)
+    if n != 7:
+        raise SystemExit(f"{name}: {n} *HOURGLASS cards changed, 7 expected")
+    return "\n".join(out)
 
 
 def control_include(name, text):
@@ -132,15 +156,15 @@ def control_include(name, text):
         lines[k] = lines[k][:60] + f"{0.0:10.1f}" + lines[k][70:]
         return "\n".join(lines)
     if name == "hourglass-half":
-        out, n = [], 0
-        for k, line in enumerate(lines):
-            if k > 1 and lines[k - 2].startswith("*HOURGLASS") and line[20:30].strip() == "0.02":
-                line = line[:20] + f"{0.01:10.2f}" + line[30:]
-                n += 1
-            out.append(line)
-        if n != 7:
-            raise SystemExit(f"hourglass-half: {n} *HOURGLASS cards changed, 7 expected")
-        return "\n".join(out)
+        return set_hourglass_field(name, lines, 20, "0.02", f"{0.01:10.2f}")
+    if name == "hourglass-viscous":
+        return set_hourglass_field(name, lines, 10, "4", f"{1:10d}")
+    if name == "warping-projection":
+        if any(line.startswith("*CONTROL_SHELL") for line in lines):
+            raise SystemExit("warping-projection: the model already has *CONTROL_SHELL")
+        i = lines.index("*CONTROL_TERMINATION")
+        card = " " * 50 + f"{1:10d}{0:10d}{1:10d}"
+        return "\n".join(lines[:i] + ["*CONTROL_SHELL", card] + lines[i:])
     raise SystemExit(f"unknown control {name}; known: {', '.join(CONTROLS)}")
 
 
@@ -182,6 +206,33 @@ def outputs(run):
         "t_end": column(e, "time", energies)[-1],
     }
     return out
+
+
+def story(run):
+    """Prints where a run's energy goes over time (see the module docs, `story`)."""
+    e = read_wide(os.path.join(run, "energies.csv"))
+    v = read_wide(os.path.join(run, "part_velocities.csv"))
+    p = read_wide(os.path.join(run, "part_energies.csv"))
+    t, vx = e["time"], column(v, "1.vx", run)
+    print(f"{'t':>6} {'kinetic':>10} {'internal':>10} {'hourglass':>10} {'contact':>10} "
+          f"{'body vx':>9}")
+    every = max(1, round(0.01 / (t[1] - t[0])))
+    for k in list(range(0, len(t), every)):
+        print(f"{t[k]:6.3f} {e['kinetic'][k]:10.4g} {e['internal'][k]:10.4g} "
+              f"{e['hourglass'][k]:10.4g} {e['contact'][k]:10.4g} {vx[k]:9.1f}")
+    he = e["hourglass"]
+    k = max(range(len(he)), key=lambda j: he[j])
+    print(f"hourglass energy: peak {he[k]:.4g} at t = {t[k]:.4f}, last {he[-1]:.4g} "
+          f"(given back {he[k] - he[-1]:.4g})")
+    turn = next((t[j] for j in range(len(vx)) if vx[j] > 0), None)
+    print(f"body x velocity: last {vx[-1]:.1f}, first positive (rebound) at "
+          f"{'never' if turn is None else f't = {turn:.4f}'}")
+    print(f"{'part':>5} {'HE peak':>10} {'at t':>7} {'HE last':>10} {'IE last':>10}")
+    parts = sorted({c.split(".")[0] for c in p if c != "time"}, key=int)
+    for q in parts:
+        h = p[f"{q}.hourglass"]
+        j = max(range(len(h)), key=lambda i: h[i])
+        print(f"{q:>5} {h[j]:10.4g} {t[j]:7.4f} {h[-1]:10.4g} {p[f'{q}.internal'][-1]:10.4g}")
 
 
 def ranks(v):
@@ -361,6 +412,8 @@ def main(argv):
                                             "wall_s"]))
     elif cmd == "compare":
         compare(argv[1], argv[2] if len(argv) > 2 else None)
+    elif cmd == "story":
+        story(argv[1])
     elif cmd == "selftest":
         selftest()
     else:

@@ -605,6 +605,12 @@ pub struct Control {
     /// result of an element does not depend on which node is numbered first or on the
     /// direction of numbering (a mirrored mesh gives a mirrored result).
     pub invariant_numbering: bool,
+    /// Stop the run on a quad whose corner Jacobian in its plane turns non-positive (a
+    /// reentrant or crossed corner; on by default). The one-point quad is evaluated only at
+    /// its centre, where the Jacobian is a quarter of the area in the diagonals' frame
+    /// (positive by construction), so it can carry on through such a shape; LS-DYNA makes
+    /// the check only when `*CONTROL_SHELL` NFAIL1 asks for it (off in a deck without it).
+    pub distortion_check: bool,
     /// The run stops with an error when the energy ratio (total over initial plus external
     /// work) exceeds this bound (1.5 by default).
     pub energy_ratio_bound: f64,
@@ -621,6 +627,7 @@ impl Default for Control {
             isdo_diagonal: false,
             warping_projection: true,
             invariant_numbering: false,
+            distortion_check: true,
             energy_ratio_bound: 1.5,
         }
     }

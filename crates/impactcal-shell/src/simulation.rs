@@ -368,6 +368,7 @@ impl Simulation {
                 projection: model.control.warping_projection,
                 isdo_diagonal: model.control.isdo_diagonal,
                 invariant: model.control.invariant_numbering,
+                distortion_check: model.control.distortion_check,
             },
             interval,
             stride,

@@ -72,6 +72,7 @@ fn rigid_rotation_residual(projection: bool) -> (f64, f64) {
         projection,
         isdo_diagonal: false,
         invariant: false,
+        distortion_check: true,
     };
     for k in 1..=steps {
         let t = k as f64 * dt;
@@ -144,6 +145,7 @@ fn constant_membrane_and_bending_patches_are_exact() {
                 projection: true,
                 isdo_diagonal: false,
                 invariant: false,
+                distortion_check: true,
             },
         )
         .unwrap();
@@ -188,6 +190,7 @@ fn constant_membrane_and_bending_patches_are_exact() {
                 projection: true,
                 isdo_diagonal: false,
                 invariant: false,
+                distortion_check: true,
             },
         )
         .unwrap();
@@ -332,4 +335,282 @@ fn results_do_not_depend_on_the_thread_count() {
         );
         assert_eq!(a.energies.data(), b.energies.data());
     }
+}
+
+/// The internal energy over the kinetic energy after a warped, distorted plate read from
+/// `deck` has spun rigidly about an in-plane axis through 0.01 rad.
+fn strain_of_a_rigid_spin(deck: &str) -> f64 {
+    let mut m = impactcal_shell::keyword::parse_deck(deck, "warped.k")
+        .unwrap()
+        .model;
+    let c = m.nodes.iter().fold([0.0; 3], |a, p| {
+        [0, 1, 2].map(|k| a[k] + p.x[k] / m.nodes.len() as f64)
+    });
+    let mut spin = InitialVelocity::translation(VelocityTarget::All, [0.0; 3]);
+    spin.omega = 50.0;
+    spin.centre = c;
+    spin.axis = [0.6, 0.8, 0.0];
+    m.initial_velocities = vec![spin];
+    m.control.end_time = 1.0;
+    let mut sim = Simulation::new(&m).unwrap();
+    while sim.time() < 0.01 / 50.0 {
+        sim.step().unwrap();
+    }
+    let e = sim.energies();
+    e.internal / e.kinetic
+}
+
+/// `*CONTROL_SHELL` BWC 1 with PROJ 1 is the full projection: a warped plate read with it
+/// spins rigidly without straining (to the second-order stretch of the central-difference
+/// rotation); read without the keyword (BWC 2, LS-DYNA's Belytschko-Tsay shell without a
+/// warping treatment) the same spin strains it; the drill projection is refused.
+#[test]
+fn control_shell_bwc_and_proj_choose_the_warping_projection() {
+    let mut m = random_plate(5, 4, 0.15);
+    m.initial_velocities.clear();
+    // Card 1 alone (the distortion check has its own test).
+    m.control.distortion_check = false;
+    let projected = impactcal_shell::keyword::write_deck(&m).unwrap();
+    assert!(projected.contains("*CONTROL_SHELL"));
+    let read = |d: &str| {
+        impactcal_shell::keyword::parse_deck(d, "warped.k")
+            .unwrap()
+            .model
+            .control
+            .warping_projection
+    };
+    assert!(read(&projected));
+    let card = format!("{}{:>10}{:>10}{:>10}", " ".repeat(50), 1, 0, 1);
+    assert!(projected.contains(&card));
+    let plain = projected.replace(&format!("*CONTROL_SHELL\n{card}\n"), "");
+    assert!(!plain.contains("*CONTROL_SHELL"));
+    assert!(!read(&plain));
+    let bwc2 = projected.replace(
+        &card,
+        &format!("{}{:>10}{:>10}{:>10}", " ".repeat(50), 2, 0, 1),
+    );
+    assert!(!read(&bwc2));
+
+    let with = strain_of_a_rigid_spin(&projected);
+    let without = strain_of_a_rigid_spin(&plain);
+    eprintln!("internal / kinetic after the spin: projection {with:e}, none {without:e}");
+    assert!(with < 1e-6, "projection on: internal / kinetic {with:e}");
+    assert!(
+        without > 100.0 * with,
+        "projection off: {without:e} against {with:e}"
+    );
+
+    let drill = projected.replace(
+        &card,
+        &format!("{}{:>10}{:>10}{:>10}", " ".repeat(50), 1, 0, 0),
+    );
+    let err = impactcal_shell::keyword::parse_deck(&drill, "warped.k").unwrap_err();
+    let msg = err.to_string();
+    assert!(msg.contains("PROJ") && msg.contains("drill"), "{msg}");
+}
+
+/// The plain Belytschko-Tsay quad (no warping projection, LS-DYNA's BWC 2) under a rigid
+/// rotation of a mildly warped quad, against its closed form. The element's strain rates
+/// (membrane, curvature, transverse shear) never see the warp, so the section stresses stay
+/// zero; only the two membrane hourglass rates do, through `gamma . z = 4 w`
+/// (`w = h . z / 4`, `z` the corners' heights over the mean plane): a rotation `phi` about
+/// an in-plane axis stores `E_hg = C_m (4 w phi)^2 / 2` with the stiffness-form coefficient
+/// `C_m = r E t A (B . B) / 8 = r E t (|d31|^2 + |d42|^2) / (16 A)`, `A = |d31 x d42| / 2`.
+/// The spurious energy therefore grows as the warp squared and with the hourglass
+/// coefficient, and the full projection removes it.
+#[test]
+fn the_plain_element_strains_a_rotating_warped_quad_only_through_its_membrane_hourglass() {
+    let t = 0.001;
+    let p = props(t, 5);
+    let a = 0.01;
+    let phi = 0.01;
+    let steps = 2000;
+    let rate = 50.0;
+    let dt = phi / rate / steps as f64;
+    let mut last = None;
+    for (case, eps) in [0.01, 0.02, 0.05].into_iter().enumerate() {
+        // A distorted quad warped by eps of its size, about its centroid.
+        let wz = eps * a;
+        let x0 = [
+            [0.0, 0.0, wz],
+            [1.1 * a, 0.1 * a, -wz],
+            [1.0 * a, 0.9 * a, wz],
+            [-0.1 * a, 1.2 * a, -wz],
+        ];
+        let c: [f64; 3] = std::array::from_fn(|k| x0.iter().map(|q| q[k]).sum::<f64>() / 4.0);
+        let x0 = x0.map(|q| [q[0] - c[0], q[1] - c[1], q[2] - c[2]]);
+        // Closed form from the geometry alone.
+        let sub = |i: usize, j: usize| [0, 1, 2].map(|k| x0[i][k] - x0[j][k]);
+        let (d31, d42) = (sub(2, 0), sub(3, 1));
+        let n = cross(d31, d42);
+        let nn = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let e3 = n.map(|c| c / nn);
+        let area = 0.5 * nn;
+        let w = [0, 1, 2]
+            .map(|k| (x0[0][k] - x0[1][k] + x0[2][k] - x0[3][k]) * e3[k])
+            .iter()
+            .sum::<f64>()
+            / 4.0;
+        let sq = |d: [f64; 3]| d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let cm = 0.05 * E * t * (sq(d31) + sq(d42)) / (16.0 * area);
+        // The axis: in the element's plane, skewed.
+        let axis = cross(e3, [0.3, 0.8, 0.5]);
+        let predicted = 0.5 * cm * (4.0 * w * phi).powi(2);
+        for projection in [false, true] {
+            let opts = KernelOptions {
+                projection,
+                isdo_diagonal: false,
+                invariant: false,
+                distortion_check: true,
+            };
+            let an = sq(axis).sqrt();
+            let om = axis.map(|c| c / an * rate);
+            let mut st = vec![0.0; STATE_HEAD + 5 * STATE_PER_POINT];
+            let (mut hourglass, mut internal) = (0.0, 0.0);
+            for k in 1..=steps {
+                let r = rotation(axis, rate * k as f64 * dt);
+                let x = x0.map(|q| apply(&r, q));
+                let v = x.map(|q| cross(om, q));
+                let out = element::quad(&x, &v, &[om; 4], &p, &mut st, dt, opts).unwrap();
+                hourglass += out.hourglass;
+                internal += out.internal;
+            }
+            let stress = st[STATE_HEAD..].iter().fold(0.0f64, |m, s| m.max(s.abs()));
+            assert!(stress < 1e-15 * E, "case {case}: point stress {stress:e}");
+            assert!(
+                internal.abs() < 1e-12 * predicted,
+                "case {case}: {internal:e}"
+            );
+            if projection {
+                assert!(
+                    hourglass.abs() < 1e-12 * predicted,
+                    "case {case}: {hourglass:e}"
+                );
+            } else {
+                assert!(
+                    (hourglass - predicted).abs() < 1e-6 * predicted,
+                    "case {case}: hourglass {hourglass:e} against {predicted:e}"
+                );
+                if let Some((e0, w0)) = last {
+                    let (e0, w0): (f64, f64) = (e0, w0);
+                    let ratio: f64 = hourglass / e0;
+                    let expect = (w / w0) * (w / w0);
+                    assert!((ratio - expect).abs() < 1e-6 * expect);
+                }
+                last = Some((hourglass, w));
+            }
+        }
+    }
+}
+
+/// A warped plate's rigid spin through 0.01 rad with the plain element: the energy it
+/// stores is fixed by the warp and the hourglass stiffness, not by the spin, so its ratio to
+/// the kinetic energy falls as the spin rate squared; and it grows as the warp squared.
+/// Returns (internal + hourglass) / initial kinetic energy.
+fn plain_spin_share(warp: f64, omega: f64) -> (f64, f64) {
+    let mut m = random_plate(5, 4, warp);
+    m.control.warping_projection = false;
+    let n = m.nodes.len() as f64;
+    let c = m
+        .nodes
+        .iter()
+        .fold([0.0; 3], |a, p| [0, 1, 2].map(|k| a[k] + p.x[k] / n));
+    let mut spin = InitialVelocity::translation(VelocityTarget::All, [0.0; 3]);
+    spin.omega = omega;
+    spin.centre = c;
+    spin.axis = [0.6, 0.8, 0.0];
+    m.initial_velocities = vec![spin];
+    m.control.end_time = 1.0;
+    let mut sim = Simulation::new(&m).unwrap();
+    while sim.time() < 0.01 / omega {
+        sim.step().unwrap();
+    }
+    let e = sim.energies();
+    ((e.internal + e.hourglass) / e.initial, e.hourglass)
+}
+
+#[test]
+fn the_plain_elements_spin_energy_scales_with_the_warp_squared_not_the_spin() {
+    let (mild, hg_mild) = plain_spin_share(0.01, 500.0);
+    let (five, hg_five) = plain_spin_share(0.05, 500.0);
+    let (fast, _) = plain_spin_share(0.05, 5000.0);
+    eprintln!(
+        "share of KE at 500 rad/s: warp 1 % {mild:e}, 5 % {five:e}; 5 % at 5000 rad/s {fast:e}"
+    );
+    // Warp x5: hourglass energy x25 (the nodes' random heights keep the same pattern).
+    let r = hg_five / hg_mild;
+    assert!((20.0..30.0).contains(&r), "hourglass energy ratio {r}");
+    assert!(mild < 1e-3 && five < 1e-2, "{mild:e} {five:e}");
+    // Spin x10: share / 100 (up to the centrifugal stretch of the faster spin).
+    assert!(fast < 0.1 * five, "{fast:e} against {five:e}");
+}
+
+/// A square quad whose corner node 4 is driven at constant velocity towards node 1, nodes
+/// 1 to 3 held, until node 4 has crossed the line through nodes 2 and 3 (a reentrant
+/// corner: a negative corner Jacobian, the centre's still positive).
+fn dart(distortion_check: bool) -> impactcal_shell::ShellModel {
+    use impactcal_shell::{Curve, MotionKind, MotionTarget, PrescribedMotion};
+    let l = 0.1;
+    let mut m = plate(1, 1, l, l, [0.0; 3]);
+    with_section(&mut m, 0.001, aluminium(1));
+    m.curves.push(Curve::new(1, vec![(0.0, 1.0), (1.0, 1.0)]));
+    let hold = |node, dof, scale| PrescribedMotion {
+        target: MotionTarget::Node(node),
+        dof,
+        kind: MotionKind::Velocity,
+        curve: 1,
+        scale,
+        birth: 0.0,
+        death: 1e28,
+    };
+    for node in 1..=3 {
+        for dof in 0..3 {
+            m.prescribed.push(hold(node, dof, 0.0));
+        }
+    }
+    m.prescribed.push(hold(4, 0, -20.0));
+    m.prescribed.push(hold(4, 1, -20.0));
+    m.prescribed.push(hold(4, 2, 0.0));
+    m.initial_velocities = vec![InitialVelocity::translation(
+        VelocityTarget::Node(4),
+        [-20.0, -20.0, 0.0],
+    )];
+    // Node 4 crosses x + y = l at 2.5 ms and stands at (0.02, 0.02) at 4 ms.
+    m.control.end_time = 4e-3;
+    m.control.distortion_check = distortion_check;
+    m
+}
+
+/// The distortion check (`Control::distortion_check`, `*CONTROL_SHELL` NFAIL1 2) stops a
+/// run on a quad with a reentrant corner; without it (LS-DYNA's default for one-point
+/// shells, a deck without NFAIL1) the quad, evaluated at its centre where the Jacobian is
+/// a quarter of its area, carries on: the work of the prescribed motion equals the
+/// internal, hourglass and kinetic energy (energy ratio) and the forces stay finite. A
+/// written deck keeps the choice; NFAIL1 1 (element deletion) is refused.
+#[test]
+fn a_reentrant_quad_stops_the_run_only_with_the_distortion_check() {
+    let err = Simulation::new(&dart(true)).unwrap().run().unwrap_err();
+    assert!(
+        matches!(err, ShellError::Unstable { .. }) && err.to_string().contains("inverted"),
+        "{err}"
+    );
+    let r = Simulation::new(&dart(false)).unwrap().run().unwrap();
+    let e = r.summary.energies;
+    assert!(e.external_work > 0.0 && e.internal > 0.0);
+    assert!(
+        (r.summary.energy_ratio - 1.0).abs() < 0.01,
+        "energy ratio {}",
+        r.summary.energy_ratio
+    );
+
+    let on = impactcal_shell::keyword::write_deck(&dart(true)).unwrap();
+    let read = |d: &str| impactcal_shell::keyword::parse_deck(d, "dart.k").map(|d| d.model);
+    assert!(read(&on).unwrap().control.distortion_check);
+    let off = impactcal_shell::keyword::write_deck(&dart(false)).unwrap();
+    assert!(!read(&off).unwrap().control.distortion_check);
+    let nfail1 = format!("{:>10}", 2);
+    assert!(on.contains(&format!("\n{nfail1}\n")));
+    let deleting = on.replace(&format!("\n{nfail1}\n"), &format!("\n{:>10}\n", 1));
+    let msg = read(&deleting).unwrap_err().to_string();
+    assert!(msg.contains("NFAIL1"), "{msg}");
 }

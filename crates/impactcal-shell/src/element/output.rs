@@ -44,4 +44,7 @@ pub struct KernelOptions {
     /// Invariant node numbering (LS-DYNA INN 2): the quad frame's first axis bisects the
     /// diagonals instead of following the edges 1-2 and 4-3.
     pub invariant: bool,
+    /// Report a quad with a non-positive corner Jacobian as [`ElementFault::Inverted`]
+    /// (`Control::distortion_check`); without it such a quad is evaluated at its centre.
+    pub distortion_check: bool,
 }

@@ -115,7 +115,7 @@ pub(crate) fn quad_block(
         if fault[l].is_none() {
             if !(area.0[l].abs() > 0.0) {
                 fault[l] = Some(ElementFault::Degenerate);
-            } else if !corner.iter().all(|j| j.0[l] > 0.0) {
+            } else if opts.distortion_check && !corner.iter().all(|j| j.0[l] > 0.0) {
                 fault[l] = Some(ElementFault::Inverted);
             }
         }
@@ -483,6 +483,7 @@ mod tests {
             projection: true,
             isdo_diagonal: false,
             invariant: false,
+            distortion_check: true,
         };
         let dt = 2e-6;
         // Full and partial blocks in turn, elements in reverse lane order.
@@ -635,6 +636,7 @@ mod tests {
                 projection: true,
                 isdo_diagonal: false,
                 invariant: false,
+                distortion_check: true,
             };
             let off = KernelOptions {
                 projection: false,

@@ -350,6 +350,7 @@ pub(super) const TABLE: &[Entry] = &[
     ),
     e("*CONTROL_ACCURACY", &[], fam::controls::accuracy),
     e("*CONTROL_CONTACT", &[], fam::controls::contact),
+    e("*CONTROL_SHELL", &[], fam::controls::shell),
     e("*CONTROL_TERMINATION", &[], fam::controls::termination),
     e("*CONTROL_TIMESTEP", &[], fam::controls::timestep),
     e("*CONTROL_HOURGLASS", &[], fam::controls::hourglass),
@@ -441,8 +442,14 @@ fn parse_source(src: Source, overrides: &Params) -> Result<Deck> {
         }
     }
     let (parameters, params) = parameters(&src, &blocks, overrides)?;
+    // LS-DYNA's Belytschko-Tsay shell has no warping treatment unless *CONTROL_SHELL asks
+    // for one (BWC 2, its default): a deck starts without the projection. Nor does it stop
+    // on a distorted one-point shell unless NFAIL1 asks for the check.
+    let mut model = ShellModel::new("");
+    model.control.warping_projection = false;
+    model.control.distortion_check = false;
     let mut r = Reader {
-        model: ShellModel::new(""),
+        model,
         warnings,
         params: &params,
         notes: RefCell::new(Vec::new()),

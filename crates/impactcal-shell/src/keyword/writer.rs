@@ -181,6 +181,27 @@ fn write_controls(model: &ShellModel, o: &mut Out) -> Result<()> {
             int_signed(-2, 10)
         ));
     }
+    if c.warping_projection || c.distortion_check {
+        // BWC 1 with PROJ 1: the full projection (without the keyword a deck reads BWC 2);
+        // NFAIL1 2 on card 4: the distortion check (without it a deck has none).
+        o.w("*CONTROL_SHELL".into());
+        if c.warping_projection {
+            o.w(format!(
+                "{}{}{}{}",
+                " ".repeat(50),
+                int(1, 10),
+                int(0, 10),
+                int(1, 10)
+            ));
+        } else {
+            o.w(String::new());
+        }
+        if c.distortion_check {
+            o.w(String::new());
+            o.w(String::new());
+            o.w(int(2, 10));
+        }
+    }
     if c.invariant_numbering {
         o.w("*CONTROL_ACCURACY".into());
         o.w(format!("{}{}", int(0, 10), int(2, 10)));

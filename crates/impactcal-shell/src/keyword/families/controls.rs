@@ -72,6 +72,84 @@ pub(crate) fn accuracy(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
     Ok(())
 }
 
+/// `*CONTROL_SHELL`, first card WRPANG, ESORT, IRNXX, ISTUPD, THEORY, BWC, MITER, PROJ.
+/// BWC and PROJ choose the warping treatment of the Belytschko-Tsay quad: BWC 2 (LS-DYNA's
+/// default, also blank or 0) is the element without one (a deck without the keyword reads
+/// the same), BWC 1 with PROJ 1 is the full projection (rigid-body modes removed from the
+/// velocities and the forces, [`crate::Control::warping_projection`]); BWC 1 with PROJ 0
+/// (the drill projection) is refused. Refused as well: THEORY other than 0 or 2 (another
+/// element) and ISTUPD other than 0 (thickness update). WRPANG (a warning threshold),
+/// ESORT (degenerate quads are always C0 triangles here), IRNXX (the Hughes-Liu normal
+/// update) and MITER (the plane-stress return is exact here) have no effect. Card 4's
+/// NFAIL1 chooses the distortion check ([`crate::Control::distortion_check`]): 0 or blank
+/// (LS-DYNA's default) none, 2 stop the run; 1 and above 2 (element deletion) are refused.
+/// Other cards are ignored with a warning when set.
+pub(crate) fn shell(r: &mut Reader<'_>, kw: &mut Kw<'_>) -> Result<()> {
+    let c = kw.take("the card WRPANG, ESORT, IRNXX, ISTUPD, THEORY, BWC, MITER, PROJ")?;
+    let f = kw.fields(&c, W10);
+    f.must_be_zero(3, "ISTUPD")?;
+    let theory = f.int(4, "THEORY", 0)?;
+    if !(theory == 0 || theory == 2) {
+        return Err(f.err(format!(
+            "field THEORY: {theory} is not supported (0 or 2, the Belytschko-Tsay shell)"
+        )));
+    }
+    let proj = f.int(7, "PROJ", 0)?;
+    r.model.control.warping_projection = match (f.int(5, "BWC", 2)?, proj) {
+        (0 | 2, _) => false,
+        (1, 1) => true,
+        (1, 0) => {
+            return Err(f.err(
+                "field PROJ: 0 (the drill projection) is not supported with BWC 1; \
+                 PROJ 1 (the full projection) is"
+                    .to_string(),
+            ));
+        }
+        (1, v) => {
+            return Err(f.err(format!(
+                "field PROJ: {v} is not supported (1, the full projection)"
+            )));
+        }
+        (v, _) => {
+            return Err(f.err(format!(
+                "field BWC: {v} is not supported (2 or blank: no warping treatment; 1 with \
+                 PROJ 1: the full projection)"
+            )));
+        }
+    };
+    let mut card = 1;
+    while let Some(d) = kw.next() {
+        card += 1;
+        if card == 4 {
+            let f = kw.fields(&d, W10);
+            r.model.control.distortion_check = match f.int(0, "NFAIL1", 0)? {
+                0 => false,
+                2 => true,
+                v => {
+                    return Err(f.err(format!(
+                        "field NFAIL1: {v} is not supported (0 or blank: no distortion check, \
+                         LS-DYNA's default; 2: stop the run; element deletion is not \
+                         implemented)"
+                    )));
+                }
+            };
+            if (1..f.len()).any(|i| matches!(f.raw(i, "card 4"), Ok(Some(_)))) {
+                r.warnings.push(kw.warning(
+                    d.line,
+                    "card 4: only NFAIL1 is read (its other fields have no effect here)",
+                ));
+            }
+        } else if !d.text.trim().is_empty() {
+            r.warnings.push(kw.warning(
+                d.line,
+                "cards 2, 3 and 5 on are ignored (no effect on this solver's \
+                 Belytschko-Tsay shell is read from them)",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// `*CONTROL_CONTACT`, up to six cards. Read: SLSFAC (the penalty scale factor of the
 /// contact interfaces, 0.1 when blank), RWPNAL (0 constraint walls; 0 < RWPNAL <= 1
 /// penalty walls), PENOPT (0 or 1: the smaller of the node's and the segment's stiffness);
