@@ -551,4 +551,64 @@ mod tests {
         );
         assert!((cross - expect).abs() <= 1e-10 * expect.abs().max(1.0));
     }
+
+    /// The test carries `c = 0.3` that the model holds at 0: after calibrating `k`, the
+    /// residual is the part of `c`'s signature `k` cannot absorb, so `c` ranks first, explains
+    /// nearly all of it, and its amplitude's interval holds 0.3; `m` does not.
+    #[test]
+    fn a_candidate_whose_signature_is_the_residual_ranks_first() {
+        use crate::closeloop::fit::calibrate;
+        use crate::closeloop::toy::{self, Toy};
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let truth = Toy::new(0.3, 0.0, 1.0);
+        let test = toy::measured(&truth, 1.3, 0.01, 3, None);
+        let options = toy::options(0.01);
+        toy::with_setting(&model, &test, &options, |setting, nominal| {
+            let ctx = &setting.ctx;
+            let fit = calibrate(ctx, &model, "r0", &[nominal.point.clone()], 8, 8)?;
+            let a = attribute(
+                ctx,
+                &model,
+                &fit,
+                "r0",
+                options.candidate_step,
+                options.alpha,
+                options.min_explained,
+                setting.onset,
+                &|_| true,
+            )?;
+            let first = &a.ranked[0];
+            assert_eq!(first.name, "c");
+            assert_eq!(first.status, "best");
+            assert_eq!(a.best().map(|s| s.name.as_str()), Some("c"));
+            assert!(first.explained_fraction > 0.95, "{first:?}");
+            let amp = first.amplitude.as_ref().unwrap();
+            assert!(amp.lower < 0.3 && 0.3 < amp.upper, "{amp:?}");
+            let m = a.ranked.iter().find(|s| s.name == "m").unwrap();
+            assert!(m.explained_fraction < first.explained_fraction);
+            assert_ne!(m.status, "best");
+            // Signatures are scored, never eligible.
+            assert!(
+                a.ranked
+                    .iter()
+                    .filter(|s| s.kind == "signature")
+                    .all(|s| s.status == "signature")
+            );
+            // Restricted to `m`, the residual has no best candidate named `c`.
+            let only_m = attribute(
+                ctx,
+                &model,
+                &fit,
+                "r0m",
+                options.candidate_step,
+                options.alpha,
+                options.min_explained,
+                setting.onset,
+                &|n| n == "m",
+            )?;
+            assert!(only_m.ranked.iter().all(|s| s.name != "c"));
+            Ok(())
+        })
+        .unwrap();
+    }
 }

@@ -284,3 +284,67 @@ pub(super) fn noise_model(
     frame.whitener = prewhiten::Prewhitener::new(&frame.labels, &floor.ar_models(), masked, t)?;
     Ok(())
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use crate::closeloop::toy::{self, Toy};
+    use impactcal_core::Histories;
+
+    /// A test that is the nominal run with a gain and a bias per channel and no noise: the
+    /// nuisance stage profiles them back exactly, with the weights `1 / sigma` of the known
+    /// noise level; held gains leave only the biases (and the offset) to fit.
+    #[test]
+    fn the_nuisance_stage_profiles_known_gains_and_biases() {
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let (a, b) = model.channels(&[1.0]);
+        let (gains, biases) = ([2.0, 0.5], [0.2, -0.1]);
+        let test = Histories::from_channels(
+            vec!["a".into(), "b".into()],
+            vec![
+                a.iter().map(|y| gains[0] * y + biases[0]).collect(),
+                b.iter().map(|y| gains[1] * y + biases[1]).collect(),
+            ],
+            toy::DT,
+            0.0,
+            "",
+        )
+        .unwrap();
+        let sigma = 0.01;
+        let fitted = crate::closeloop::LoopOptions {
+            fit_gains: true,
+            ..toy::options(sigma)
+        };
+        toy::with_setting(&model, &test, &fitted, |setting, _| {
+            assert_eq!(setting.n_nuisance, 1 + 2 * 2);
+            let (terms, rss) = setting.ctx.profile(&setting.y_nominal);
+            assert_eq!(terms.tau, 0.0);
+            for s in 0..2 {
+                assert!((terms.gains[s] - gains[s]).abs() < 1e-9, "{terms:?}");
+                assert!((terms.biases[s] - biases[s]).abs() < 1e-9, "{terms:?}");
+            }
+            assert!(rss < 1e-12, "{rss}");
+            for w in &setting.ctx.frame.weights {
+                assert!((w * sigma - 1.0).abs() < 1e-9, "{w}");
+            }
+            Ok(())
+        })
+        .unwrap();
+        toy::with_setting(&model, &test, &toy::options(sigma), |setting, _| {
+            assert_eq!(setting.n_nuisance, 1 + 2);
+            let (terms, _) = setting.ctx.profile(&setting.y_nominal);
+            assert_eq!(terms.gains, [1.0, 1.0]);
+            // With the gain held at 1, the bias is the mean difference.
+            for (s, y) in [&a, &b].iter().enumerate() {
+                let mean = y
+                    .iter()
+                    .map(|y| (gains[s] - 1.0) * y + biases[s])
+                    .sum::<f64>()
+                    / toy::T as f64;
+                assert!((terms.biases[s] - mean).abs() < 1e-9, "{terms:?}");
+            }
+            Ok(())
+        })
+        .unwrap();
+    }
+}

@@ -77,6 +77,9 @@ mod report;
 pub mod result;
 pub mod selection;
 mod setup;
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod toy;
 
 use std::cell::Cell;
 use std::path::Path;

@@ -174,3 +174,120 @@ pub(super) fn check_covered(
         ))
     }
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::closeloop::toy::{self, Toy};
+    use crate::study::Silent;
+    use impactcal_core::Model;
+    use std::cell::Cell;
+
+    /// Each bad input is refused before any run, naming what is wrong.
+    #[test]
+    fn bad_inputs_are_refused_naming_them() {
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let options = toy::options(0.01);
+        let message = |o: &LoopOptions, h: Option<Holdout<'_>>| {
+            checked_inputs(&model, o, h).err().unwrap().to_string()
+        };
+        let e = message(
+            &LoopOptions {
+                candidates: Some(vec!["z".into()]),
+                ..options.clone()
+            },
+            None,
+        );
+        assert!(
+            e.contains("candidate `z`") && e.contains("it lists: c, m"),
+            "{e}"
+        );
+        let e = message(
+            &LoopOptions {
+                alpha: 0.7,
+                ..options.clone()
+            },
+            None,
+        );
+        assert!(e.contains("alpha"), "{e}");
+        let h = toy::measured(&model, 1.0, 0.01, 1, None);
+        let set = vec![("w".to_string(), 2.0)];
+        let e = message(
+            &options,
+            Some(Holdout {
+                histories: &h,
+                set: &set,
+            }),
+        );
+        assert!(e.contains("[holdout] set"), "{e}");
+        // A holdout the model can take comes back with the model at its condition.
+        let set = vec![("v".to_string(), 2.0)];
+        let (_, at) = checked_inputs(
+            &model,
+            &options,
+            Some(Holdout {
+                histories: &h,
+                set: &set,
+            }),
+        )
+        .unwrap()
+        .unwrap();
+        let (a, _) = at.channels(&[1.0]);
+        let (a1, _) = model.channels(&[1.0]);
+        assert!((a[T_LAST] - 2.0 * a1[T_LAST]).abs() < 1e-12);
+    }
+
+    const T_LAST: usize = toy::T - 1;
+
+    /// The nominal stage runs the model at its nominal point and gives the test on its
+    /// channels unchanged (same time base); a test channel the model lacks is refused.
+    #[test]
+    fn the_nominal_stage_pairs_the_test_with_the_model() {
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let dir = tempfile::tempdir().unwrap();
+        let used = Cell::new(0);
+        let runner = Journaled {
+            dir: dir.path(),
+            fingerprint: "toy",
+            observer: &Silent,
+            used: &used,
+            worker: None,
+            condition: &[],
+            plan: None,
+        };
+        let test = toy::measured(&model, 1.2, 0.01, 2, None);
+        let data = |h| TestData {
+            histories: h,
+            map: None,
+            cfc: None,
+        };
+        let n = nominal(&runner, &model, data(&test)).unwrap();
+        assert_eq!(n.point, vec![1.0]);
+        assert_eq!(n.raw, model.simulate(&[1.0]).unwrap());
+        assert_eq!(n.labels, ["a", "b"]);
+        assert_eq!(n.test.data(), test.data());
+        assert_eq!(used.get(), 1);
+        let plan = plan(&model, &n, &toy::options(0.01), 1).unwrap();
+        assert_eq!(plan.shapes.channels, 2);
+        assert_eq!(plan.shapes.samples, toy::T);
+        assert_eq!(plan.shapes.candidates, 2);
+        assert_eq!(plan.shapes.dense, 1 + 2 + 1);
+        let extra = Histories::from_channels(
+            vec!["a".into(), "q".into()],
+            vec![test.channel(0).to_vec(), test.channel(1).to_vec()],
+            toy::DT,
+            0.0,
+            "",
+        )
+        .unwrap();
+        let e = nominal(&runner, &model, data(&extra))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            e.contains("test channels") && e.contains("q not covered"),
+            "{e}"
+        );
+    }
+}
