@@ -122,3 +122,64 @@ pub(super) fn holdout_errors<M: Enrichable>(
         enriched: at(2)?,
     })
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::closeloop::recalibration;
+    use crate::closeloop::toy::{self, Toy};
+
+    /// The holdout stage on the two-channel toy at the condition `v = 1.5`: each stage's
+    /// relative L2 error equals the hand computation with the models at that condition,
+    /// and the enriched model (which found the hidden `c`) predicts the holdout best.
+    #[test]
+    fn holdout_errors_equal_the_hand_computed_l2() {
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let truth = Toy::new(0.3, 0.0, 1.0);
+        let options = toy::options(0.01);
+        let test = toy::measured(&truth, 1.3, 0.01, 5, None);
+        let set = vec![("v".to_string(), 1.5)];
+        let held_out = toy::measured(&truth.at_condition(&set).unwrap(), 1.3, 0.01, 6, None);
+        let declared_at = model.at_condition(&set).unwrap();
+        let h = Holdout {
+            histories: &held_out,
+            set: &set,
+        };
+        let data = TestData {
+            histories: &test,
+            map: None,
+            cfc: None,
+        };
+        toy::with_setting(&model, &test, &options, |setting, nominal| {
+            let (fit0, outcome) = recalibration(setting, &model, &nominal.point, &options)?;
+            let e = holdout_errors(
+                setting,
+                &model,
+                (h, &declared_at),
+                &outcome.added,
+                nominal,
+                (&fit0, &outcome.fit),
+                data,
+                &options,
+            )?;
+            let enriched_at = model.enrich(&outcome.added)?.at_condition(&set)?;
+            let z = held_out.data();
+            let by_hand = [
+                toy::rel_l2_by_hand(z, &toy::response(&declared_at, &nominal.point)),
+                toy::rel_l2_by_hand(z, &toy::response(&declared_at, &fit0.point)),
+                toy::rel_l2_by_hand(z, &toy::response(&enriched_at, &outcome.fit.point)),
+            ];
+            let got = [e.nominal.rel_l2, e.calibrated.rel_l2, e.enriched.rel_l2];
+            for (g, h) in got.iter().zip(&by_hand) {
+                assert!((g - h).abs() <= 1e-9 * h, "{got:?} vs {by_hand:?}");
+            }
+            assert!(
+                by_hand[2] < by_hand[1] && by_hand[2] < by_hand[0],
+                "{by_hand:?}"
+            );
+            Ok(())
+        })
+        .unwrap();
+    }
+}

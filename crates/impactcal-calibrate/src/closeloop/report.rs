@@ -107,3 +107,89 @@ pub(super) fn added(fit: &Fit, added: &[Parameter], d0: usize, draws: &DrawStats
         })
         .collect()
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::closeloop::recalibration;
+    use crate::closeloop::toy::{self, Toy};
+    use impactcal_core::Enrichable;
+
+    /// The detection stage on the toy: silent on the right model with white noise of the
+    /// known sigma (reduced chi-square near 1); on a wave no candidate makes, of RMS
+    /// `A / sqrt 2`, it fires with the reduced chi-square near `1 + A^2 / (2 sigma^2)` and
+    /// ends unattributed, with the discrepancy's signature.
+    #[test]
+    fn detection_is_silent_on_the_right_model_and_fires_on_a_known_residual() {
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let sigma = 0.01;
+        let options = toy::options(sigma);
+        let outcome_of = |extra: Option<&[f64]>| {
+            let test = toy::measured(&model, 1.3, sigma, 11, extra);
+            toy::with_setting(&model, &test, &options, |setting, nominal| {
+                let (_, outcome) = recalibration(setting, &model, &nominal.point, &options)?;
+                let det = outcome.rounds.last().unwrap().detection.clone();
+                let (v, d) = verdict(&outcome, &det, &nominal.labels, toy::T)?;
+                Ok((outcome, v, d))
+            })
+            .unwrap()
+        };
+        let (outcome, v, d) = outcome_of(None);
+        let det = &outcome.rounds[0].detection;
+        assert!(!det.model_form_error, "{det:?}");
+        assert!((det.chi2_red - 1.0).abs() < 0.3, "{}", det.chi2_red);
+        assert_eq!(v, Verdict::NoModelFormError);
+        assert!(d.is_none() && outcome.added.is_empty());
+
+        let amplitude = 0.05;
+        let wave = toy::foreign_wave(amplitude);
+        let (outcome, v, d) = outcome_of(Some(&wave));
+        let det = &outcome.rounds[0].detection;
+        assert!(det.model_form_error, "{det:?}");
+        let expect = 1.0 + amplitude * amplitude / (2.0 * sigma * sigma);
+        assert!(
+            (det.chi2_red / expect - 1.0).abs() < 0.1,
+            "{} vs {expect}",
+            det.chi2_red
+        );
+        assert_eq!(v, Verdict::Unattributed);
+        let d = d.unwrap();
+        assert!(!d.components.is_empty());
+    }
+
+    /// The enrichment stage on a test carrying the held `c = 0.3`: forward selection adds
+    /// exactly `c`, with the admissible range and held value the model lists, and the
+    /// report gives its recalibrated value inside its interval around the truth; where the
+    /// data do not determine it, the interval is the whole admissible range.
+    #[test]
+    fn enrichment_adds_exactly_the_chosen_candidate_with_its_range() {
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let truth = Toy::new(0.3, 0.0, 1.0);
+        let options = toy::options(0.01);
+        let test = toy::measured(&truth, 1.3, 0.01, 5, None);
+        toy::with_setting(&model, &test, &options, |setting, nominal| {
+            let (_, outcome) = recalibration(setting, &model, &nominal.point, &options)?;
+            let listed = model.candidates();
+            let c = &listed.iter().find(|c| c.name() == "c").unwrap().parameter;
+            assert_eq!(outcome.added, std::slice::from_ref(c));
+            let ctx = &setting.ctx;
+            let draws = ctx
+                .model_noise
+                .stats(&outcome.fit, &ctx.frame, None, None)?;
+            let report = added(&outcome.fit, &outcome.added, 1, &draws);
+            assert_eq!(report.len(), 1);
+            let r = &report[0];
+            assert_eq!(r.name, "c");
+            assert_eq!(r.value, outcome.fit.point[1]);
+            assert!(r.lower < 0.3 && 0.3 < r.upper, "{r:?}");
+            assert!(r.lower < r.value && r.value < r.upper);
+            let mut undetermined = outcome.fit.clone();
+            undetermined.se[1] = f64::INFINITY;
+            let r = &added(&undetermined, &outcome.added, 1, &draws)[0];
+            assert_eq!((r.lower, r.upper), (c.lower, c.upper));
+            Ok(())
+        })
+        .unwrap();
+    }
+}

@@ -190,3 +190,38 @@ pub fn with_setting<M: Enrichable, R>(
     let setting = frame::nuisance(runner, model, &nominal, None, options)?;
     body(&setting, &nominal)
 }
+
+/// The relative L2 error by hand, for held unit gains, no offset and uniform weights: per
+/// channel the bias is the mean of `test - y`, and the error is
+/// `sqrt(sum (test - b - y)^2 / sum (test - b)^2)` over both channels.
+pub fn rel_l2_by_hand(test: &[f64], y: &[f64]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for s in 0..test.len() / T {
+        let (z, y) = (&test[s * T..(s + 1) * T], &y[s * T..(s + 1) * T]);
+        let b = z.iter().zip(y).map(|(z, y)| z - y).sum::<f64>() / T as f64;
+        num += z
+            .iter()
+            .zip(y)
+            .map(|(z, y)| (z - b - y).powi(2))
+            .sum::<f64>();
+        den += z.iter().map(|z| (z - b).powi(2)).sum::<f64>();
+    }
+    (num / den).sqrt()
+}
+
+/// The toy's response at `p` as one vector, channel `a` then `b`.
+pub fn response(model: &Toy, p: &[f64]) -> Vec<f64> {
+    let (a, b) = model.channels(p);
+    a.into_iter().chain(b).collect()
+}
+
+/// A wave no candidate of the toy makes, `S x T`: `amplitude cos(11 pi u)` on `a` and
+/// `amplitude sin(13 pi u)` on `b`.
+pub fn foreign_wave(amplitude: f64) -> Vec<f64> {
+    use std::f64::consts::PI;
+    let u = |j: usize| j as f64 / (T - 1) as f64;
+    (0..T)
+        .map(|j| amplitude * (11.0 * PI * u(j)).cos())
+        .chain((0..T).map(|j| amplitude * (13.0 * PI * u(j)).sin()))
+        .collect()
+}
