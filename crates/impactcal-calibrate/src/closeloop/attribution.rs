@@ -565,7 +565,14 @@ mod tests {
         let options = toy::options(0.01);
         toy::with_setting(&model, &test, &options, |setting, nominal| {
             let ctx = &setting.ctx;
-            let fit = calibrate(ctx, &model, "r0", &[nominal.point.clone()], 8, 8)?;
+            let fit = calibrate(
+                ctx,
+                &model,
+                "r0",
+                std::slice::from_ref(&nominal.point),
+                8,
+                8,
+            )?;
             let a = attribute(
                 ctx,
                 &model,

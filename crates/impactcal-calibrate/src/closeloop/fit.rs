@@ -396,14 +396,28 @@ mod tests {
         let options = toy::options(1e-3);
         toy::with_setting(&model, &test, &options, |setting, nominal| {
             let ctx = &setting.ctx;
-            let fit = calibrate(ctx, &model, "r0", &[nominal.point.clone()], 8, 8)?;
+            let fit = calibrate(
+                ctx,
+                &model,
+                "r0",
+                std::slice::from_ref(&nominal.point),
+                8,
+                8,
+            )?;
             assert!((fit.point[0] - 1.3).abs() < 1e-5, "{:?}", fit.point);
             // The polish stops once the predicted fall is below 1e-3 noise variances.
             assert!(fit.rss < 1e-3, "rss {}", fit.rss);
             assert!(fit.se[0] > 0.0 && fit.se[0].is_finite());
-            assert!(fit.runs >= 1 + 8, "{} runs", fit.runs);
+            assert!(fit.runs > 8, "{} runs", fit.runs);
             // The polish alone, from the nominal point, gets there too.
-            let polished = calibrate(ctx, &model, "gn", &[nominal.point.clone()], 0, 8)?;
+            let polished = calibrate(
+                ctx,
+                &model,
+                "gn",
+                std::slice::from_ref(&nominal.point),
+                0,
+                8,
+            )?;
             assert!(
                 (polished.point[0] - 1.3).abs() < 1e-5,
                 "{:?}",
@@ -436,7 +450,7 @@ mod tests {
             );
             let fit = calibrate(ctx, &model, "s", &[far, near], 0, 1)?;
             assert_eq!(fit.point, from_near.point);
-            assert_eq!(fit.rss, from_near.rss);
+            assert_eq!(fit.rss.to_bits(), from_near.rss.to_bits());
             Ok(())
         })
         .unwrap();

@@ -318,7 +318,7 @@ mod tests {
         toy::with_setting(&model, &test, &fitted, |setting, _| {
             assert_eq!(setting.n_nuisance, 1 + 2 * 2);
             let (terms, rss) = setting.ctx.profile(&setting.y_nominal);
-            assert_eq!(terms.tau, 0.0);
+            assert_eq!(terms.tau.to_bits(), 0f64.to_bits());
             for s in 0..2 {
                 assert!((terms.gains[s] - gains[s]).abs() < 1e-9, "{terms:?}");
                 assert!((terms.biases[s] - biases[s]).abs() < 1e-9, "{terms:?}");

@@ -181,7 +181,7 @@ mod tests {
             assert_eq!(report.len(), 1);
             let r = &report[0];
             assert_eq!(r.name, "c");
-            assert_eq!(r.value, outcome.fit.point[1]);
+            assert_eq!(r.value.to_bits(), outcome.fit.point[1].to_bits());
             assert!(r.lower < 0.3 && 0.3 < r.upper, "{r:?}");
             assert!(r.lower < r.value && r.value < r.upper);
             let mut undetermined = outcome.fit.clone();
