@@ -116,10 +116,11 @@ pub struct Holdout<'a> {
 /// (created if needed; its journal is reused when it belongs to the same loop).
 ///
 /// # Errors
-/// [`CalibrateError::Study`] for invalid options, a budget too small to recalibrate (with
-/// the runs needed), a model with no candidate, a holdout condition the model cannot take,
+/// [`CalibrateError::Core`](crate::CalibrateError::Core) with [`impactcal_core::CoreError::InvalidOption`] naming the
+/// option as `loop.<key>` for an invalid option or a budget too small to recalibrate (with
+/// the runs needed); [`CalibrateError::Study`](crate::CalibrateError::Study) for a model with no candidate, a holdout condition the model cannot take,
 /// test channels the map does not cover, a noise floor that cannot be measured;
-/// [`CalibrateError::ForeignJournal`] when `dir` holds another loop's or study's journal;
+/// [`CalibrateError::ForeignJournal`](crate::CalibrateError::ForeignJournal) when `dir` holds another loop's or study's journal;
 /// run, journal and numerical errors.
 pub fn run_loop<M: Enrichable>(
     model: &M,
@@ -151,7 +152,7 @@ pub fn run_loop<M: Enrichable>(
 /// another executor; the result is the same bit for bit.
 ///
 /// # Errors
-/// As [`run_loop`]; a run the worker fails is a [`CalibrateError::Core`] simulation error
+/// As [`run_loop`]; a run the worker fails is a [`CalibrateError::Core`](crate::CalibrateError::Core) simulation error
 /// naming the run's stage and the worker's exit status and last line of standard error.
 #[allow(clippy::too_many_arguments)]
 pub fn run_loop_on<M: Enrichable>(

@@ -17,8 +17,8 @@ use crate::study::channels::{TestPreparation, prepared_test};
 /// the holdout's condition (returned beside the holdout).
 ///
 /// # Errors
-/// [`CalibrateError::Study`] for invalid options or a budget too small to recalibrate, a
-/// candidate the model does not list, no candidate left to consider, a holdout condition
+/// [`LoopOptions::check`]'s errors; [`CalibrateError::Study`] for a candidate the model
+/// does not list, no candidate left to consider, a holdout condition
 /// the model cannot take.
 pub(super) fn checked_inputs<'h, M: Enrichable>(
     model: &M,
