@@ -139,7 +139,7 @@ impl LoopOptions {
                     self.recalibrate,
                     format!(
                         "cannot recalibrate up to {} parameters ({declared} declared + \
-                         max_added {}): at least {need} runs are needed; raise it or lower \
+                         max_added {}): at least {need} are needed; raise it or lower \
                          max_added",
                         declared + self.max_added,
                         self.max_added
