@@ -222,33 +222,65 @@ impl Unfitted {
 /// held value, admissible range and finite step.
 type Direction = (String, String, String, Shape, Option<(f64, f64, f64, f64)>);
 
-/// Scores the candidates of `model` (and the signature directions) against the residual of
-/// `fit` (see the module docs). `step` is the finite step as a fraction of each range.
+/// The pairs among the identifiable directions `tilde` whose unfitted parts have mutual
+/// coherence above [`COHERENCE_MAX`]: `(a, b, mu)`.
+fn coherent_pairs(
+    scores: &[Score],
+    tilde: &[usize],
+    unfitted: &[Unfitted],
+    uty: &[Vec<f64>],
+    norms: &[f64],
+    t: usize,
+) -> Vec<(String, String, f64)> {
+    let mut indistinguishable = Vec::new();
+    for (a, &i) in tilde.iter().enumerate() {
+        for &j in &tilde[a + 1..] {
+            let gij = Unfitted::inner((&unfitted[i], &uty[i]), (&unfitted[j], &uty[j]), t);
+            let mu = gij.abs() / (norms[i] * norms[j]).sqrt();
+            if mu > COHERENCE_MAX {
+                indistinguishable.push((scores[i].name.clone(), scores[j].name.clone(), mu));
+            }
+        }
+    }
+    indistinguishable
+}
+
+/// The scores ranked: eligible candidates first, then the other identifiable candidates,
+/// the signatures, the rest, each group by descending score; the first eligible one is
+/// marked `best`.
+fn ranked(mut scores: Vec<Score>) -> Vec<Score> {
+    let order = |s: &Score| match s.status.as_str() {
+        "eligible" => 0,
+        "signature" => 2,
+        _ if s.kind == "candidate" && s.identifiable => 1,
+        _ => 3,
+    };
+    scores.sort_by(|a, b| order(a).cmp(&order(b)).then(b.score.total_cmp(&a.score)));
+    if let Some(first) = scores.first_mut()
+        && first.status == "eligible"
+    {
+        first.status = "best".into();
+    }
+    scores
+}
+
+/// The directions to score, whitened: one run per candidate in `cands` (journal stage
+/// `<prefix>-candidates`, each moved from its held value by `step` of its range, inwards)
+/// under the fitted nuisance terms, then the signatures: the time scaling about the impact
+/// (`onset`, shifted by the trigger offset) and a drift per channel.
 ///
 /// # Errors
 /// Run and journal errors; the model's `enrich` errors.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn attribute<M: Enrichable>(
+fn directions<M: Enrichable>(
     ctx: &Ctx<'_>,
     model: &M,
     fit: &Fit,
+    cands: &[Candidate],
     prefix: &str,
     step: f64,
-    alpha: f64,
-    min_explained: f64,
     onset: usize,
-    allowed: &dyn Fn(&str) -> bool,
-) -> Result<Attribution> {
-    let cands: Vec<Candidate> = model
-        .candidates()
-        .into_iter()
-        .filter(|c| allowed(c.name()))
-        .collect();
-    if let Some(plan) = ctx.runner.plan {
-        plan.check(super::plan::ATTRIBUTION, &format!("{prefix}-candidates"))?;
-    }
+) -> Result<Vec<Direction>> {
     let frame = &ctx.frame;
-    let jac = &fit.jac;
     let t = frame.samples;
     let base = nuisance::apply(&fit.y, frame, &fit.terms);
     let mut dirs: Vec<Direction> = Vec::new();
@@ -319,6 +351,38 @@ pub(crate) fn attribute<M: Enrichable>(
             None,
         ));
     }
+    Ok(dirs)
+}
+
+/// Scores the candidates of `model` (and the signature directions) against the residual of
+/// `fit` (see the module docs). `step` is the finite step as a fraction of each range.
+///
+/// # Errors
+/// Run and journal errors; the model's `enrich` errors.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn attribute<M: Enrichable>(
+    ctx: &Ctx<'_>,
+    model: &M,
+    fit: &Fit,
+    prefix: &str,
+    step: f64,
+    alpha: f64,
+    min_explained: f64,
+    onset: usize,
+    allowed: &dyn Fn(&str) -> bool,
+) -> Result<Attribution> {
+    let cands: Vec<Candidate> = model
+        .candidates()
+        .into_iter()
+        .filter(|c| allowed(c.name()))
+        .collect();
+    if let Some(plan) = ctx.runner.plan {
+        plan.check(super::plan::ATTRIBUTION, &format!("{prefix}-candidates"))?;
+    }
+    let frame = &ctx.frame;
+    let jac = &fit.jac;
+    let t = frame.samples;
+    let dirs = directions(ctx, model, fit, &cands, prefix, step, onset)?;
 
     // Each direction without its fitted part: its size, confounding ratio and `g~`.
     let mut unfitted = Vec::with_capacity(dirs.len());
@@ -446,30 +510,9 @@ pub(crate) fn attribute<M: Enrichable>(
             sensor_pattern: pattern,
         });
     }
-    let mut indistinguishable = Vec::new();
-    for (a, &i) in tilde.iter().enumerate() {
-        for &j in &tilde[a + 1..] {
-            let gij = Unfitted::inner((&unfitted[i], &uty[i]), (&unfitted[j], &uty[j]), t);
-            let mu = gij.abs() / (norms[i] * norms[j]).sqrt();
-            if mu > COHERENCE_MAX {
-                indistinguishable.push((scores[i].name.clone(), scores[j].name.clone(), mu));
-            }
-        }
-    }
-    let order = |s: &Score| match s.status.as_str() {
-        "eligible" => 0,
-        "signature" => 2,
-        _ if s.kind == "candidate" && s.identifiable => 1,
-        _ => 3,
-    };
-    scores.sort_by(|a, b| order(a).cmp(&order(b)).then(b.score.total_cmp(&a.score)));
-    if let Some(first) = scores.first_mut()
-        && first.status == "eligible"
-    {
-        first.status = "best".into();
-    }
+    let indistinguishable = coherent_pairs(&scores, &tilde, &unfitted, &uty, &norms, t);
     Ok(Attribution {
-        ranked: scores,
+        ranked: ranked(scores),
         indistinguishable,
     })
 }
