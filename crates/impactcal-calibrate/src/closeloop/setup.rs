@@ -180,7 +180,6 @@ pub(super) fn check_covered(
 mod tests {
     use super::*;
     use crate::closeloop::toy::{self, Toy};
-    use crate::study::Silent;
     use impactcal_core::Model;
     use std::cell::Cell;
 
@@ -247,15 +246,7 @@ mod tests {
         let model = Toy::new(0.0, 0.0, 1.0);
         let dir = tempfile::tempdir().unwrap();
         let used = Cell::new(0);
-        let runner = Journaled {
-            dir: dir.path(),
-            fingerprint: "toy",
-            observer: &Silent,
-            used: &used,
-            worker: None,
-            condition: &[],
-            plan: None,
-        };
+        let runner = toy::journaled(dir.path(), &used);
         let test = toy::measured(&model, 1.2, 0.01, 2, None);
         let data = |h| TestData {
             histories: h,

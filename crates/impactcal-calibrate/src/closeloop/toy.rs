@@ -7,6 +7,7 @@
 //! 1.
 
 use std::cell::Cell;
+use std::path::Path;
 
 use impactcal_core::{
     Candidate, CoreError, Enrichable, Histories, Model, Parameter, ParameterSpace,
@@ -157,6 +158,19 @@ pub fn options(sigma: f64) -> LoopOptions {
     }
 }
 
+/// A journaled runner in `dir` in this process, counting its runs in `used`.
+pub fn journaled<'a>(dir: &'a Path, used: &'a Cell<usize>) -> Journaled<'a> {
+    Journaled {
+        dir,
+        fingerprint: "toy",
+        observer: &Silent,
+        used,
+        worker: None,
+        condition: &[],
+        plan: None,
+    }
+}
+
 /// Runs the loop's first stages (nominal run, plan, nuisance frame) of `model` against
 /// `test` in a fresh folder, then `body` on what they give.
 pub fn with_setting<M: Enrichable, R>(
@@ -167,15 +181,7 @@ pub fn with_setting<M: Enrichable, R>(
 ) -> Result<R> {
     let dir = tempfile::tempdir().unwrap();
     let used = Cell::new(0usize);
-    let runner = Journaled {
-        dir: dir.path(),
-        fingerprint: "toy",
-        observer: &Silent,
-        used: &used,
-        worker: None,
-        condition: &[],
-        plan: None,
-    };
+    let runner = journaled(dir.path(), &used);
     let data = TestData {
         histories: test,
         map: None,
