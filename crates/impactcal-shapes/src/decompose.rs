@@ -115,12 +115,11 @@ impl ImpactShapes {
     /// base is `0, 1, 2, ...`.
     ///
     /// # Errors
-    /// [`CoreError::Empty`](impactcal_core::CoreError::Empty) or
-    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for bad data;
+    /// [`CoreError::Empty`] or [`CoreError::NonFinite`] for bad data;
     /// [`ShapesError::TooManyShapes`] when [`Truncation::Count`] exceeds the numerical rank;
-    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a fraction
-    /// out of range, a zero count, or the
-    /// randomized method without a count; [`ShapesError::NoConvergence`] if the SVD fails.
+    /// [`CoreError::InvalidOption`] for options refused by [`ParamGuard::check_ref`] (a
+    /// fraction out of range, a zero count, the randomized method without a count);
+    /// [`ShapesError::NoConvergence`] if the SVD fails.
     pub fn from_matrix(y: MatRef<'_, f64>, options: &ShapeOptions) -> Result<Self> {
         finite_nonempty("response matrix", y)?;
         ParamGuard::check_ref(options)?;
