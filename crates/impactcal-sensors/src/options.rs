@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use crate::candidates::CandidateShapes;
 use crate::error::{Result, SensorsError};
 use impactcal_core::error::invalid_option;
+use impactcal_core::{CoreError, ParamGuard};
 
 /// How the sensor set is built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -128,7 +129,8 @@ impl PlacementOptions {
     /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for an empty
     /// label; [`SensorsError::KeepExcludeConflict`] for a label that is also excluded.
     pub fn keep<S: Into<String>>(mut self, labels: impl IntoIterator<Item = S>) -> Result<Self> {
-        self.keep = checked_labels("keep", labels)?;
+        self.keep = labels.into_iter().map(Into::into).collect();
+        self.check_ref()?;
         self.check_conflict()?;
         Ok(self)
     }
@@ -138,7 +140,8 @@ impl PlacementOptions {
     /// # Errors
     /// As [`keep`](Self::keep).
     pub fn exclude<S: Into<String>>(mut self, labels: impl IntoIterator<Item = S>) -> Result<Self> {
-        self.exclude = checked_labels("exclude", labels)?;
+        self.exclude = labels.into_iter().map(Into::into).collect();
+        self.check_ref()?;
         self.check_conflict()?;
         Ok(self)
     }
@@ -151,14 +154,8 @@ impl PlacementOptions {
     /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a level
     /// that is not finite and positive, naming its position.
     pub fn noise(mut self, sigma: Vec<f64>) -> Result<Self> {
-        if let Some(i) = sigma.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
-            return Err(invalid_option(
-                format!("noise level {i} (0-based)"),
-                sigma[i],
-                "must be finite and positive",
-            ));
-        }
         self.noise = Some(sigma);
+        self.check_ref()?;
         Ok(self)
     }
 
@@ -246,14 +243,8 @@ impl PlacementOptions {
     /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a value
     /// that is negative or not finite.
     pub fn rank_tolerance(mut self, tolerance: f64) -> Result<Self> {
-        if !(tolerance.is_finite() && tolerance >= 0.0) {
-            return Err(invalid_option(
-                "rank tolerance",
-                tolerance,
-                "must be finite and non-negative",
-            ));
-        }
         self.rank_tolerance = tolerance;
+        self.check_ref()?;
         Ok(self)
     }
 
@@ -298,20 +289,83 @@ impl PlacementOptions {
     }
 }
 
-/// Labels checked to be non-empty.
-fn checked_labels<S: Into<String>>(
-    option: &str,
-    labels: impl IntoIterator<Item = S>,
-) -> Result<Vec<String>> {
-    labels
-        .into_iter()
-        .map(|l| {
-            let l: String = l.into();
-            if l.trim().is_empty() {
-                Err(invalid_option(option, "\"\"", "labels must not be empty"))
-            } else {
-                Ok(l)
+impl ParamGuard for PlacementOptions {
+    type Checked = PlacementOptions;
+
+    /// Checks every option on its own; each setter that can refuse its value calls it (the
+    /// options against the candidates are checked by [`place`](crate::place)). A label
+    /// both kept and excluded is a [`SensorsError::KeepExcludeConflict`] of the setters.
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] naming the option: an empty label in `keep` or
+    /// `exclude`, a noise level that is not finite and positive (`noise level <i>
+    /// (0-based)`), a `rank tolerance` that is negative or not finite.
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        for (option, labels) in [("keep", &self.keep), ("exclude", &self.exclude)] {
+            if labels.iter().any(|l| l.trim().is_empty()) {
+                return Err(CoreError::invalid_option(
+                    option,
+                    "\"\"",
+                    "labels must not be empty",
+                ));
             }
-        })
-        .collect()
+        }
+        if let Some(sigma) = &self.noise
+            && let Some(i) = sigma.iter().position(|v| !(v.is_finite() && *v > 0.0))
+        {
+            return Err(CoreError::invalid_option(
+                format!("noise level {i} (0-based)"),
+                sigma[i],
+                "must be finite and positive",
+            ));
+        }
+        if !(self.rank_tolerance.is_finite() && self.rank_tolerance >= 0.0) {
+            return Err(CoreError::invalid_option(
+                "rank tolerance",
+                self.rank_tolerance,
+                "must be finite and non-negative",
+            ));
+        }
+        Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<PlacementOptions> {
+        self.check_ref()?;
+        Ok(self)
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// Each setter that can refuse its value refuses a bad one with
+    /// `CoreError::InvalidOption` naming the option, through `ParamGuard::check_ref`.
+    #[test]
+    fn a_bad_value_is_refused_naming_its_key() {
+        let key = |r: Result<PlacementOptions>| match r {
+            Err(SensorsError::Core(CoreError::InvalidOption { name, .. })) => name,
+            other => panic!("{other:?}"),
+        };
+        let o = || PlacementOptions::new(3);
+        assert_eq!(key(o().keep(["a", " "])), "keep");
+        assert_eq!(key(o().exclude([""])), "exclude");
+        assert_eq!(key(o().noise(vec![1.0, 0.0])), "noise level 1 (0-based)");
+        assert_eq!(key(o().rank_tolerance(f64::NAN)), "rank tolerance");
+        let bad = PlacementOptions {
+            rank_tolerance: -1.0,
+            ..o()
+        };
+        match bad.check_ref() {
+            Err(CoreError::InvalidOption { name, .. }) => assert_eq!(name, "rank tolerance"),
+            other => panic!("{other:?}"),
+        }
+        let fine = o().keep(["a"]).unwrap().noise(vec![1.0, 2.0]).unwrap();
+        assert!(fine.check_ref().is_ok());
+        assert!(matches!(
+            fine.exclude(["a"]),
+            Err(SensorsError::KeepExcludeConflict { .. })
+        ));
+    }
 }

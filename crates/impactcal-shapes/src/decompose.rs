@@ -3,12 +3,11 @@
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::svd::{ComputeSvdVectors, svd, svd_scratch};
 use faer::{Col, Mat, MatRef};
-use impactcal_core::Histories;
+use impactcal_core::{CoreError, Histories, ParamGuard};
 
 use crate::checks::{finite_nonempty, numerical_rank};
 use crate::error::{Result, ShapesError};
 use crate::randomized::{RandomizedSvd, randomized_svd};
-use impactcal_core::error::invalid_option;
 
 /// How many shapes to keep.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -116,27 +115,21 @@ impl ImpactShapes {
     /// base is `0, 1, 2, ...`.
     ///
     /// # Errors
-    /// [`CoreError::Empty`](impactcal_core::CoreError::Empty) or
-    /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for bad data;
+    /// [`CoreError::Empty`] or [`CoreError::NonFinite`] for bad data;
     /// [`ShapesError::TooManyShapes`] when [`Truncation::Count`] exceeds the numerical rank;
-    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a fraction
-    /// out of range, a zero count, or the
-    /// randomized method without a count; [`ShapesError::NoConvergence`] if the SVD fails.
+    /// [`CoreError::InvalidOption`] for options refused by [`ParamGuard::check_ref`] (a
+    /// fraction out of range, a zero count, the randomized method without a count);
+    /// [`ShapesError::NoConvergence`] if the SVD fails.
     pub fn from_matrix(y: MatRef<'_, f64>, options: &ShapeOptions) -> Result<Self> {
         finite_nonempty("response matrix", y)?;
-        validate_truncation(options.truncation)?;
+        ParamGuard::check_ref(options)?;
         let (m, l) = y.shape();
         let frobenius_sq = y.squared_norm_l2();
         let randomized = match (options.method, options.truncation) {
             (SvdMethod::Full, _) => None,
             (SvdMethod::Randomized(r), Truncation::Count(k)) => Some((r, k)),
-            (SvdMethod::Randomized(_), _) => {
-                return Err(invalid_option(
-                    "method",
-                    "randomized",
-                    "the randomized solver needs a fixed shape count (Truncation::Count)",
-                ));
-            }
+            // Refused by the options' check above.
+            (SvdMethod::Randomized(_), _) => None,
             (SvdMethod::Auto, Truncation::Count(k)) => {
                 let small = m.min(l);
                 (small >= 400 && k + 10 <= small / 4).then_some((RandomizedSvd::default(), k))
@@ -321,24 +314,63 @@ impl ImpactShapes {
     }
 }
 
-fn validate_truncation(t: Truncation) -> Result<()> {
-    match t {
-        Truncation::Count(0) => Err(invalid_option(
-            "shape count",
-            0,
-            "the shape count must be at least 1",
-        )),
-        Truncation::Contribution(f) if !(f > 0.0 && f <= 1.0) => Err(invalid_option(
-            "contribution",
-            f,
-            "a cumulative contribution must lie in (0, 1]",
-        )),
-        Truncation::ReconstructionError(e) if !(0.0..1.0).contains(&e) => Err(invalid_option(
-            "reconstruction error",
-            e,
-            "a relative reconstruction error must lie in [0, 1)",
-        )),
-        _ => Ok(()),
+impl ParamGuard for ShapeOptions {
+    type Checked = ShapeOptions;
+
+    /// Checks the truncation and the solver on their own (the data are checked by the
+    /// decomposition).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] naming the option: a `shape count` of 0, a
+    /// `contribution` outside `(0, 1]`, a `reconstruction error` outside `[0, 1)`, a
+    /// randomized `method` without a fixed shape count, `power_iterations` of 0.
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        match self.truncation {
+            Truncation::Count(0) => {
+                return Err(CoreError::invalid_option(
+                    "shape count",
+                    0,
+                    "the shape count must be at least 1",
+                ));
+            }
+            Truncation::Contribution(f) if !(f > 0.0 && f <= 1.0) => {
+                return Err(CoreError::invalid_option(
+                    "contribution",
+                    f,
+                    "a cumulative contribution must lie in (0, 1]",
+                ));
+            }
+            Truncation::ReconstructionError(e) if !(0.0..1.0).contains(&e) => {
+                return Err(CoreError::invalid_option(
+                    "reconstruction error",
+                    e,
+                    "a relative reconstruction error must lie in [0, 1)",
+                ));
+            }
+            _ => {}
+        }
+        if let SvdMethod::Randomized(r) = self.method {
+            if !matches!(self.truncation, Truncation::Count(_)) {
+                return Err(CoreError::invalid_option(
+                    "method",
+                    "randomized",
+                    "the randomized solver needs a fixed shape count (Truncation::Count)",
+                ));
+            }
+            if r.power_iterations == 0 {
+                return Err(CoreError::invalid_option(
+                    "power_iterations",
+                    0,
+                    "the randomized solver needs at least one power iteration",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<ShapeOptions> {
+        ParamGuard::check_ref(&self)?;
+        Ok(self)
     }
 }
 
@@ -392,5 +424,57 @@ pub(crate) fn fix_signs(u: &mut Mat<f64>, v: &mut Mat<f64>, n: usize) {
             u.col_mut(j).iter_mut().for_each(|x| *x = -*x);
             v.col_mut(j).iter_mut().for_each(|x| *x = -*x);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each bad option is refused by `ParamGuard::check_ref` with
+    /// `CoreError::InvalidOption` naming it, and the decomposition refuses it the same way.
+    #[test]
+    fn a_bad_value_is_refused_naming_its_key() {
+        let randomized = |truncation, power_iterations| ShapeOptions {
+            truncation,
+            method: SvdMethod::Randomized(RandomizedSvd {
+                power_iterations,
+                ..RandomizedSvd::default()
+            }),
+        };
+        let cases = [
+            (ShapeOptions::count(0), "shape count"),
+            (
+                ShapeOptions {
+                    truncation: Truncation::Contribution(1.5),
+                    ..ShapeOptions::default()
+                },
+                "contribution",
+            ),
+            (
+                ShapeOptions {
+                    truncation: Truncation::ReconstructionError(-0.1),
+                    ..ShapeOptions::default()
+                },
+                "reconstruction error",
+            ),
+            (randomized(Truncation::Contribution(0.9), 4), "method"),
+            (randomized(Truncation::Count(2), 0), "power_iterations"),
+        ];
+        let y = Mat::from_fn(4, 6, |i, j| (i * 6 + j) as f64 + (i as f64).sin());
+        for (o, key) in cases {
+            match ParamGuard::check_ref(&o) {
+                Err(CoreError::InvalidOption { name, .. }) => assert_eq!(name, key),
+                other => panic!("{key}: {other:?}"),
+            }
+            match ImpactShapes::from_matrix(y.as_ref(), &o) {
+                Err(ShapesError::Core(CoreError::InvalidOption { name, .. })) => {
+                    assert_eq!(name, key);
+                }
+                other => panic!("{key}: {other:?}"),
+            }
+        }
+        assert!(ParamGuard::check_ref(&randomized(Truncation::Count(2), 1)).is_ok());
+        assert!(ParamGuard::check_ref(&ShapeOptions::default()).is_ok());
     }
 }

@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use crate::analysis::non_finite_output;
 use crate::error::{Result, SobolError};
+use impactcal_core::ParamGuard;
 use impactcal_core::error::{dimension_mismatch, invalid_option};
 
 /// Options of [`given_data_first_order`].
@@ -19,6 +20,46 @@ pub struct GivenDataOptions {
     pub parameter_names: Option<Vec<String>>,
     /// Output names (default `y1, y2, ...`).
     pub output_names: Option<Vec<String>>,
+}
+
+impl ParamGuard for GivenDataOptions {
+    type Checked = GivenDataOptions;
+
+    /// Checks the options on their own (the bins against the sample's runs and the names
+    /// against the columns are checked when the indices are computed).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) naming the
+    /// option: fewer than 2 `bins`, a `low_variance_tolerance` that is not finite and
+    /// non-negative, an empty name in `parameter_names` or `output_names`.
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        if let Some(b) = self.bins
+            && b < 2
+        {
+            return Err(invalid_option("bins", b, "need at least 2 bins"));
+        }
+        if !(self.low_variance_tolerance >= 0.0 && self.low_variance_tolerance.is_finite()) {
+            return Err(invalid_option(
+                "low_variance_tolerance",
+                self.low_variance_tolerance,
+                "the low-variance tolerance must be finite and non-negative",
+            ));
+        }
+        for (key, names) in [
+            ("parameter_names", &self.parameter_names),
+            ("output_names", &self.output_names),
+        ] {
+            if let Some(i) = names.iter().flatten().position(|n| n.trim().is_empty()) {
+                return Err(invalid_option(key, format!("entry {i}"), "a name is empty"));
+            }
+        }
+        Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<GivenDataOptions> {
+        self.check_ref()?;
+        Ok(self)
+    }
 }
 
 impl Default for GivenDataOptions {
@@ -78,8 +119,9 @@ pub struct GivenDataIndices {
 /// Under [`SobolError::Core`](crate::SobolError::Core):
 /// [`CoreError::DimensionMismatch`](impactcal_core::CoreError::DimensionMismatch) when the
 /// row counts differ, there is no output column, or a name list has the wrong length;
+/// [`ParamGuard::check_ref`]'s errors for the options;
 /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) when there are
-/// fewer than 2 runs per bin or fewer than 2 bins;
+/// fewer than 2 runs per bin;
 /// [`CoreError::NonFinite`](impactcal_core::CoreError::NonFinite) for NaN or infinite
 /// outputs or parameter values, naming row and column.
 pub fn given_data_first_order(
@@ -87,6 +129,7 @@ pub fn given_data_first_order(
     outputs: MatRef<'_, f64>,
     options: &GivenDataOptions,
 ) -> Result<GivenDataIndices> {
+    options.check_ref()?;
     let (n, d, cols) = (x.nrows(), x.ncols(), outputs.ncols());
     if outputs.nrows() != n {
         return Err(dimension_mismatch(
@@ -203,4 +246,63 @@ pub fn given_data_first_order(
         normalised_first_order_share,
         variance: sst.iter().map(|s| s / n as f64).collect(),
     })
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use impactcal_core::CoreError;
+
+    /// Each bad option is refused by `ParamGuard::check_ref` with
+    /// `CoreError::InvalidOption` naming it, and the analysis refuses it the same way.
+    #[test]
+    fn a_bad_value_is_refused_naming_its_key() {
+        let base = GivenDataOptions::default();
+        let cases = [
+            (
+                GivenDataOptions {
+                    bins: Some(1),
+                    ..base.clone()
+                },
+                "bins",
+            ),
+            (
+                GivenDataOptions {
+                    low_variance_tolerance: -1.0,
+                    ..base.clone()
+                },
+                "low_variance_tolerance",
+            ),
+            (
+                GivenDataOptions {
+                    parameter_names: Some(vec!["a".into(), String::new()]),
+                    ..base.clone()
+                },
+                "parameter_names",
+            ),
+            (
+                GivenDataOptions {
+                    output_names: Some(vec![" ".into()]),
+                    ..base.clone()
+                },
+                "output_names",
+            ),
+        ];
+        let x = faer::Mat::from_fn(64, 2, |i, j| ((i * 7 + j * 3) % 64) as f64 / 64.0);
+        let y = faer::Mat::from_fn(64, 1, |i, _| x[(i, 0)] + 0.5 * x[(i, 1)]);
+        for (o, key) in cases {
+            match o.check_ref() {
+                Err(CoreError::InvalidOption { name, .. }) => assert_eq!(name, key),
+                other => panic!("{key}: {other:?}"),
+            }
+            match given_data_first_order(x.as_ref(), y.as_ref(), &o) {
+                Err(SobolError::Core(CoreError::InvalidOption { name, .. })) => {
+                    assert_eq!(name, key);
+                }
+                other => panic!("{key}: {other:?}"),
+            }
+        }
+        assert!(given_data_first_order(x.as_ref(), y.as_ref(), &base).is_ok());
+    }
 }

@@ -222,33 +222,65 @@ impl Unfitted {
 /// held value, admissible range and finite step.
 type Direction = (String, String, String, Shape, Option<(f64, f64, f64, f64)>);
 
-/// Scores the candidates of `model` (and the signature directions) against the residual of
-/// `fit` (see the module docs). `step` is the finite step as a fraction of each range.
+/// The pairs among the identifiable directions `tilde` whose unfitted parts have mutual
+/// coherence above [`COHERENCE_MAX`]: `(a, b, mu)`.
+fn coherent_pairs(
+    scores: &[Score],
+    tilde: &[usize],
+    unfitted: &[Unfitted],
+    uty: &[Vec<f64>],
+    norms: &[f64],
+    t: usize,
+) -> Vec<(String, String, f64)> {
+    let mut indistinguishable = Vec::new();
+    for (a, &i) in tilde.iter().enumerate() {
+        for &j in &tilde[a + 1..] {
+            let gij = Unfitted::inner((&unfitted[i], &uty[i]), (&unfitted[j], &uty[j]), t);
+            let mu = gij.abs() / (norms[i] * norms[j]).sqrt();
+            if mu > COHERENCE_MAX {
+                indistinguishable.push((scores[i].name.clone(), scores[j].name.clone(), mu));
+            }
+        }
+    }
+    indistinguishable
+}
+
+/// The scores ranked: eligible candidates first, then the other identifiable candidates,
+/// the signatures, the rest, each group by descending score; the first eligible one is
+/// marked `best`.
+fn ranked(mut scores: Vec<Score>) -> Vec<Score> {
+    let order = |s: &Score| match s.status.as_str() {
+        "eligible" => 0,
+        "signature" => 2,
+        _ if s.kind == "candidate" && s.identifiable => 1,
+        _ => 3,
+    };
+    scores.sort_by(|a, b| order(a).cmp(&order(b)).then(b.score.total_cmp(&a.score)));
+    if let Some(first) = scores.first_mut()
+        && first.status == "eligible"
+    {
+        first.status = "best".into();
+    }
+    scores
+}
+
+/// The directions to score, whitened: one run per candidate in `cands` (journal stage
+/// `<prefix>-candidates`, each moved from its held value by `step` of its range, inwards)
+/// under the fitted nuisance terms, then the signatures: the time scaling about the impact
+/// (`onset`, shifted by the trigger offset) and a drift per channel.
 ///
 /// # Errors
 /// Run and journal errors; the model's `enrich` errors.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn attribute<M: Enrichable>(
+fn directions<M: Enrichable>(
     ctx: &Ctx<'_>,
     model: &M,
     fit: &Fit,
+    cands: &[Candidate],
     prefix: &str,
     step: f64,
-    alpha: f64,
-    min_explained: f64,
     onset: usize,
-    allowed: &dyn Fn(&str) -> bool,
-) -> Result<Attribution> {
-    let cands: Vec<Candidate> = model
-        .candidates()
-        .into_iter()
-        .filter(|c| allowed(c.name()))
-        .collect();
-    if let Some(plan) = ctx.runner.plan {
-        plan.check(super::plan::ATTRIBUTION, &format!("{prefix}-candidates"))?;
-    }
+) -> Result<Vec<Direction>> {
     let frame = &ctx.frame;
-    let jac = &fit.jac;
     let t = frame.samples;
     let base = nuisance::apply(&fit.y, frame, &fit.terms);
     let mut dirs: Vec<Direction> = Vec::new();
@@ -319,6 +351,38 @@ pub(crate) fn attribute<M: Enrichable>(
             None,
         ));
     }
+    Ok(dirs)
+}
+
+/// Scores the candidates of `model` (and the signature directions) against the residual of
+/// `fit` (see the module docs). `step` is the finite step as a fraction of each range.
+///
+/// # Errors
+/// Run and journal errors; the model's `enrich` errors.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn attribute<M: Enrichable>(
+    ctx: &Ctx<'_>,
+    model: &M,
+    fit: &Fit,
+    prefix: &str,
+    step: f64,
+    alpha: f64,
+    min_explained: f64,
+    onset: usize,
+    allowed: &dyn Fn(&str) -> bool,
+) -> Result<Attribution> {
+    let cands: Vec<Candidate> = model
+        .candidates()
+        .into_iter()
+        .filter(|c| allowed(c.name()))
+        .collect();
+    if let Some(plan) = ctx.runner.plan {
+        plan.check(super::plan::ATTRIBUTION, &format!("{prefix}-candidates"))?;
+    }
+    let frame = &ctx.frame;
+    let jac = &fit.jac;
+    let t = frame.samples;
+    let dirs = directions(ctx, model, fit, &cands, prefix, step, onset)?;
 
     // Each direction without its fitted part: its size, confounding ratio and `g~`.
     let mut unfitted = Vec::with_capacity(dirs.len());
@@ -446,30 +510,9 @@ pub(crate) fn attribute<M: Enrichable>(
             sensor_pattern: pattern,
         });
     }
-    let mut indistinguishable = Vec::new();
-    for (a, &i) in tilde.iter().enumerate() {
-        for &j in &tilde[a + 1..] {
-            let gij = Unfitted::inner((&unfitted[i], &uty[i]), (&unfitted[j], &uty[j]), t);
-            let mu = gij.abs() / (norms[i] * norms[j]).sqrt();
-            if mu > COHERENCE_MAX {
-                indistinguishable.push((scores[i].name.clone(), scores[j].name.clone(), mu));
-            }
-        }
-    }
-    let order = |s: &Score| match s.status.as_str() {
-        "eligible" => 0,
-        "signature" => 2,
-        _ if s.kind == "candidate" && s.identifiable => 1,
-        _ => 3,
-    };
-    scores.sort_by(|a, b| order(a).cmp(&order(b)).then(b.score.total_cmp(&a.score)));
-    if let Some(first) = scores.first_mut()
-        && first.status == "eligible"
-    {
-        first.status = "best".into();
-    }
+    let indistinguishable = coherent_pairs(&scores, &tilde, &unfitted, &uty, &norms, t);
     Ok(Attribution {
-        ranked: scores,
+        ranked: ranked(scores),
         indistinguishable,
     })
 }
@@ -550,5 +593,72 @@ mod tests {
             "the two drifts must share something for the test"
         );
         assert!((cross - expect).abs() <= 1e-10 * expect.abs().max(1.0));
+    }
+
+    /// The test carries `c = 0.3` that the model holds at 0: after calibrating `k`, the
+    /// residual is the part of `c`'s signature `k` cannot absorb, so `c` ranks first, explains
+    /// nearly all of it, and its amplitude's interval holds 0.3; `m` does not.
+    #[test]
+    fn a_candidate_whose_signature_is_the_residual_ranks_first() {
+        use crate::closeloop::fit::calibrate;
+        use crate::closeloop::toy::{self, Toy};
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let truth = Toy::new(0.3, 0.0, 1.0);
+        let test = toy::measured(&truth, 1.3, 0.01, 3, None);
+        let options = toy::options(0.01);
+        toy::with_setting(&model, &test, &options, |setting, nominal| {
+            let ctx = &setting.ctx;
+            let fit = calibrate(
+                ctx,
+                &model,
+                "r0",
+                std::slice::from_ref(&nominal.point),
+                8,
+                8,
+            )?;
+            let a = attribute(
+                ctx,
+                &model,
+                &fit,
+                "r0",
+                options.candidate_step,
+                options.alpha,
+                options.min_explained,
+                setting.onset,
+                &|_| true,
+            )?;
+            let first = &a.ranked[0];
+            assert_eq!(first.name, "c");
+            assert_eq!(first.status, "best");
+            assert_eq!(a.best().map(|s| s.name.as_str()), Some("c"));
+            assert!(first.explained_fraction > 0.95, "{first:?}");
+            let amp = first.amplitude.as_ref().unwrap();
+            assert!(amp.lower < 0.3 && 0.3 < amp.upper, "{amp:?}");
+            let m = a.ranked.iter().find(|s| s.name == "m").unwrap();
+            assert!(m.explained_fraction < first.explained_fraction);
+            assert_ne!(m.status, "best");
+            // Signatures are scored, never eligible.
+            assert!(
+                a.ranked
+                    .iter()
+                    .filter(|s| s.kind == "signature")
+                    .all(|s| s.status == "signature")
+            );
+            // Restricted to `m`, the residual has no best candidate named `c`.
+            let only_m = attribute(
+                ctx,
+                &model,
+                &fit,
+                "r0m",
+                options.candidate_step,
+                options.alpha,
+                options.min_explained,
+                setting.onset,
+                &|n| n == "m",
+            )?;
+            assert!(only_m.ranked.iter().all(|s| s.name != "c"));
+            Ok(())
+        })
+        .unwrap();
     }
 }

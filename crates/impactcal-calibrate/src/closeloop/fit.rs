@@ -379,3 +379,80 @@ fn polish_from<M: Model>(
         it += 1;
     }
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::closeloop::toy::{self, Toy};
+
+    /// Noise-free data of `k = 1.3` (linear in `k` on channel `a`, quadratic on `b`):
+    /// CORS and the polish land on 1.3, the residual falls to the polish's tolerance and the
+    /// runs are counted.
+    #[test]
+    fn recovers_the_parameter_of_a_quadratic_toy() {
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let test = toy::measured(&model, 1.3, 0.0, 1, None);
+        let options = toy::options(1e-3);
+        toy::with_setting(&model, &test, &options, |setting, nominal| {
+            let ctx = &setting.ctx;
+            let fit = calibrate(
+                ctx,
+                &model,
+                "r0",
+                std::slice::from_ref(&nominal.point),
+                8,
+                8,
+            )?;
+            assert!((fit.point[0] - 1.3).abs() < 1e-5, "{:?}", fit.point);
+            // The polish stops once the predicted fall is below 1e-3 noise variances.
+            assert!(fit.rss < 1e-3, "rss {}", fit.rss);
+            assert!(fit.se[0] > 0.0 && fit.se[0].is_finite());
+            assert!(fit.runs > 8, "{} runs", fit.runs);
+            // The polish alone, from the nominal point, gets there too.
+            let polished = calibrate(
+                ctx,
+                &model,
+                "gn",
+                std::slice::from_ref(&nominal.point),
+                0,
+                8,
+            )?;
+            assert!(
+                (polished.point[0] - 1.3).abs() < 1e-5,
+                "{:?}",
+                polished.point
+            );
+            Ok(())
+        })
+        .unwrap();
+    }
+
+    /// With two starts and no search, the fit is the better of the two polishes: one step
+    /// from the far start stops short of the optimum, one from the near start reaches it.
+    #[test]
+    fn keeps_the_best_start() {
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let test = toy::measured(&model, 1.3, 0.0, 1, None);
+        let options = toy::options(1e-3);
+        toy::with_setting(&model, &test, &options, |setting, _| {
+            let ctx = &setting.ctx;
+            let (far, near) = (vec![0.55], vec![1.29]);
+            let y_far = ctx.run_one(&model, "far", &far)?;
+            let y_near = ctx.run_one(&model, "near", &near)?;
+            let from_far = polish_from(ctx, &model, "pf", far.clone(), y_far, 1)?;
+            let from_near = polish_from(ctx, &model, "pn", near.clone(), y_near, 1)?;
+            assert!(
+                from_near.rss < from_far.rss,
+                "the test needs the near start to polish better: {} vs {}",
+                from_near.rss,
+                from_far.rss
+            );
+            let fit = calibrate(ctx, &model, "s", &[far, near], 0, 1)?;
+            assert_eq!(fit.point, from_near.point);
+            assert_eq!(fit.rss.to_bits(), from_near.rss.to_bits());
+            Ok(())
+        })
+        .unwrap();
+    }
+}

@@ -2,7 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{CalibrateError, Result};
+use impactcal_core::{CoreError, ParamGuard};
+
+use crate::error::Result;
 
 /// Options of the closed loop. Defaults in parentheses.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -58,7 +60,7 @@ pub struct LoopOptions {
     pub m1_members: usize,
     /// Memory the loop's process may use, in bytes; `None`: what the machine has available
     /// (`crate::memory`). A stage whose estimate does not fit stops the loop with a
-    /// [`CalibrateError::Memory`] before it allocates. Not read from a loop file nor part of
+    /// [`CalibrateError::Memory`](crate::CalibrateError::Memory) before it allocates. Not read from a loop file nor part of
     /// the loop's fingerprint (`impactcal close-loop --max-memory` sets it): a loop resumed
     /// with another limit reuses its journal.
     #[serde(skip)]
@@ -105,100 +107,276 @@ impl LoopOptions {
         2 * (d + 1) + 2
     }
 
-    /// Checks every option; `declared` is the dimension of the model's space.
+    /// Checks every option ([`ParamGuard::check_ref`]), then the run budgets against
+    /// `declared`, the dimension of the model's space. (With [`ParamGuard`] in scope,
+    /// `options.check(d)` resolves to the trait's by-value `check`: call it as
+    /// `LoopOptions::check(&options, d)`.)
     ///
     /// # Errors
-    /// [`CalibrateError::Study`] naming the first bad option, and for a budget too small
-    /// to (re)calibrate, with the number of runs needed.
+    /// [`CoreError::InvalidOption`] (as [`CalibrateError::Core`](crate::CalibrateError::Core)) naming the first bad
+    /// option as `loop.<key>`, and for a budget too small to (re)calibrate, with the
+    /// number of runs needed.
     pub fn check(&self, declared: usize) -> Result<()> {
-        let bad =
-            |what: &str, why: String| Err(CalibrateError::study(format!("option `{what}`"), why));
+        ParamGuard::check_ref(self)?;
+        let need = Self::cors_runs_needed(declared);
+        if self.reconcile < need {
+            return Err(CoreError::invalid_option(
+                "loop.reconcile_runs",
+                self.reconcile,
+                format!(
+                    "cannot calibrate {declared} parameters: CORS needs at least {need} runs \
+                     (an initial design of {} and two steps)",
+                    2 * (declared + 1)
+                ),
+            )
+            .into());
+        }
+        if self.max_added > 0 {
+            let need = Self::cors_runs_needed(declared + self.max_added);
+            if self.recalibrate < need {
+                return Err(CoreError::invalid_option(
+                    "loop.recalibrate_runs",
+                    self.recalibrate,
+                    format!(
+                        "cannot recalibrate up to {} parameters ({declared} declared + \
+                         max_added {}): at least {need} are needed; raise it or lower \
+                         max_added",
+                        declared + self.max_added,
+                        self.max_added
+                    ),
+                )
+                .into());
+            }
+        }
+        Ok(())
+    }
+}
+
+impl ParamGuard for LoopOptions {
+    type Checked = LoopOptions;
+
+    /// Checks every option on its own (the run budgets against the model's dimension are
+    /// checked by [`LoopOptions::check`] when the loop starts).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] naming the first bad option as `loop.<key>` (the key
+    /// of a loop file): `alpha` outside `(0, 0.5)`, `min_explained` outside `[0, 1]`,
+    /// fewer than 2 `jitter_runs`, `jitter_eps` outside `(0, 0.1)`, fewer than 19
+    /// `m1_members`, a `cors_batch` of 0, `candidate_step` outside `(0, 0.5]`,
+    /// `units_tolerance` outside `[0, 0.5)`, a `sigma` not finite and positive, a
+    /// `max_time_shift` not finite and non-negative, an empty candidate name.
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        let bad = |key: &str, value: &dyn std::fmt::Display, why: &str| {
+            Err(CoreError::invalid_option(format!("loop.{key}"), value, why))
+        };
         if !(self.alpha > 0.0 && self.alpha < 0.5) {
-            return bad("alpha", format!("{} must lie in (0, 0.5)", self.alpha));
+            return bad("alpha", &self.alpha, "must lie in (0, 0.5)");
         }
         if !(0.0..=1.0).contains(&self.min_explained) {
-            return bad(
-                "min_explained",
-                format!("{} must lie in [0, 1]", self.min_explained),
-            );
+            return bad("min_explained", &self.min_explained, "must lie in [0, 1]");
         }
         if self.ensemble < 2 {
             return bad(
                 "jitter_runs",
-                format!("{} runs; the model's noise needs at least 2", self.ensemble),
+                &self.ensemble,
+                "the model's noise needs at least 2 runs",
             );
         }
         if !(self.jitter > 0.0 && self.jitter < 0.1) {
-            return bad(
-                "jitter_eps",
-                format!("{} must lie in (0, 0.1)", self.jitter),
-            );
+            return bad("jitter_eps", &self.jitter, "must lie in (0, 0.1)");
         }
         if self.m1_members < 19 {
             return bad(
                 "m1_members",
-                format!(
-                    "{}: an M1 envelope needs at least 19 members (a right model then leaves \
-                     it at 10 % of the samples)",
-                    self.m1_members
-                ),
+                &self.m1_members,
+                "an M1 envelope needs at least 19 members (a right model then leaves it at \
+                 10 % of the samples)",
             );
         }
         if self.batch == 0 {
-            return bad("cors_batch", "must be at least 1".into());
+            return bad("cors_batch", &0, "must be at least 1");
         }
         if !(self.candidate_step > 0.0 && self.candidate_step <= 0.5) {
             return bad(
                 "candidate_step",
-                format!("{} must lie in (0, 0.5]", self.candidate_step),
+                &self.candidate_step,
+                "must lie in (0, 0.5]",
             );
         }
         if !(self.units_tolerance >= 0.0 && self.units_tolerance < 0.5) {
             return bad(
                 "units_tolerance",
-                format!("{} must lie in [0, 0.5)", self.units_tolerance),
+                &self.units_tolerance,
+                "must lie in [0, 0.5)",
             );
         }
         if let Some(s) = self.sigma
             && !(s.is_finite() && s > 0.0)
         {
-            return bad("sigma", format!("{s} must be finite and positive"));
+            return bad("sigma", &s, "must be finite and positive");
         }
         if let Some(s) = self.max_time_shift
             && !(s.is_finite() && s >= 0.0)
         {
-            return bad(
-                "max_time_shift",
-                format!("{s} must be finite and non-negative"),
-            );
+            return bad("max_time_shift", &s, "must be finite and non-negative");
         }
-        let need = Self::cors_runs_needed(declared);
-        if self.reconcile < need {
-            return bad(
-                "reconcile_runs",
-                format!(
-                    "{} runs cannot calibrate {declared} parameters: CORS needs at least {need} \
-                     (an initial design of {} and two steps)",
-                    self.reconcile,
-                    2 * (declared + 1)
-                ),
-            );
-        }
-        if self.max_added > 0 {
-            let need = Self::cors_runs_needed(declared + self.max_added);
-            if self.recalibrate < need {
-                return bad(
-                    "recalibrate_runs",
-                    format!(
-                        "{} runs cannot recalibrate up to {} parameters ({declared} declared + \
-                         max_added {}): at least {need} are needed; raise it or lower max_added",
-                        self.recalibrate,
-                        declared + self.max_added,
-                        self.max_added
-                    ),
-                );
-            }
+        if let Some(names) = &self.candidates
+            && names.iter().any(|n| n.trim().is_empty())
+        {
+            return bad("candidates", &"\"\"", "a candidate name is empty");
         }
         Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<LoopOptions> {
+        ParamGuard::check_ref(&self)?;
+        Ok(self)
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::error::CalibrateError;
+
+    /// The defaults pass; each bad value is refused with `CoreError::InvalidOption` naming
+    /// its key as a loop file spells it.
+    #[test]
+    fn a_bad_value_is_refused_naming_its_key() {
+        let base = LoopOptions::default();
+        assert!(ParamGuard::check_ref(&base).is_ok());
+        assert!(LoopOptions::check(&base, 2).is_ok());
+        let cases: Vec<(LoopOptions, &str)> = vec![
+            (
+                LoopOptions {
+                    alpha: 0.7,
+                    ..base.clone()
+                },
+                "loop.alpha",
+            ),
+            (
+                LoopOptions {
+                    min_explained: 1.5,
+                    ..base.clone()
+                },
+                "loop.min_explained",
+            ),
+            (
+                LoopOptions {
+                    ensemble: 1,
+                    ..base.clone()
+                },
+                "loop.jitter_runs",
+            ),
+            (
+                LoopOptions {
+                    jitter: 0.0,
+                    ..base.clone()
+                },
+                "loop.jitter_eps",
+            ),
+            (
+                LoopOptions {
+                    m1_members: 5,
+                    ..base.clone()
+                },
+                "loop.m1_members",
+            ),
+            (
+                LoopOptions {
+                    batch: 0,
+                    ..base.clone()
+                },
+                "loop.cors_batch",
+            ),
+            (
+                LoopOptions {
+                    candidate_step: 0.0,
+                    ..base.clone()
+                },
+                "loop.candidate_step",
+            ),
+            (
+                LoopOptions {
+                    units_tolerance: f64::NAN,
+                    ..base.clone()
+                },
+                "loop.units_tolerance",
+            ),
+            (
+                LoopOptions {
+                    sigma: Some(-1.0),
+                    ..base.clone()
+                },
+                "loop.sigma",
+            ),
+            (
+                LoopOptions {
+                    max_time_shift: Some(f64::INFINITY),
+                    ..base.clone()
+                },
+                "loop.max_time_shift",
+            ),
+            (
+                LoopOptions {
+                    candidates: Some(vec![" ".into()]),
+                    ..base.clone()
+                },
+                "loop.candidates",
+            ),
+        ];
+        for (o, key) in cases {
+            match ParamGuard::check_ref(&o) {
+                Err(CoreError::InvalidOption { name, .. }) => assert_eq!(name, key),
+                other => panic!("{key}: {other:?}"),
+            }
+            // The loop's own check refuses it the same way.
+            let e = LoopOptions::check(&o, 2).unwrap_err();
+            assert!(
+                matches!(e, CalibrateError::Core(CoreError::InvalidOption { .. })),
+                "{e}"
+            );
+            assert!(e.to_string().contains(&format!("`{key}`")), "{e}");
+        }
+        // Budgets against the model's dimension: 2 (2 + 1) + 2 = 8 runs for 2 parameters,
+        // 2 (2 + 3 + 1) + 2 = 14 to recalibrate with up to 3 added.
+        let e = LoopOptions::check(
+            &LoopOptions {
+                reconcile: 7,
+                ..base.clone()
+            },
+            2,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("`loop.reconcile_runs` = 7") && e.contains("at least 8"),
+            "{e}"
+        );
+        let e = LoopOptions::check(
+            &LoopOptions {
+                recalibrate: 13,
+                ..base.clone()
+            },
+            2,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("`loop.recalibrate_runs` = 13") && e.contains("at least 14"),
+            "{e}"
+        );
+        assert!(
+            LoopOptions::check(
+                &LoopOptions {
+                    recalibrate: 0,
+                    max_added: 0,
+                    ..base
+                },
+                2
+            )
+            .is_ok()
+        );
     }
 }

@@ -41,7 +41,7 @@
 
 use impactcal_core::{Enrichable, Parameter};
 
-use super::attribution::attribute;
+use super::attribution::{Attribution, Score, attribute};
 use super::detection::{Detection, chi2_quantile, detect};
 use super::fit::{Ctx, Fit, calibrate};
 use super::options::LoopOptions;
@@ -85,6 +85,99 @@ fn score(fit: &Fit, added: &[Parameter], n_nuisance: usize, kept: bool) -> Model
     }
 }
 
+/// One round's record: the quantities `added` so far, the calibrated `point` under the
+/// space's `names`, its detection and attribution, the runs its fit used.
+fn round(
+    added: &[Parameter],
+    names: &[&str],
+    point: &[f64],
+    detection: Detection,
+    attribution: Option<Attribution>,
+    runs: usize,
+) -> Round {
+    Round {
+        added: added.iter().map(|p| p.name.clone()).collect(),
+        calibrated: names
+            .iter()
+            .zip(point)
+            .map(|(n, v)| (n.to_string(), *v))
+            .collect(),
+        detection,
+        attribution,
+        runs,
+    }
+}
+
+/// Why the recalibration `fit_n` with `p` added (the candidate `best` of the attribution,
+/// `trial` when it only fell short of its share) is refused, if it is: a quantity the data
+/// do not determine, a realised share below `min_explained` for a trial, a change no larger
+/// than the model's own noise makes or than the noise allows (`z^2` the `1 - alpha` quantile
+/// of `chi2_1`), or BIC not falling by more than 2 against `base_bic` (`bics` is
+/// `(base_bic, bic)`). See the module docs.
+///
+/// # Errors
+/// Numerical errors of the model-noise pass.
+#[allow(clippy::too_many_arguments)]
+fn refusal(
+    ctx: &Ctx<'_>,
+    p: &Parameter,
+    best: &Score,
+    trial: bool,
+    fit_n: &Fit,
+    realised: f64,
+    (base_bic, bic): (f64, f64),
+    options: &LoopOptions,
+) -> Result<Option<String>> {
+    let z2 = chi2_quantile(1.0, options.alpha)?;
+    let last = fit_n.point.len() - 1;
+    let value = fit_n.point[last];
+    let draws = ctx.model_noise.stats(fit_n, &ctx.frame, None, None)?;
+    let noise_var = draws.parameter_variances(fit_n.point.len())[last];
+    let sd = (fit_n.se[last].powi(2) + noise_var).sqrt();
+    let change = (value - p.nominal).abs() * best.response_per_unit;
+    let by_itself = draws.largest();
+    let why = if !sd.is_finite() {
+        Some(format!(
+            "`{}` recalibrated to {value:.6e} from its held {:.6e}, where the data do not \
+             determine it: its direction lies in the span of the other fitted quantities \
+             and nuisance terms (or it has no effect) at that point",
+            p.name, p.nominal
+        ))
+    } else if trial && (realised.is_nan() || realised < options.min_explained) {
+        Some(format!(
+            "`{}` scored first but explains too little: {:.3} of the residual linearised, \
+             {:.3} once recalibrated with it, against the recalibration without it \
+             (min_explained {})",
+            p.name, best.explained_fraction, realised, options.min_explained
+        ))
+    } else if change <= by_itself {
+        Some(format!(
+            "`{}` recalibrated to {value:.6e} from its held {:.6e}: that change moves the \
+             whitened response by {change:.3e}, no more than the model moves it by itself \
+             under a jitter of its parameters ({by_itself:.3e})",
+            p.name, p.nominal
+        ))
+    } else if (value - p.nominal).powi(2) <= z2 * sd * sd {
+        Some(format!(
+            "`{}` recalibrated to {value:.6e} from its held {:.6e}: a change within what \
+             the measurement noise and the model's own noise make (standard deviation \
+             {sd:.3e}, of which the model's noise {:.3e})",
+            p.name,
+            p.nominal,
+            noise_var.sqrt()
+        ))
+    } else if bic > base_bic - 2.0 {
+        Some(format!(
+            "adding `{}` did not lower BIC by more than 2 against the recalibration \
+             without it ({base_bic:.1} -> {:.1})",
+            p.name, bic
+        ))
+    } else {
+        None
+    };
+    Ok(why)
+}
+
 /// Runs forward selection from the calibrated declared model `fit0`.
 ///
 /// # Errors
@@ -110,7 +203,6 @@ pub(crate) fn forward<M: Enrichable>(
             .largest_chi2();
         Ok(d.with_model_noise(floor))
     };
-    let z2 = chi2_quantile(1.0, options.alpha)?;
     let mut fit = fit0;
     let mut det = detect_fit(&fit)?;
     let mut runs = fit.runs;
@@ -138,17 +230,14 @@ pub(crate) fn forward<M: Enrichable>(
             None
         };
         let names = cur.space().names();
-        rounds.push(Round {
-            added: added.iter().map(|p| p.name.clone()).collect(),
-            calibrated: names
-                .iter()
-                .zip(&fit.point)
-                .map(|(n, v)| (n.to_string(), *v))
-                .collect(),
-            detection: det.clone(),
-            attribution: attribution.clone(),
+        rounds.push(round(
+            &added,
+            &names,
+            &fit.point,
+            det.clone(),
+            attribution.clone(),
             runs,
-        });
+        ));
         if !det.model_form_error {
             stopped = "no model-form error remains (chi-square at the noise floor or no \
                        coherent residual)"
@@ -225,52 +314,16 @@ pub(crate) fn forward<M: Enrichable>(
             (fit.rss, prev_bic)
         };
         let realised = 1.0 - fit_n.rss / base_rss;
-        let last = fit_n.point.len() - 1;
-        let value = fit_n.point[last];
-        let draws = ctx.model_noise.stats(&fit_n, &ctx.frame, None, None)?;
-        let noise_var = draws.parameter_variances(fit_n.point.len())[last];
-        let sd = (fit_n.se[last].powi(2) + noise_var).sqrt();
-        let change = (value - p.nominal).abs() * best.response_per_unit;
-        let by_itself = draws.largest();
-        let refusal = if !sd.is_finite() {
-            Some(format!(
-                "`{}` recalibrated to {value:.6e} from its held {:.6e}, where the data do not \
-                 determine it: its direction lies in the span of the other fitted quantities \
-                 and nuisance terms (or it has no effect) at that point",
-                p.name, p.nominal
-            ))
-        } else if trial && (realised.is_nan() || realised < options.min_explained) {
-            Some(format!(
-                "`{}` scored first but explains too little: {:.3} of the residual linearised, \
-                 {:.3} once recalibrated with it, against the recalibration without it \
-                 (min_explained {})",
-                p.name, best.explained_fraction, realised, options.min_explained
-            ))
-        } else if change <= by_itself {
-            Some(format!(
-                "`{}` recalibrated to {value:.6e} from its held {:.6e}: that change moves the \
-                 whitened response by {change:.3e}, no more than the model moves it by itself \
-                 under a jitter of its parameters ({by_itself:.3e})",
-                p.name, p.nominal
-            ))
-        } else if (value - p.nominal).powi(2) <= z2 * sd * sd {
-            Some(format!(
-                "`{}` recalibrated to {value:.6e} from its held {:.6e}: a change within what \
-                 the measurement noise and the model's own noise make (standard deviation \
-                 {sd:.3e}, of which the model's noise {:.3e})",
-                p.name,
-                p.nominal,
-                noise_var.sqrt()
-            ))
-        } else if s.bic > base_bic - 2.0 {
-            Some(format!(
-                "adding `{}` did not lower BIC by more than 2 against the recalibration \
-                 without it ({base_bic:.1} -> {:.1})",
-                p.name, s.bic
-            ))
-        } else {
-            None
-        };
+        let refusal = refusal(
+            ctx,
+            &p,
+            best,
+            trial,
+            &fit_n,
+            realised,
+            (base_bic, s.bic),
+            options,
+        )?;
         if let Some(why) = refusal {
             models.push(ModelScore { kept: false, ..s });
             stopped = why;
@@ -278,17 +331,15 @@ pub(crate) fn forward<M: Enrichable>(
                 // The control is the better fit of the model as it stands: it is the result.
                 // Recorded as one more round, without an attribution.
                 models.push(control_score);
-                rounds.push(Round {
-                    added: added.iter().map(|p| p.name.clone()).collect(),
-                    calibrated: names
-                        .iter()
-                        .zip(&control.point)
-                        .map(|(n, v)| (n.to_string(), *v))
-                        .collect(),
-                    detection: detect_fit(&control)?,
-                    attribution: None,
-                    runs: control.runs,
-                });
+                let detection = detect_fit(&control)?;
+                rounds.push(round(
+                    &added,
+                    &names,
+                    &control.point,
+                    detection,
+                    None,
+                    control.runs,
+                ));
                 fit = control;
             }
             break;

@@ -4,7 +4,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use impactcal_core::signal::{crop, interpolate_onto};
-use impactcal_core::{Cfc, ChannelMap, CoreError, Histories};
+use impactcal_core::{Cfc, ChannelMap, CoreError, Histories, ParamGuard};
 
 use super::{Grade, Iso18571, Iso18571Rating, PointwiseErrors, Russell, SpragueGeers};
 use crate::error::{CalibrateError, Result};
@@ -123,6 +123,34 @@ pub struct CompareOptions {
     pub window: Option<(f64, f64)>,
     /// The ISO/TS 18571 constants.
     pub iso: Iso18571,
+}
+
+impl ParamGuard for CompareOptions {
+    type Checked = CompareOptions;
+
+    /// Checks the options on their own (the window against the data is checked by
+    /// [`compare`]; the ISO/TS 18571 constants by their own setters).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] for a `window` whose ends are not finite or not
+    /// increasing.
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        if let Some((t0, t1)) = self.window
+            && !(t0.is_finite() && t1.is_finite() && t0 < t1)
+        {
+            return Err(CoreError::invalid_option(
+                "window",
+                format!("[{t0}, {t1}]"),
+                "must be finite and increasing (s)",
+            ));
+        }
+        Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<CompareOptions> {
+        self.check_ref()?;
+        Ok(self)
+    }
 }
 
 /// The metrics of one channel pair.
@@ -268,6 +296,7 @@ pub fn compare(
     pairs: &[ChannelPair],
     options: &CompareOptions,
 ) -> Result<Comparison> {
+    options.check_ref()?;
     if pairs.is_empty() {
         return Err(CoreError::Invalid("no channel pairs to compare".into()).into());
     }
@@ -353,4 +382,50 @@ fn side(which: &str, e: CoreError) -> CalibrateError {
 /// Names the channel in a metric's error.
 fn name_channel(e: CalibrateError, label: &str) -> CalibrateError {
     e.with_subject(|what| format!("channel `{label}` ({what})"))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// A window that is not finite or not increasing is refused by
+    /// `ParamGuard::check_ref` naming `window`, and `compare` refuses it the same way.
+    #[test]
+    fn a_bad_window_is_refused_naming_its_key() {
+        let h = Histories::from_channels(
+            vec!["x".into()],
+            vec![(0..50).map(|k| (k as f64 * 0.2).sin()).collect()],
+            1e-3,
+            0.0,
+            "",
+        )
+        .unwrap();
+        let pairs = [ChannelPair {
+            test_label: "x".into(),
+            model_label: "x".into(),
+            gain: 1.0,
+        }];
+        for window in [(0.02, 0.01), (f64::NAN, 0.01), (0.0, f64::INFINITY)] {
+            let o = CompareOptions {
+                window: Some(window),
+                ..CompareOptions::default()
+            };
+            match o.check_ref() {
+                Err(CoreError::InvalidOption { name, .. }) => assert_eq!(name, "window"),
+                other => panic!("{window:?}: {other:?}"),
+            }
+            match compare(&h, &h, &pairs, &o) {
+                Err(CalibrateError::Core(CoreError::InvalidOption { name, .. })) => {
+                    assert_eq!(name, "window");
+                }
+                other => panic!("{window:?}: {other:?}"),
+            }
+        }
+        let fine = CompareOptions {
+            window: Some((0.0, 0.02)),
+            ..CompareOptions::default()
+        };
+        assert!(compare(&h, &h, &pairs, &fine).is_ok());
+    }
 }

@@ -45,7 +45,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{CoreError, Result};
+use crate::error::{CoreError, ParamGuard, Result};
 use crate::histories::Histories;
 use crate::table::{Table, TableOptions};
 
@@ -162,23 +162,54 @@ pub struct RecordQuality {
     pub channels: Vec<ChannelQuality>,
 }
 
+impl ParamGuard for QualityOptions {
+    type Checked = QualityOptions;
+
+    /// Checks the options on their own (a pre-trigger time is checked against the record
+    /// by [`check`]).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] for a `pre-trigger` time that is not finite, or an
+    /// empty label among the `accelerations`.
+    fn check_ref(&self) -> Result<()> {
+        if let Some(t) = self.pre_trigger
+            && !t.is_finite()
+        {
+            return Err(CoreError::invalid_option(
+                "pre-trigger",
+                t,
+                "must be a finite time (s)",
+            ));
+        }
+        if let Accelerations::Labels(labels) = &self.accelerations
+            && labels.iter().any(|l| l.trim().is_empty())
+        {
+            return Err(CoreError::invalid_option(
+                "accelerations",
+                "\"\"",
+                "a channel label is empty",
+            ));
+        }
+        Ok(())
+    }
+
+    fn check(self) -> Result<QualityOptions> {
+        self.check_ref()?;
+        Ok(self)
+    }
+}
+
 /// Checks every channel of `h` (see the module docs).
 ///
 /// # Errors
-/// [`CoreError::InvalidOption`] for a pre-trigger time that is not finite or leaves fewer
-/// than [`faults::MIN_QUIET`] samples before it.
+/// [`ParamGuard::check_ref`]'s errors for the options; [`CoreError::InvalidOption`] for a
+/// pre-trigger time that leaves fewer than [`faults::MIN_QUIET`] samples before it.
 pub fn check(h: &Histories, options: &QualityOptions) -> Result<RecordQuality> {
+    options.check_ref()?;
     let n = h.samples();
     let quiet_given = match options.pre_trigger {
         None => None,
         Some(t) => {
-            if !t.is_finite() {
-                return Err(CoreError::invalid_option(
-                    "pre-trigger",
-                    t,
-                    "must be a finite time (s)",
-                ));
-            }
             let k = ((t - h.start()) / h.dt() - 1e-9).ceil().max(0.0) as usize;
             if k < faults::MIN_QUIET || k > n {
                 return Err(CoreError::invalid_option(

@@ -277,3 +277,45 @@ fn the_drop_tower_excerpt_shows_its_clipping_and_noise() {
     let top = q.channel("accel_top").unwrap();
     assert!(top.clipped.is_empty());
 }
+
+/// Each bad option is refused by `ParamGuard::check_ref` with `CoreError::InvalidOption`
+/// naming it, and `check` refuses it the same way before reading the record.
+#[test]
+fn a_bad_option_is_refused_naming_its_key() {
+    use crate::error::ParamGuard;
+    let cases = [
+        (
+            QualityOptions {
+                pre_trigger: Some(f64::NAN),
+                ..QualityOptions::default()
+            },
+            "pre-trigger",
+        ),
+        (
+            QualityOptions {
+                accelerations: Accelerations::Labels(vec!["a1".into(), " ".into()]),
+                ..QualityOptions::default()
+            },
+            "accelerations",
+        ),
+    ];
+    let h = Histories::from_channels(
+        vec!["a1".into()],
+        vec![(0..200).map(|k| (k as f64 * 0.1).sin()).collect()],
+        1e-4,
+        0.0,
+        "g",
+    )
+    .unwrap();
+    for (o, key) in cases {
+        match o.check_ref() {
+            Err(CoreError::InvalidOption { name, .. }) => assert_eq!(name, key),
+            other => panic!("{key}: {other:?}"),
+        }
+        match check(&h, &o) {
+            Err(CoreError::InvalidOption { name, .. }) => assert_eq!(name, key),
+            other => panic!("{key}: {other:?}"),
+        }
+    }
+    assert!(QualityOptions::default().check_ref().is_ok());
+}
