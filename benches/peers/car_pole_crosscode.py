@@ -110,6 +110,12 @@ CONTROLS = {
     "warping-projection": "*CONTROL_SHELL BWC 1, PROJ 1 added: the full projection, which "
                           "in this element only removes the rigid rotation from the "
                           "membrane hourglass rates (and from their forces)",
+    "hourglass-membrane-only": "every *HOURGLASS QB and QW (0: QM) set to 0.002, QM 0.02 "
+                               "kept: the out-of-plane and rotation modes at a tenth",
+    "hourglass-out-of-plane-only": "every *HOURGLASS QM set to 0.002, QB and QW to 0.02: "
+                                   "the membrane modes at a tenth",
+    "hourglass-sixteenth": "every *HOURGLASS QM 0.02 set to 0.00125: the forces a 1/4 in "
+                           "the hourglass vector would give at QM 0.02",
 }
 
 
@@ -159,6 +165,15 @@ def control_include(name, text):
         return set_hourglass_field(name, lines, 20, "0.02", f"{0.01:10.2f}")
     if name == "hourglass-viscous":
         return set_hourglass_field(name, lines, 10, "4", f"{1:10d}")
+    if name == "hourglass-membrane-only":
+        lines = set_hourglass_field(name, lines, 60, "0.0", f"{0.002:10.3f}").split("\n")
+        return set_hourglass_field(name, lines, 70, "0.0", f"{0.002:10.3f}")
+    if name == "hourglass-out-of-plane-only":
+        lines = set_hourglass_field(name, lines, 60, "0.0", f"{0.02:10.2f}").split("\n")
+        lines = set_hourglass_field(name, lines, 70, "0.0", f"{0.02:10.2f}").split("\n")
+        return set_hourglass_field(name, lines, 20, "0.02", f"{0.002:10.3f}")
+    if name == "hourglass-sixteenth":
+        return set_hourglass_field(name, lines, 20, "0.02", f"{0.00125:10.5f}")
     if name == "warping-projection":
         if any(line.startswith("*CONTROL_SHELL") for line in lines):
             raise SystemExit("warping-projection: the model already has *CONTROL_SHELL")

@@ -614,3 +614,111 @@ fn a_reentrant_quad_stops_the_run_only_with_the_distortion_check() {
     let msg = read(&deleting).unwrap_err().to_string();
     assert!(msg.contains("NFAIL1"), "{msg}");
 }
+
+/// Each of the five hourglass modes of the stiffness form imposed alone on one flat quad,
+/// against the closed form of LS-DYNA's Belytschko-Tsay hourglass (Theory Manual, BT
+/// section, eqs. 7.15-7.20; Belytschko, Lin and Tsay 1984). The nodal field `h_I d` with
+/// `h = (1, -1, 1, -1)` has zero centre strain on any quad (`B_a . h = 0`) and the hourglass
+/// rate `q = gamma . h d' = 4 d'` (`gamma . h = h . h = 4`), so after a displacement
+/// amplitude `d` the mode holds `Q = C 4 d`, the nodes carry `gamma_I Q` and the stored energy
+/// is `C (4 d)^2 / 2 = 8 C d^2`, with, in terms of the diagonals
+/// (`B . B = (|d31|^2 + |d42|^2) / (2 A^2)`):
+/// membrane `C_m = r_m E t (|d31|^2 + |d42|^2) / (16 A)` (a square: `r E t / 4`, a nodal
+/// hourglass stiffness `r E t`); out-of-plane `C_w = r_w k G t^3 (|d31|^2 + |d42|^2) / (24
+/// A^2)`; rotation `C_b = r_b E t^3 (|d31|^2 + |d42|^2) / (384 A)`. Different coefficients
+/// per mode check that QM, QW and QB reach the modes they name. On a parallelogram
+/// `gamma = h` and the nodal forces are checked too; on a general quad the energy.
+#[test]
+fn each_stiffness_hourglass_mode_of_one_quad_meets_its_closed_form() {
+    let (t, a) = (0.002, 0.01);
+    let (rm, rw, rb) = (0.03, 0.05, 0.07);
+    let hg = Hourglass {
+        membrane: rm,
+        transverse: rw,
+        rotation: rb,
+        ..Hourglass::default()
+    };
+    let mut section = Section::new(1, t);
+    section.nip = 5;
+    let p = PartProps::new(&section, &aluminium(1), &hg).unwrap();
+    let kappa = section.shear_factor;
+    let g = E / (2.0 * (1.0 + NU));
+    let shapes: [([[f64; 2]; 4], bool); 4] = [
+        ([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]], true),
+        ([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]], true),
+        ([[0.0, 0.0], [1.5, 0.0], [2.1, 0.8], [0.6, 0.8]], true),
+        ([[0.0, 0.0], [1.1, 0.1], [1.0, 0.9], [-0.1, 1.2]], false),
+    ];
+    const H: [f64; 4] = [1.0, -1.0, 1.0, -1.0];
+    let (steps, d) = (1000, 1e-7 * a);
+    let dt = 1e-7;
+    let rate = d / (steps as f64 * dt);
+    for (s, (shape, parallelogram)) in shapes.iter().enumerate() {
+        let x0 = shape.map(|q| [q[0] * a, q[1] * a, 0.0]);
+        let sub = |i: usize, j: usize| [0, 1, 2].map(|k| x0[i][k] - x0[j][k]);
+        let sq = |v: [f64; 3]| v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        let (d31, d42) = (sub(2, 0), sub(3, 1));
+        let area = 0.5 * cross(d31, d42)[2];
+        let diag = sq(d31) + sq(d42);
+        let c = [
+            rm * E * t * diag / (16.0 * area),
+            rm * E * t * diag / (16.0 * area),
+            rw * kappa * g * t.powi(3) * diag / (24.0 * area * area),
+            rb * E * t.powi(3) * diag / (384.0 * area),
+            rb * E * t.powi(3) * diag / (384.0 * area),
+        ];
+        // Mode k: component k of the nodal (velocity, angular velocity) pattern h_I.
+        for (k, ck) in c.iter().enumerate() {
+            let opts = KernelOptions {
+                projection: false,
+                isdo_diagonal: false,
+                invariant: false,
+                distortion_check: true,
+            };
+            let mut st = vec![0.0; STATE_HEAD + 5 * STATE_PER_POINT];
+            let (mut hourglass, mut internal) = (0.0, 0.0);
+            let mut last = None;
+            for n in 1..=steps {
+                let u = rate * dt * n as f64;
+                let mut x = x0;
+                let mut v = [[0.0; 3]; 4];
+                let mut w = [[0.0; 3]; 4];
+                for i in 0..4 {
+                    if k < 3 {
+                        x[i][k] += H[i] * u;
+                        v[i][k] = H[i] * rate;
+                    } else {
+                        w[i][k - 3] = H[i] * rate;
+                    }
+                }
+                let out = element::quad(&x, &v, &w, &p, &mut st, dt, opts).unwrap();
+                hourglass += out.hourglass;
+                internal += out.internal;
+                last = Some(out);
+            }
+            let out = last.unwrap();
+            let energy = 8.0 * ck * d * d;
+            assert!(
+                (hourglass - energy).abs() < 1e-5 * energy,
+                "shape {s} mode {k}: hourglass energy {hourglass:e} against {energy:e}"
+            );
+            assert!(
+                internal.abs() < 1e-9 * energy,
+                "shape {s} mode {k}: {internal:e}"
+            );
+            if *parallelogram {
+                let q = ck * 4.0 * d;
+                for i in 0..4 {
+                    for j in 0..6 {
+                        let want = if j == k { H[i] * q } else { 0.0 };
+                        let got = out.f[i][j];
+                        assert!(
+                            (got - want).abs() < 1e-5 * q,
+                            "shape {s} mode {k}: node {i} component {j}: {got:e} against {want:e}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
