@@ -46,7 +46,8 @@ use super::detection::chi2_quantile;
 use super::fit::{Ctx, Fit};
 use super::jacobian::Jacobian;
 use super::linalg::dot;
-use super::nuisance;
+use super::model_noise::DrawStats;
+use super::nuisance::{self, Frame};
 use crate::error::Result;
 
 /// Confounding ratio above which a candidate is not identifiable.
@@ -380,57 +381,137 @@ pub(crate) fn attribute<M: Enrichable>(
         plan.check(super::plan::ATTRIBUTION, &format!("{prefix}-candidates"))?;
     }
     let frame = &ctx.frame;
-    let jac = &fit.jac;
     let t = frame.samples;
     let dirs = directions(ctx, model, fit, &cands, prefix, step, onset)?;
-
-    // Each direction without its fitted part: its size, confounding ratio and `g~`.
-    let mut unfitted = Vec::with_capacity(dirs.len());
-    let mut kappas = Vec::with_capacity(dirs.len());
-    let mut described = Vec::with_capacity(dirs.len());
-    for (name, kind, group, shape, range) in dirs {
-        let (gg, pgg, u) = Unfitted::of(shape, jac);
-        kappas.push(if gg > 0.0 { (pgg / gg).sqrt() } else { 1.0 });
-        unfitted.push(u);
-        described.push((name, kind, group, range));
-    }
-    let uty: Vec<Vec<f64>> = unfitted
-        .iter()
-        .map(|u| match u {
-            Unfitted::Dense(g) => jac.coefficients(g),
-            Unfitted::Channel { .. } => Vec::new(),
-        })
-        .collect();
-    let norms: Vec<f64> = unfitted
-        .iter()
-        .zip(&uty)
-        .map(|(u, c)| Unfitted::inner((u, c), (u, c), t).max(0.0))
-        .collect();
+    let parts = Parts::of(dirs, &fit.jac, t);
 
     // One pass over the model's noise draws: each direction's inner products with them.
     let products = |d: &[f64], utd: &[f64]| -> Vec<f64> {
-        unfitted.iter().map(|u| u.dot(d, utd, t)).collect()
+        parts.unfitted.iter().map(|u| u.dot(d, utd, t)).collect()
     };
     let draws = ctx.model_noise.stats(fit, frame, None, Some(&products))?;
-    let draws_energy = draws.unfitted_energy();
     let r = &fit.residual;
-    let utr = jac.coefficients(r);
-    let rr = dot(r, r);
-    let crit = chi2_quantile(1.0, alpha / described.len() as f64)?;
-    let mut scores = Vec::new();
+    let scoring = Scoring {
+        frame,
+        jac: &fit.jac,
+        residual: r,
+        utr: fit.jac.coefficients(r),
+        rr: dot(r, r),
+        crit: chi2_quantile(1.0, alpha / parts.described.len() as f64)?,
+        min_explained,
+        draws: &draws,
+        draws_energy: draws.unfitted_energy(),
+    };
+    let mut scores = Vec::with_capacity(parts.described.len());
     let mut tilde: Vec<usize> = Vec::new();
-    for (i, (name, kind, group, range)) in described.into_iter().enumerate() {
-        let kappa = kappas[i];
-        let gtt = norms[i];
+    for (i, described) in parts.described.iter().enumerate() {
+        let s = scoring.score(
+            i,
+            described,
+            parts.kappas[i],
+            parts.norms[i],
+            &parts.unfitted[i],
+        );
+        if s.identifiable {
+            tilde.push(i);
+        }
+        scores.push(s);
+    }
+    let indistinguishable = coherent_pairs(
+        &scores,
+        &tilde,
+        &parts.unfitted,
+        &parts.uty,
+        &parts.norms,
+        t,
+    );
+    Ok(Attribution {
+        ranked: ranked(scores),
+        indistinguishable,
+    })
+}
+
+/// A direction as the report names it: name, kind, group, and for a candidate its held
+/// value, admissible range and finite step.
+type Described = (String, String, String, Option<(f64, f64, f64, f64)>);
+
+/// The directions with their fitted parts taken out, index by index: `g~`
+/// ([`Unfitted`]), the confounding ratio `kappa = ||P_J g|| / ||g||` (1 for a zero
+/// direction), `U_a^T g~` of a dense one (empty for a channel's), `||g~||^2`, and how
+/// each is named.
+struct Parts {
+    unfitted: Vec<Unfitted>,
+    kappas: Vec<f64>,
+    uty: Vec<Vec<f64>>,
+    norms: Vec<f64>,
+    described: Vec<Described>,
+}
+
+impl Parts {
+    /// The parts of `dirs` against the fitted span of `jac` (`t` samples per channel).
+    fn of(dirs: Vec<Direction>, jac: &Jacobian, t: usize) -> Parts {
+        let mut unfitted = Vec::with_capacity(dirs.len());
+        let mut kappas = Vec::with_capacity(dirs.len());
+        let mut described = Vec::with_capacity(dirs.len());
+        for (name, kind, group, shape, range) in dirs {
+            let (gg, pgg, u) = Unfitted::of(shape, jac);
+            kappas.push(if gg > 0.0 { (pgg / gg).sqrt() } else { 1.0 });
+            unfitted.push(u);
+            described.push((name, kind, group, range));
+        }
+        let uty: Vec<Vec<f64>> = unfitted
+            .iter()
+            .map(|u| match u {
+                Unfitted::Dense(g) => jac.coefficients(g),
+                Unfitted::Channel { .. } => Vec::new(),
+            })
+            .collect();
+        let norms: Vec<f64> = unfitted
+            .iter()
+            .zip(&uty)
+            .map(|(u, c)| Unfitted::inner((u, c), (u, c), t).max(0.0))
+            .collect();
+        Parts {
+            unfitted,
+            kappas,
+            uty,
+            norms,
+            described,
+        }
+    }
+}
+
+/// What every direction is scored against: the residual `r` (whitened), its coefficients
+/// `U_a^T r` and `<r, r>`, the Bonferroni-corrected `chi2_1` quantile `crit`, the smallest
+/// explained fraction, and the model's noise draws with their mean energy outside the
+/// fitted span.
+struct Scoring<'s> {
+    frame: &'s Frame,
+    jac: &'s Jacobian,
+    residual: &'s [f64],
+    utr: Vec<f64>,
+    rr: f64,
+    crit: f64,
+    min_explained: f64,
+    draws: &'s DrawStats,
+    draws_energy: f64,
+}
+
+impl Scoring<'_> {
+    /// The score of direction `i`, named by `described`, with confounding ratio `kappa`,
+    /// `gtt = ||g~||^2` and unfitted part `u` (see the module docs).
+    fn score(&self, i: usize, described: &Described, kappa: f64, gtt: f64, u: &Unfitted) -> Score {
+        let (name, kind, group, range) = described;
+        let range = *range;
         let identifiable = kappa <= KAPPA_MAX && gtt > 0.0;
-        let gr = unfitted[i].dot(r, &utr, t);
-        let (explained, lm) = if identifiable && rr > 0.0 {
-            (gr * gr / (gtt * rr), gr * gr / gtt)
+        let gr = u.dot(self.residual, &self.utr, self.frame.samples);
+        let (explained, lm) = if identifiable && self.rr > 0.0 {
+            (gr * gr / (gtt * self.rr), gr * gr / gtt)
         } else {
             (0.0, 0.0)
         };
         let noise_var = if identifiable {
-            draws.amplitude_variance(i, gtt)
+            self.draws.amplitude_variance(i, gtt)
         } else {
             0.0
         };
@@ -453,23 +534,8 @@ pub(crate) fn attribute<M: Enrichable>(
             (Some(a), Some((_, lo, hi, _))) => a.upper >= lo && a.lower <= hi,
             _ => true,
         };
-        let share = |part: f64| if gr != 0.0 { part / gr } else { 0.0 };
-        let mut pattern = BTreeMap::new();
-        match &unfitted[i] {
-            Unfitted::Dense(gt) => {
-                for (s, l) in frame.labels.iter().enumerate() {
-                    let part: f64 = (s * t..(s + 1) * t).map(|j| gt[j] * r[j]).sum();
-                    pattern.insert(l.clone(), share(part));
-                }
-            }
-            Unfitted::Channel { s, l, c } => {
-                let rs = &r[s * t..(s + 1) * t];
-                let part = dot(l, rs) - dot(c, &jac.coefficients_channel(*s, rs));
-                pattern.insert(frame.labels[*s].clone(), share(part));
-            }
-        }
-        let significant = lm > crit;
-        let above_model_noise = identifiable && (gr / gtt).powi(2) / total_var > crit;
+        let significant = lm > self.crit;
+        let above_model_noise = identifiable && (gr / gtt).powi(2) / total_var > self.crit;
         let status = if kind == "signature" {
             "signature"
         } else if !identifiable {
@@ -480,18 +546,15 @@ pub(crate) fn attribute<M: Enrichable>(
             "not significant"
         } else if !above_model_noise {
             "within the model's noise"
-        } else if explained < min_explained {
+        } else if explained < self.min_explained {
             "explains too little"
         } else {
             "eligible"
         };
-        if identifiable {
-            tilde.push(i);
-        }
-        scores.push(Score {
-            name,
-            kind,
-            group,
+        Score {
+            name: name.clone(),
+            kind: kind.clone(),
+            group: group.clone(),
             kappa,
             identifiable,
             explained_fraction: explained,
@@ -501,20 +564,37 @@ pub(crate) fn attribute<M: Enrichable>(
             model_noise_sd: noise_var.sqrt(),
             response_per_unit: match range {
                 Some((_, _, _, h)) if identifiable => {
-                    (gtt - draws_energy / (h * h)).max(0.0).sqrt()
+                    (gtt - self.draws_energy / (h * h)).max(0.0).sqrt()
                 }
                 _ => 0.0,
             },
             admissible,
             status: status.into(),
-            sensor_pattern: pattern,
-        });
+            sensor_pattern: self.sensor_pattern(u, gr),
+        }
     }
-    let indistinguishable = coherent_pairs(&scores, &tilde, &unfitted, &uty, &norms, t);
-    Ok(Attribution {
-        ranked: ranked(scores),
-        indistinguishable,
-    })
+
+    /// The share of `<g~, r>` (`gr`) on each channel of the unfitted part `u` (a drift's:
+    /// on its own channel only); 0 where `gr` is 0.
+    fn sensor_pattern(&self, u: &Unfitted, gr: f64) -> BTreeMap<String, f64> {
+        let (frame, r, t) = (self.frame, self.residual, self.frame.samples);
+        let share = |part: f64| if gr != 0.0 { part / gr } else { 0.0 };
+        let mut pattern = BTreeMap::new();
+        match u {
+            Unfitted::Dense(gt) => {
+                for (s, l) in frame.labels.iter().enumerate() {
+                    let part: f64 = (s * t..(s + 1) * t).map(|j| gt[j] * r[j]).sum();
+                    pattern.insert(l.clone(), share(part));
+                }
+            }
+            Unfitted::Channel { s, l, c } => {
+                let rs = &r[s * t..(s + 1) * t];
+                let part = dot(l, rs) - dot(c, &self.jac.coefficients_channel(*s, rs));
+                pattern.insert(frame.labels[*s].clone(), share(part));
+            }
+        }
+        pattern
+    }
 }
 
 #[cfg(test)]

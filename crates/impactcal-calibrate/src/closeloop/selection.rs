@@ -39,6 +39,8 @@
 //! realises its share, when an addition is within the noise, when BIC does not fall by more than 2, or after `max_added`
 //! additions.
 
+use std::ops::ControlFlow;
+
 use impactcal_core::{Enrichable, Parameter};
 
 use super::attribution::{Attribution, Score, attribute};
@@ -178,11 +180,13 @@ fn refusal(
     Ok(why)
 }
 
-/// Runs forward selection from the calibrated declared model `fit0`.
+/// Runs forward selection from the calibrated declared model `fit0`: round by round,
+/// attribution of the residual ([`Selection::attribution`]), the choice of a candidate
+/// ([`State::choice`]), its recalibration and control ([`Selection::recalibrations`]) and
+/// the decision ([`Selection::conclude`]), until a stopping rule holds (see the module docs).
 ///
 /// # Errors
 /// Run, journal and numerical errors of the fits and attributions.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn forward<M: Enrichable>(
     ctx: &Ctx<'_>,
     model: &M,
@@ -192,103 +196,154 @@ pub(crate) fn forward<M: Enrichable>(
     n_nuisance: usize,
     noise_dof: Option<f64>,
 ) -> Result<Outcome> {
-    let labels = ctx.frame.labels.clone();
-    let t = ctx.frame.samples;
-    let detect_fit = |fit: &Fit| -> Result<Detection> {
-        let p = fit.point.len() + n_nuisance;
-        let d = detect(&labels, &fit.residual, t, p, options.alpha, noise_dof)?;
+    let selection = Selection {
+        ctx,
+        model,
+        options,
+        onset,
+        n_nuisance,
+        noise_dof,
+    };
+    let det = selection.detect(&fit0)?;
+    let cur = model.enrich(&[])?;
+    let models = vec![score(&fit0, &[], n_nuisance, true)];
+    let mut state = State {
+        fit: fit0,
+        det,
+        cur,
+        added: Vec::new(),
+        rounds: Vec::new(),
+        models,
+    };
+    let stopped = loop {
+        let attribution = selection.attribution(&state)?;
+        state.record(attribution.clone());
+        let (best, trial, p) = match state.choice(attribution.as_ref(), options.max_added) {
+            ControlFlow::Continue(choice) => choice,
+            ControlFlow::Break(why) => break why,
+        };
+        let next_round = state.rounds.len();
+        let tried = selection.recalibrations(&state, p, best, next_round)?;
+        if let Some(why) = selection.conclude(&mut state, tried, best, trial)? {
+            break why;
+        }
+    };
+    Ok(state.outcome(stopped))
+}
+
+/// What forward selection runs under: the loop's context, the declared model, the options,
+/// the impact's sample `onset`, the number of nuisance terms and the degrees of freedom of
+/// the measured noise level.
+struct Selection<'s, 'a, M> {
+    ctx: &'s Ctx<'a>,
+    model: &'s M,
+    options: &'s LoopOptions,
+    onset: usize,
+    n_nuisance: usize,
+    noise_dof: Option<f64>,
+}
+
+/// Where forward selection stands: the model `cur` (the declared one with `added`), its
+/// fit and the detection on its residual, and the rounds and model scores so far.
+struct State<M> {
+    fit: Fit,
+    det: Detection,
+    cur: M,
+    added: Vec<Parameter>,
+    rounds: Vec<Round>,
+    models: Vec<ModelScore>,
+}
+
+/// One candidate tried: the parameter `p`, the model `next` with `added` (the quantities
+/// added so far and `p`), its recalibration `fit`, and the `control`, the same
+/// recalibration without `p`.
+struct Tried<M> {
+    p: Parameter,
+    added: Vec<Parameter>,
+    next: M,
+    fit: Fit,
+    control: Fit,
+}
+
+impl<M: Enrichable> Selection<'_, '_, M> {
+    /// Detection on the residual of `fit` (with `k` the fitted quantities and nuisance
+    /// terms), with the chi-square the model's own noise reaches at that `k`.
+    ///
+    /// # Errors
+    /// Numerical errors of the detection and the model-noise pass.
+    fn detect(&self, fit: &Fit) -> Result<Detection> {
+        let ctx = self.ctx;
+        let p = fit.point.len() + self.n_nuisance;
+        let frame = &ctx.frame;
+        let d = detect(
+            &frame.labels,
+            &fit.residual,
+            frame.samples,
+            p,
+            self.options.alpha,
+            self.noise_dof,
+        )?;
         let floor = ctx
             .model_noise
-            .stats(fit, &ctx.frame, Some(p), None)?
+            .stats(fit, frame, Some(p), None)?
             .largest_chi2();
         Ok(d.with_model_noise(floor))
-    };
-    let mut fit = fit0;
-    let mut det = detect_fit(&fit)?;
-    let mut runs = fit.runs;
-    let mut cur = model.enrich(&[])?;
-    let mut added: Vec<Parameter> = Vec::new();
-    let mut rounds = Vec::new();
-    let mut models = vec![score(&fit, &added, n_nuisance, true)];
-    let stopped;
-    loop {
-        let r = rounds.len();
-        let attribution = if r == 0 || det.model_form_error {
-            ctx.runner.observer.step("attribution");
-            Some(attribute(
-                ctx,
-                &cur,
-                &fit,
-                &format!("r{r}"),
-                options.candidate_step,
-                options.alpha,
-                options.min_explained,
-                onset,
-                &|n| options.allows(n),
-            )?)
-        } else {
-            None
-        };
-        let names = cur.space().names();
-        rounds.push(round(
-            &added,
-            &names,
-            &fit.point,
-            det.clone(),
-            attribution.clone(),
-            runs,
-        ));
-        if !det.model_form_error {
-            stopped = "no model-form error remains (chi-square at the noise floor or no \
-                       coherent residual)"
-                .to_string();
-            break;
+    }
+
+    /// The attribution of the current residual (journal stage `r<round>-candidates`), in
+    /// the first round and whenever model-form error remains; `None` otherwise.
+    ///
+    /// # Errors
+    /// Those of [`attribute`].
+    fn attribution(&self, state: &State<M>) -> Result<Option<Attribution>> {
+        let r = state.rounds.len();
+        if r > 0 && !state.det.model_form_error {
+            return Ok(None);
         }
-        if added.len() >= options.max_added {
-            stopped = format!("max_added ({}) reached", options.max_added);
-            break;
-        }
-        let chosen = attribution.as_ref().and_then(|a| {
-            a.best()
-                .map(|s| (s, false))
-                .or_else(|| a.short_of_share().map(|s| (s, true)))
-        });
-        let Some((best, trial)) = chosen else {
-            stopped = "no candidate is identifiable, admissible, significant and explains \
-                       enough of the residual"
-                .to_string();
-            break;
-        };
-        let Some(cand) = cur.candidates().into_iter().find(|c| c.name() == best.name) else {
-            stopped = format!("candidate `{}` vanished from the model's list", best.name);
-            break;
-        };
-        let p = cand.parameter.clone();
-        let mut trial_added = added.clone();
-        trial_added.push(p.clone());
-        let next = model.enrich(&trial_added)?;
-        let estimate = best
-            .amplitude
-            .as_ref()
-            .map_or(p.nominal, |a| a.value.clamp(p.lower, p.upper));
-        let mut at_held = fit.point.clone();
-        at_held.push(p.nominal);
-        let mut at_estimate = fit.point.clone();
-        at_estimate.push(estimate);
-        let mut start = vec![at_held];
-        if (estimate - p.nominal).abs() > 1e-12 * p.width() {
-            start.push(at_estimate);
-        }
+        let o = self.options;
+        self.ctx.runner.observer.step("attribution");
+        attribute(
+            self.ctx,
+            &state.cur,
+            &state.fit,
+            &format!("r{r}"),
+            o.candidate_step,
+            o.alpha,
+            o.min_explained,
+            self.onset,
+            &|n| o.allows(n),
+        )
+        .map(Some)
+    }
+
+    /// The model with `p` (of the attribution's score `best`) added, recalibrated from the
+    /// current optimum (journal stages `r<round>-...`) and the control without it
+    /// (`r<round>-control-...`), each with the options' recalibration budget and polish.
+    ///
+    /// # Errors
+    /// The model's `enrich` errors; run, journal and numerical errors of the fits.
+    fn recalibrations(
+        &self,
+        state: &State<M>,
+        p: Parameter,
+        best: &Score,
+        round: usize,
+    ) -> Result<Tried<M>> {
+        let (ctx, o) = (self.ctx, self.options);
+        let mut added = state.added.clone();
+        added.push(p.clone());
+        let next = self.model.enrich(&added)?;
+        let start = starts(&state.fit.point, &p, best);
         ctx.runner
             .observer
             .step(&format!("recalibration with `{}`", p.name));
-        let fit_n = calibrate(
+        let fit = calibrate(
             ctx,
             &next,
-            &format!("r{}", r + 1),
+            &format!("r{round}"),
             &start,
-            options.recalibrate,
-            options.polish,
+            o.recalibrate,
+            o.polish,
         )?;
         // The control: the same recalibration without the candidate. A recalibration that
         // goes on from the previous optimum may lower the residual by itself (a search
@@ -299,77 +354,192 @@ pub(crate) fn forward<M: Enrichable>(
             .step(&format!("recalibration without `{}` (control)", p.name));
         let control = calibrate(
             ctx,
-            &cur,
-            &format!("r{}-control", r + 1),
-            std::slice::from_ref(&fit.point),
-            options.recalibrate,
-            options.polish,
+            &state.cur,
+            &format!("r{round}-control"),
+            std::slice::from_ref(&state.fit.point),
+            o.recalibrate,
+            o.polish,
         )?;
-        let s = score(&fit_n, &trial_added, n_nuisance, true);
-        let control_score = score(&control, &added, n_nuisance, true);
-        let prev_bic = models.last().map_or(f64::INFINITY, |m| m.bic);
-        let (base_rss, base_bic) = if control.rss < fit.rss {
-            (control.rss, control_score.bic.min(prev_bic))
-        } else {
-            (fit.rss, prev_bic)
-        };
-        let realised = 1.0 - fit_n.rss / base_rss;
-        let refusal = refusal(
-            ctx,
-            &p,
+        Ok(Tried {
+            p,
+            added,
+            next,
+            fit,
+            control,
+        })
+    }
+
+    /// Keeps the candidate `tried` (of the attribution's score `best`; `trial` when it only
+    /// fell short of its share) or refuses it ([`refusal`]), against the better of the
+    /// current fit and the control. A kept candidate becomes the current model; a refusal
+    /// returns its reason, with the control as the result when it fits better (recorded as
+    /// one more round, without an attribution).
+    ///
+    /// # Errors
+    /// Numerical errors of the refusal's model-noise pass and of the detection.
+    fn conclude(
+        &self,
+        state: &mut State<M>,
+        tried: Tried<M>,
+        best: &Score,
+        trial: bool,
+    ) -> Result<Option<String>> {
+        let n_nuisance = self.n_nuisance;
+        let s = score(&tried.fit, &tried.added, n_nuisance, true);
+        let control_score = score(&tried.control, &state.added, n_nuisance, true);
+        let prev_bic = state.models.last().map_or(f64::INFINITY, |m| m.bic);
+        let (base_rss, base_bic) = comparison_base(
+            state.fit.rss,
+            prev_bic,
+            tried.control.rss,
+            control_score.bic,
+        );
+        let realised = 1.0 - tried.fit.rss / base_rss;
+        let bics = (base_bic, s.bic);
+        let why = refusal(
+            self.ctx,
+            &tried.p,
             best,
             trial,
-            &fit_n,
+            &tried.fit,
             realised,
-            (base_bic, s.bic),
-            options,
+            bics,
+            self.options,
         )?;
-        if let Some(why) = refusal {
-            models.push(ModelScore { kept: false, ..s });
-            stopped = why;
-            if control.rss < fit.rss {
-                // The control is the better fit of the model as it stands: it is the result.
-                // Recorded as one more round, without an attribution.
-                models.push(control_score);
-                let detection = detect_fit(&control)?;
-                rounds.push(round(
-                    &added,
-                    &names,
-                    &control.point,
-                    detection,
-                    None,
-                    control.runs,
-                ));
-                fit = control;
+        if let Some(why) = why {
+            state.models.push(ModelScore { kept: false, ..s });
+            if tried.control.rss < state.fit.rss {
+                // The control is the better fit of the model as it stands: the result.
+                state.models.push(control_score);
+                state.det = self.detect(&tried.control)?;
+                state.fit = tried.control;
+                state.record(None);
             }
-            break;
+            return Ok(Some(why));
         }
-        models.push(s);
+        state.models.push(s);
         if trial
-            && let Some(entry) = rounds
+            && let Some(entry) = state
+                .rounds
                 .last_mut()
                 .and_then(|round| round.attribution.as_mut())
-                .and_then(|a| a.ranked.iter_mut().find(|c| c.name == p.name))
+                .and_then(|a| a.ranked.iter_mut().find(|c| c.name == tried.p.name))
         {
             entry.status = format!("best once recalibrated (explains {realised:.3})");
         }
-        runs = fit_n.runs;
-        det = detect_fit(&fit_n)?;
-        fit = fit_n;
-        cur = next;
-        added = trial_added;
+        state.det = self.detect(&tried.fit)?;
+        state.fit = tried.fit;
+        state.cur = tried.next;
+        state.added = tried.added;
+        Ok(None)
     }
-    let weights = akaike_weights(&models.iter().map(|m| m.aic).collect::<Vec<_>>());
-    for (m, w) in models.iter_mut().zip(weights) {
-        m.akaike_weight = w;
+}
+
+impl<M: Enrichable> State<M> {
+    /// Records the current model as a round, with the attribution of its residual.
+    fn record(&mut self, attribution: Option<Attribution>) {
+        let names = self.cur.space().names();
+        self.rounds.push(round(
+            &self.added,
+            &names,
+            &self.fit.point,
+            self.det.clone(),
+            attribution,
+            self.fit.runs,
+        ));
     }
-    Ok(Outcome {
-        fit,
-        added,
-        rounds,
-        models,
-        stopped,
-    })
+
+    /// The candidate to try next, from the current round's `attribution`: its score, whether
+    /// it is only a trial (it fell short of its share), and its parameter; or why selection
+    /// stops (no model-form error remains, `max_added` reached, no candidate to try, or one
+    /// the model no longer lists).
+    fn choice<'b>(
+        &self,
+        attribution: Option<&'b Attribution>,
+        max_added: usize,
+    ) -> ControlFlow<String, (&'b Score, bool, Parameter)> {
+        if !self.det.model_form_error {
+            return ControlFlow::Break(
+                "no model-form error remains (chi-square at the noise floor or no coherent \
+                 residual)"
+                    .to_string(),
+            );
+        }
+        if self.added.len() >= max_added {
+            return ControlFlow::Break(format!("max_added ({max_added}) reached"));
+        }
+        let chosen = attribution.and_then(|a| {
+            a.best()
+                .map(|s| (s, false))
+                .or_else(|| a.short_of_share().map(|s| (s, true)))
+        });
+        let Some((best, trial)) = chosen else {
+            return ControlFlow::Break(
+                "no candidate is identifiable, admissible, significant and explains enough \
+                 of the residual"
+                    .to_string(),
+            );
+        };
+        match self
+            .cur
+            .candidates()
+            .into_iter()
+            .find(|c| c.name() == best.name)
+        {
+            Some(c) => ControlFlow::Continue((best, trial, c.parameter)),
+            None => ControlFlow::Break(format!(
+                "candidate `{}` vanished from the model's list",
+                best.name
+            )),
+        }
+    }
+
+    /// The outcome, with each model's Akaike weight.
+    fn outcome(mut self, stopped: String) -> Outcome {
+        let weights = akaike_weights(&self.models.iter().map(|m| m.aic).collect::<Vec<_>>());
+        for (m, w) in self.models.iter_mut().zip(weights) {
+            m.akaike_weight = w;
+        }
+        Outcome {
+            fit: self.fit,
+            added: self.added,
+            rounds: self.rounds,
+            models: self.models,
+            stopped,
+        }
+    }
+}
+
+/// The starting points of a recalibration with `p` added to the optimum `point`: `p` at
+/// its held value, and at the attribution's estimate (clamped to its range) when that
+/// differs from the held value by more than `1e-12` of the range.
+fn starts(point: &[f64], p: &Parameter, best: &Score) -> Vec<Vec<f64>> {
+    let estimate = best
+        .amplitude
+        .as_ref()
+        .map_or(p.nominal, |a| a.value.clamp(p.lower, p.upper));
+    let with = |v: f64| {
+        let mut x = point.to_vec();
+        x.push(v);
+        x
+    };
+    let mut start = vec![with(p.nominal)];
+    if (estimate - p.nominal).abs() > 1e-12 * p.width() {
+        start.push(with(estimate));
+    }
+    start
+}
+
+/// The fit an addition is judged against, as `(rss, bic)`: the control (residual sum of
+/// squares `control_rss`, BIC `control_bic`) when it fits better than the current fit
+/// (`fit_rss`), with the lower of its BIC and the current model's `prev_bic`; the current
+/// fit otherwise.
+fn comparison_base(fit_rss: f64, prev_bic: f64, control_rss: f64, control_bic: f64) -> (f64, f64) {
+    if control_rss < fit_rss {
+        (control_rss, control_bic.min(prev_bic))
+    } else {
+        (fit_rss, prev_bic)
+    }
 }
 
 #[cfg(test)]
@@ -385,5 +555,60 @@ mod tests {
         let (aic, bic) = criteria(100.0, 1000, 3);
         assert!((aic - 106.0).abs() < 1e-12);
         assert!((bic - (100.0 + 3.0 * 1000f64.ln())).abs() < 1e-12);
+    }
+
+    fn scored(amplitude: Option<f64>) -> Score {
+        Score {
+            name: "c".into(),
+            kind: "candidate".into(),
+            group: "damping".into(),
+            kappa: 0.1,
+            identifiable: true,
+            explained_fraction: 0.9,
+            score: 50.0,
+            significant: true,
+            amplitude: amplitude.map(|value| crate::closeloop::Amplitude {
+                value,
+                lower: value - 0.1,
+                upper: value + 0.1,
+            }),
+            model_noise_sd: 0.0,
+            response_per_unit: 1.0,
+            admissible: true,
+            status: "best".into(),
+            sensor_pattern: Default::default(),
+        }
+    }
+
+    /// A recalibration starts from the candidate at its held value and, when the
+    /// attribution estimated another value, there too, clamped to the admissible range.
+    #[test]
+    fn a_recalibration_starts_at_the_held_value_and_the_clamped_estimate() {
+        let p = Parameter::new("c", 0.0, 2.0, 0.5).unwrap();
+        let point = [1.0, 3.0];
+        assert_eq!(
+            starts(&point, &p, &scored(Some(1.25))),
+            vec![vec![1.0, 3.0, 0.5], vec![1.0, 3.0, 1.25]]
+        );
+        assert_eq!(
+            starts(&point, &p, &scored(Some(7.0))),
+            vec![vec![1.0, 3.0, 0.5], vec![1.0, 3.0, 2.0]]
+        );
+        // No estimate, or one at the held value: one start.
+        assert_eq!(starts(&point, &p, &scored(None)), vec![vec![1.0, 3.0, 0.5]]);
+        assert_eq!(
+            starts(&point, &p, &scored(Some(0.5))),
+            vec![vec![1.0, 3.0, 0.5]]
+        );
+    }
+
+    /// An addition is judged against the control only when the control fits better, and
+    /// then against the lower of the two BICs.
+    #[test]
+    fn the_comparison_base_is_the_better_of_the_fit_and_the_control() {
+        assert_eq!(comparison_base(100.0, 120.0, 90.0, 125.0), (90.0, 120.0));
+        assert_eq!(comparison_base(100.0, 120.0, 90.0, 110.0), (90.0, 110.0));
+        assert_eq!(comparison_base(100.0, 120.0, 100.0, 110.0), (100.0, 120.0));
+        assert_eq!(comparison_base(100.0, 120.0, 130.0, 90.0), (100.0, 120.0));
     }
 }
