@@ -38,7 +38,7 @@ pub(crate) mod enrich;
 mod mesh;
 mod svg;
 
-use impactcal_core::{CoreError, Histories, Model, ParameterSpace};
+use impactcal_core::{CoreError, Histories, Model, ParamGuard, ParameterSpace};
 
 pub use catalogue::{
     Adjustable, AirframeValues, GRAVITY, Preset, catalogue, space_of, structural_space,
@@ -165,6 +165,15 @@ impl MeshDensity {
         }
     }
 
+    /// The density's name: `coarse`, `medium` or `fine`.
+    pub fn name(self) -> &'static str {
+        match self {
+            MeshDensity::Coarse => "coarse",
+            MeshDensity::Medium => "medium",
+            MeshDensity::Fine => "fine",
+        }
+    }
+
     /// Parses `coarse`, `medium` or `fine`.
     ///
     /// # Errors
@@ -216,6 +225,58 @@ impl Default for AirframeOptions {
     }
 }
 
+impl ParamGuard for AirframeOptions {
+    /// The options themselves: nothing downstream needs a separate checked form.
+    type Checked = AirframeOptions;
+
+    /// Checks each option on its own (the number of sensors against the mesh's nodes is
+    /// checked by [`Airframe::new`], which builds the mesh).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`] naming the option as `airframe.<key>`: an `end_time`
+    /// not finite and positive, an `output_interval` not in `(0, end_time]`, a
+    /// `ground_gap` not finite and non-negative, no `sensors`.
+    fn check_ref(&self) -> impactcal_core::Result<()> {
+        let bad = |key: &str, value: &dyn std::fmt::Display, why: String| {
+            Err(CoreError::invalid_option(
+                format!("airframe.{key}"),
+                value,
+                why,
+            ))
+        };
+        if !(self.end_time.is_finite() && self.end_time > 0.0) {
+            return bad(
+                "end_time",
+                &self.end_time,
+                "must be finite and positive (s)".into(),
+            );
+        }
+        if !(self.output_interval > 0.0 && self.output_interval <= self.end_time) {
+            return bad(
+                "output_interval",
+                &self.output_interval,
+                format!("must lie in (0, end_time = {}] (s)", self.end_time),
+            );
+        }
+        if !(self.ground_gap.is_finite() && self.ground_gap >= 0.0) {
+            return bad(
+                "ground_gap",
+                &self.ground_gap,
+                "must be finite and non-negative (in)".into(),
+            );
+        }
+        if self.sensors == 0 {
+            return bad("sensors", &0, "must be at least 1".into());
+        }
+        Ok(())
+    }
+
+    fn check(self) -> impactcal_core::Result<AirframeOptions> {
+        ParamGuard::check_ref(&self)?;
+        Ok(self)
+    }
+}
+
 /// A generated airframe: the mesh (fixed for a density), its sensor nodes, and the map from
 /// [`AirframeValues`] to a runnable [`ShellModel`].
 #[derive(Debug, Clone)]
@@ -230,44 +291,30 @@ impl Airframe {
     /// nodes from the cabin centre; they depend only on the mesh, never on parameter values).
     ///
     /// # Errors
-    /// [`ShellError::Value`] for a non-positive or non-finite end time or interval, an
-    /// interval longer than the end time, a negative gap or zero sensors.
+    /// [`ShellError::Core`] with [`CoreError::InvalidOption`] naming the option
+    /// (`airframe.<key>`): options refused by [`ParamGuard::check_ref`], or more sensors
+    /// than the mesh has nodes.
     pub fn new(options: AirframeOptions) -> Result<Self> {
-        let o = &options;
-        if !(o.end_time.is_finite() && o.end_time > 0.0) {
-            return Err(ShellError::value(
-                "airframe end time",
-                format!("must be positive, got {}", o.end_time),
-            ));
-        }
-        if !(o.output_interval.is_finite()
-            && o.output_interval > 0.0
-            && o.output_interval <= o.end_time)
-        {
-            return Err(ShellError::value(
-                "airframe output interval",
+        ParamGuard::check_ref(&options)?;
+        let mesh = mesh::build(&Counts::for_factor(options.mesh.factor()));
+        if options.sensors > mesh.nodes.len() {
+            return Err(CoreError::invalid_option(
+                "airframe.sensors",
+                options.sensors,
                 format!(
-                    "must lie in (0, end time = {}], got {}",
-                    o.end_time, o.output_interval
+                    "the {} mesh has {} nodes: at most that many sensors",
+                    options.mesh.name(),
+                    mesh.nodes.len()
                 ),
-            ));
+            )
+            .into());
         }
-        if !(o.ground_gap.is_finite() && o.ground_gap >= 0.0) {
-            return Err(ShellError::value(
-                "airframe ground gap",
-                format!("must be >= 0, got {}", o.ground_gap),
-            ));
-        }
-        if o.sensors == 0 {
-            return Err(ShellError::value("airframe sensors", "must be at least 1"));
-        }
-        let mesh = mesh::build(&Counts::for_factor(o.mesh.factor()));
         let centre = [
             0.5 * mesh::CABIN_LENGTH,
             0.0,
             mesh::FLOOR_HEIGHT + mesh::HALF_WIDTH,
         ];
-        let sensors = mesh::spread_nodes(&mesh.nodes, o.sensors, centre)
+        let sensors = mesh::spread_nodes(&mesh.nodes, options.sensors, centre)
             .into_iter()
             .map(|i| i as u64 + 1)
             .collect();
@@ -596,5 +643,108 @@ impl Model for AirframeModel {
         r.velocity.ok_or_else(|| {
             CoreError::Invalid("the airframe run produced no sensor histories".into())
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The defaults pass; each bad option is refused, by the check and by
+    /// [`Airframe::new`], with `CoreError::InvalidOption` naming its key.
+    #[test]
+    fn a_bad_option_is_refused_naming_its_key() {
+        let base = AirframeOptions::default();
+        assert!(ParamGuard::check_ref(&base).is_ok());
+        let cases = [
+            (
+                AirframeOptions {
+                    end_time: -0.01,
+                    ..base
+                },
+                "airframe.end_time",
+            ),
+            (
+                AirframeOptions {
+                    end_time: f64::NAN,
+                    ..base
+                },
+                "airframe.end_time",
+            ),
+            (
+                AirframeOptions {
+                    output_interval: 0.0,
+                    ..base
+                },
+                "airframe.output_interval",
+            ),
+            (
+                AirframeOptions {
+                    end_time: 0.01,
+                    output_interval: 0.02,
+                    ..base
+                },
+                "airframe.output_interval",
+            ),
+            (
+                AirframeOptions {
+                    ground_gap: -0.1,
+                    ..base
+                },
+                "airframe.ground_gap",
+            ),
+            (
+                AirframeOptions {
+                    ground_gap: f64::INFINITY,
+                    ..base
+                },
+                "airframe.ground_gap",
+            ),
+            (AirframeOptions { sensors: 0, ..base }, "airframe.sensors"),
+        ];
+        for (o, key) in cases {
+            match ParamGuard::check_ref(&o) {
+                Err(CoreError::InvalidOption { name, .. }) => assert_eq!(name, key),
+                other => panic!("{key}: {other:?}"),
+            }
+            match Airframe::new(o) {
+                Err(ShellError::Core(CoreError::InvalidOption { name, .. })) => {
+                    assert_eq!(name, key)
+                }
+                other => panic!("{key}: {other:?}"),
+            }
+        }
+    }
+
+    /// More sensors than the mesh has nodes is refused, naming the number of nodes, rather
+    /// than silently giving fewer; exactly that many is accepted.
+    #[test]
+    fn more_sensors_than_nodes_is_refused_naming_the_node_count() {
+        let nodes = match Airframe::new(AirframeOptions {
+            sensors: 1,
+            ..AirframeOptions::default()
+        }) {
+            Ok(af) => af.node_count(),
+            Err(e) => panic!("{e}"),
+        };
+        let all = AirframeOptions {
+            sensors: nodes,
+            ..AirframeOptions::default()
+        };
+        assert!(ParamGuard::check(all).is_ok());
+        match Airframe::new(AirframeOptions {
+            sensors: nodes + 1,
+            ..all
+        }) {
+            Err(e @ ShellError::Core(CoreError::InvalidOption { .. })) => {
+                let e = e.to_string();
+                assert!(
+                    e.contains("`airframe.sensors`")
+                        && e.contains(&format!("the coarse mesh has {nodes} nodes")),
+                    "{e}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }
