@@ -55,6 +55,7 @@ use std::path::PathBuf;
 
 use impactcal_calibrate::closeloop::LoopOptions;
 use impactcal_calibrate::study::StudyOptions;
+use impactcal_core::{CoreError, ParamGuard};
 use impactcal_runner::config::{ExecutorTable, SolverSection};
 use serde::Deserialize;
 use toml::de::{DeTable, DeValue};
@@ -285,8 +286,8 @@ const GONE: &[(&str, &str)] = &[
 /// # Errors
 /// [`ExperimentError::File`] for TOML that does not parse or a value of the wrong type (with
 /// its line and column) or a missing `[test]`; [`ExperimentError::Key`] for an unknown key
-/// (with the closest names), a key of an earlier schema (with its new place) or a section
-/// that is gone.
+/// (with the closest names), a key of an earlier schema (with its new place), a section
+/// that is gone, or a `[loop]` value out of range (with what it must be).
 pub fn parse(text: &str, file: &str) -> Result<ExperimentFile> {
     let doc = DeTable::parse(text).map_err(|e| toml_error(&e, text, file))?;
     check_keys(doc.get_ref(), text, file)?;
@@ -302,7 +303,32 @@ pub fn parse(text: &str, file: &str) -> Result<ExperimentFile> {
         parsed.study.shapes = parsed.study.shapes.min(parsed.study.sensors);
     }
     check_declared(&parsed, doc.get_ref(), text, file)?;
+    check_loop(&parsed.loop_options, doc.get_ref(), text, file)?;
     Ok(parsed)
+}
+
+/// Checks `[loop]` as the file is read ([`ParamGuard::check_ref`]), so that a value out of
+/// range is named with its line before anything runs; the run budgets, which depend on the
+/// model's dimension, are checked when the loop starts
+/// ([`LoopOptions::check_budgets`]).
+fn check_loop(options: &LoopOptions, doc: &DeTable<'_>, text: &str, file: &str) -> Result<()> {
+    match ParamGuard::check_ref(options) {
+        Ok(()) => Ok(()),
+        Err(CoreError::InvalidOption {
+            name,
+            value,
+            message,
+        }) => {
+            let key = name.strip_prefix("loop.").unwrap_or(&name);
+            Err(ExperimentError::Key {
+                file: file.to_string(),
+                line: line_of(doc, &["loop", key], text),
+                key: format!("[loop] {key}"),
+                message: format!("{value}: {message}"),
+            })
+        }
+        Err(e) => Err(e.into()),
+    }
 }
 
 /// The 1-based line of the key `path` (a section, then keys below it) in `doc`, or 0.
@@ -618,6 +644,37 @@ mod tests {
             "{TEST}[executor]\nkind = \"processes\"\njobs = \"2\"\n"
         ));
         assert!(e.contains("line "), "{e}");
+    }
+
+    /// A `[loop]` value out of range is refused as the file is read, naming the file, the
+    /// line and the key, before the model is built or anything runs.
+    #[test]
+    fn a_bad_loop_value_is_refused_when_the_file_is_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("loop.toml");
+        // No model and no test data exist: the file is refused before they are looked at.
+        let text = "[model]\ndeck = \"absent.k\"\n[test]\ndata = \"absent.csv\"\n\
+                    [loop]\nseed = 3\nalpha = 0.7\n";
+        std::fs::write(&path, text).unwrap();
+        let e = match crate::Experiment::from_file(&path) {
+            Ok(_) => panic!("a [loop] alpha of 0.7 was accepted"),
+            Err(e) => e,
+        };
+        assert!(matches!(e, ExperimentError::Key { line: 7, .. }), "{e:?}");
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "{}: line 7: [loop] alpha: 0.7: must lie in (0, 0.5)",
+                path.display()
+            )
+        );
+        // Another key, another line; a valid [loop] parses.
+        let e = err(&format!("{TEST}[loop]\njitter_runs = 1\n"));
+        assert!(
+            e.starts_with("x.toml: line 4: [loop] jitter_runs: 1: the model's noise needs"),
+            "{e}"
+        );
+        assert!(parse(&format!("{TEST}[loop]\nalpha = 0.05\n"), "x.toml").is_ok());
     }
 
     #[test]

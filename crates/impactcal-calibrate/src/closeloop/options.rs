@@ -108,15 +108,15 @@ impl LoopOptions {
     }
 
     /// Checks every option ([`ParamGuard::check_ref`]), then the run budgets against
-    /// `declared`, the dimension of the model's space. (With [`ParamGuard`] in scope,
-    /// `options.check(d)` resolves to the trait's by-value `check`: call it as
-    /// `LoopOptions::check(&options, d)`.)
+    /// `declared`, the dimension of the model's space: CORS needs
+    /// [`cors_runs_needed`](Self::cors_runs_needed)`(declared)` runs to calibrate and
+    /// `cors_runs_needed(declared + max_added)` to recalibrate.
     ///
     /// # Errors
     /// [`CoreError::InvalidOption`] (as [`CalibrateError::Core`](crate::CalibrateError::Core)) naming the first bad
     /// option as `loop.<key>`, and for a budget too small to (re)calibrate, with the
     /// number of runs needed.
-    pub fn check(&self, declared: usize) -> Result<()> {
+    pub fn check_budgets(&self, declared: usize) -> Result<()> {
         ParamGuard::check_ref(self)?;
         let need = Self::cors_runs_needed(declared);
         if self.reconcile < need {
@@ -156,7 +156,7 @@ impl ParamGuard for LoopOptions {
     type Checked = LoopOptions;
 
     /// Checks every option on its own (the run budgets against the model's dimension are
-    /// checked by [`LoopOptions::check`] when the loop starts).
+    /// checked by [`LoopOptions::check_budgets`] when the loop starts).
     ///
     /// # Errors
     /// [`CoreError::InvalidOption`] naming the first bad option as `loop.<key>` (the key
@@ -246,7 +246,7 @@ mod tests {
     fn a_bad_value_is_refused_naming_its_key() {
         let base = LoopOptions::default();
         assert!(ParamGuard::check_ref(&base).is_ok());
-        assert!(LoopOptions::check(&base, 2).is_ok());
+        assert!(base.check_budgets(2).is_ok());
         let cases: Vec<(LoopOptions, &str)> = vec![
             (
                 LoopOptions {
@@ -332,7 +332,7 @@ mod tests {
                 other => panic!("{key}: {other:?}"),
             }
             // The loop's own check refuses it the same way.
-            let e = LoopOptions::check(&o, 2).unwrap_err();
+            let e = o.check_budgets(2).unwrap_err();
             assert!(
                 matches!(e, CalibrateError::Core(CoreError::InvalidOption { .. })),
                 "{e}"
@@ -341,7 +341,7 @@ mod tests {
         }
         // Budgets against the model's dimension: 2 (2 + 1) + 2 = 8 runs for 2 parameters,
         // 2 (2 + 3 + 1) + 2 = 14 to recalibrate with up to 3 added.
-        let e = LoopOptions::check(
+        let e = LoopOptions::check_budgets(
             &LoopOptions {
                 reconcile: 7,
                 ..base.clone()
@@ -354,7 +354,7 @@ mod tests {
             e.contains("`loop.reconcile_runs` = 7") && e.contains("at least 8"),
             "{e}"
         );
-        let e = LoopOptions::check(
+        let e = LoopOptions::check_budgets(
             &LoopOptions {
                 recalibrate: 13,
                 ..base.clone()
@@ -368,7 +368,7 @@ mod tests {
             "{e}"
         );
         assert!(
-            LoopOptions::check(
+            LoopOptions::check_budgets(
                 &LoopOptions {
                     recalibrate: 0,
                     max_added: 0,

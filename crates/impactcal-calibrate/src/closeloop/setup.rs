@@ -17,7 +17,7 @@ use crate::study::channels::{TestPreparation, prepared_test};
 /// the holdout's condition (returned beside the holdout).
 ///
 /// # Errors
-/// [`LoopOptions::check`]'s errors; [`CalibrateError::Study`] for a candidate the model
+/// [`LoopOptions::check_budgets`]'s errors; [`CalibrateError::Study`] for a candidate the model
 /// does not list, no candidate left to consider, a holdout condition
 /// the model cannot take.
 pub(super) fn checked_inputs<'h, M: Enrichable>(
@@ -25,7 +25,7 @@ pub(super) fn checked_inputs<'h, M: Enrichable>(
     options: &LoopOptions,
     holdout: Option<Holdout<'h>>,
 ) -> Result<Option<(Holdout<'h>, M)>> {
-    options.check(model.space().dim())?;
+    options.check_budgets(model.space().dim())?;
     let listed = model.candidates();
     if let Some(names) = &options.candidates {
         for n in names {
