@@ -5,7 +5,8 @@ use impactcal::calibrate::closeloop::{LoopResult, Verdict};
 
 use crate::error::CliError;
 use crate::simulate::thread_pool;
-use crate::study::{Args, Progress};
+use crate::progress::Progress;
+use crate::study::Args;
 
 /// Runs `impactcal close-loop`.
 pub fn run(args: Args) -> Result<(), CliError> {

@@ -23,7 +23,7 @@ use serde::Serialize;
 use crate::error::CliError;
 use crate::output::write_text;
 use crate::simulate::thread_pool;
-use crate::study::Progress;
+use crate::progress::Progress;
 
 /// The demo's window (s): the airframe is predictable over it (docs/airframe.md,
 /// "Predictability"); later, its own noise grows by e every 4 ms.

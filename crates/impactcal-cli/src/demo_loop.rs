@@ -21,7 +21,7 @@ use crate::demo::Args;
 use crate::error::CliError;
 use crate::output::write_text;
 use crate::simulate::thread_pool;
-use crate::study::Progress;
+use crate::progress::Progress;
 
 /// The loop demo's window (s): the window of the coarse-airframe loop test. Over 25 ms
 /// the declared thicknesses, calibrated first, take up more of the damping's signature

@@ -88,6 +88,7 @@ use impactcal_core::{Cfc, Enrichable, Histories};
 
 use crate::error::Result;
 use crate::study::TestData;
+use crate::progress::LoopRunEstimate;
 use crate::study::execute::Observer;
 use impactcal_runner::Runner;
 
@@ -168,6 +169,17 @@ pub fn run_loop_on<M: Enrichable>(
     let holdout_models = setup::checked_inputs(model, options, holdout)?;
     let fp = fingerprint(description, model.space(), options, test, holdout);
     let used = Cell::new(0usize);
+    let allowed = model
+        .candidates()
+        .iter()
+        .filter(|c| options.allows(c.name()))
+        .count();
+    let estimate = LoopRunEstimate::new(
+        options,
+        model.space().dim(),
+        allowed,
+        holdout_models.is_some(),
+    );
     let runner = Journaled {
         dir,
         fingerprint: &fp,
@@ -176,7 +188,9 @@ pub fn run_loop_on<M: Enrichable>(
         worker,
         condition: &[],
         plan: None,
+        estimate: Some(&estimate),
     };
+    runner.replan(|e| 1 + e.after_nominal());
     let nominal = setup::nominal(&runner, model, test)?;
     let threads = if worker.is_some() {
         0

@@ -46,6 +46,7 @@ use super::detection::{Detection, chi2_quantile, detect};
 use super::fit::{Ctx, Fit, calibrate};
 use super::options::LoopOptions;
 use super::result::{ModelScore, Round};
+use crate::progress::LoopRunEstimate;
 use crate::error::Result;
 
 /// What forward selection ends with.
@@ -213,7 +214,17 @@ pub(crate) fn forward<M: Enrichable>(
     let stopped;
     loop {
         let r = rounds.len();
-        let attribution = if r == 0 || det.model_form_error {
+        let attributes = r == 0 || det.model_form_error;
+        let may_add = det.model_form_error && added.len() < options.max_added;
+        let allowed = cur
+            .candidates()
+            .iter()
+            .filter(|c| options.allows(c.name()))
+            .count();
+        let d = cur.space().dim();
+        ctx.runner
+            .replan(|e| e.rest_of_round(d, if attributes { allowed } else { 0 }, may_add));
+        let attribution = if attributes {
             ctx.runner.observer.step("attribution");
             Some(attribute(
                 ctx,
@@ -263,6 +274,8 @@ pub(crate) fn forward<M: Enrichable>(
             stopped = format!("candidate `{}` vanished from the model's list", best.name);
             break;
         };
+        ctx.runner
+            .replan(|e| e.recalibrations(d) + e.holdout_runs());
         let p = cand.parameter.clone();
         let mut trial_added = added.clone();
         trial_added.push(p.clone());
@@ -359,6 +372,7 @@ pub(crate) fn forward<M: Enrichable>(
         cur = next;
         added = trial_added;
     }
+    ctx.runner.replan(LoopRunEstimate::holdout_runs);
     let weights = akaike_weights(&models.iter().map(|m| m.aic).collect::<Vec<_>>());
     for (m, w) in models.iter_mut().zip(weights) {
         m.akaike_weight = w;

@@ -150,6 +150,7 @@ pub fn run(
     };
 
     // 1. Baseline, test on the model's channels, noise, objective channels.
+    observer.plan(1 + options.jitter_runs + options.halton_runs + options.reconcile_runs);
     let nominal_point = space.nominal();
     let nominal_raw = runs
         .stage("nominal", std::slice::from_ref(&nominal_point))?
