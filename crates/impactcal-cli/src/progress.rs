@@ -156,6 +156,24 @@ impl Tracker {
         }
     }
 
+    /// Ends the computation at `now`: nothing is under way, the runs planned are those
+    /// done. Returns `now`.
+    pub fn end(&mut self) -> Instant {
+        let now = Instant::now();
+        self.stage = None;
+        self.planned = self.done;
+        now
+    }
+
+    /// The last line: "[213/213 runs] in 1 min".
+    pub fn final_line(&self, now: Instant) -> String {
+        format!(
+            "[{}] in {}",
+            self.summary(now),
+            duration(now.saturating_duration_since(self.started))
+        )
+    }
+
     /// The periodic line, when a stage of runs is under way and `interval` has passed
     /// since the last line; the time of the last line is then `now`.
     pub fn tick(&mut self, now: Instant) -> Option<String> {
@@ -167,10 +185,12 @@ impl Tracker {
     }
 }
 
-/// A duration as a person reads it: "40 s", "4 min", "1 h 05 min".
+/// A duration as a person reads it: "under 1 s", "40 s", "4 min", "1 h 05 min".
 fn duration(t: Duration) -> String {
     let s = t.as_secs();
-    if s < 60 {
+    if s == 0 {
+        "under 1 s".to_string()
+    } else if s < 60 {
         format!("{s} s")
     } else if s < 3600 {
         format!("{} min", (s + 30) / 60)
@@ -234,9 +254,21 @@ impl Progress {
         }
     }
 
-    /// Clears the bars (or stops the periodic lines): what is printed next starts on a
-    /// line of its own.
+    /// Clears the bars (or stops the periodic lines after a last line, "[213/213 runs] in
+    /// 1 min"): what is printed next starts on a line of its own. Runs still planned then
+    /// are not made: the runs planned become the runs done.
     pub fn done(&self) {
+        if self.closed() {
+            return;
+        }
+        let last = {
+            let mut t = self.shared.tracker();
+            let end = t.end();
+            (t.overall().0 > 0).then(|| t.final_line(end))
+        };
+        if let (None, Some(line)) = (&self.bars, last) {
+            eprintln!("impactcal: {line}");
+        }
         if let Some(b) = &self.bars {
             b.stage.finish_and_clear();
             b.overall.finish_and_clear();
@@ -246,6 +278,10 @@ impl Progress {
             *stop = true;
         }
         self.shared.wake.notify_all();
+    }
+
+    fn closed(&self) -> bool {
+        self.shared.stop.lock().map_or(true, |s| *s)
     }
 
     fn say(&self, line: &str) {
@@ -484,6 +520,7 @@ mod tests {
 
     #[test]
     fn durations_read_as_a_person_says_them() {
+        assert_eq!(duration(Duration::from_millis(300)), "under 1 s");
         assert_eq!(duration(Duration::from_secs(42)), "42 s");
         assert_eq!(duration(Duration::from_secs(250)), "4 min");
         assert_eq!(duration(Duration::from_secs(3900)), "1 h 05 min");

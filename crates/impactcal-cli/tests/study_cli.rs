@@ -347,7 +347,9 @@ fn a_study_on_the_process_pool_killed_and_resumed_is_identical() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
-        stderr.contains(&format!("ensemble: 40 runs ({done} from the journal)")),
+        stderr.contains(&format!(
+            "ensemble over the parameter space: 0/40 runs ({done} from the journal)"
+        )),
         "{stderr}"
     );
     let a = std::fs::read_to_string(whole.join("study.json")).unwrap();
