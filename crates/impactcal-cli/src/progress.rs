@@ -132,28 +132,40 @@ impl Tracker {
     pub fn summary(&self, now: Instant) -> String {
         let (done, planned) = self.overall();
         match self.time_left(now) {
-            Some(t) if done < planned => {
-                format!("{done}/{planned} runs, about {} left", duration(t))
-            }
+            Some(t) if done < planned => format!("{done}/{planned} runs, {}", left(t)),
             _ => format!("{done}/{planned} runs"),
+        }
+    }
+
+    /// `text` after the overall counts in brackets, "[3/130 runs, about 4 min left] text";
+    /// `text` alone before anything was planned or run.
+    pub fn with_counts(&self, now: Instant, text: &str) -> String {
+        if self.overall() == (0, 0) {
+            return text.to_string();
+        }
+        let head = format!("[{}]", self.summary(now));
+        if text.is_empty() {
+            head
+        } else {
+            format!("{head} {text}")
         }
     }
 
     /// The plain line of the stage under way at `now`, e.g. "[3/130 runs, about 4 min
     /// left] calibration, CORS-RBF search: 2/24 runs (1 from the journal)".
     pub fn line(&self, now: Instant) -> String {
-        let head = format!("[{}]", self.summary(now));
-        match &self.stage {
+        let text = match &self.stage {
             Some(s) => {
                 let reuse = if s.reused > 0 {
                     format!(" ({} from the journal)", s.reused)
                 } else {
                     String::new()
                 };
-                format!("{head} {}: {}/{} runs{reuse}", s.title, s.done, s.total)
+                format!("{}: {}/{} runs{reuse}", s.title, s.done, s.total)
             }
-            None => head,
-        }
+            None => String::new(),
+        };
+        self.with_counts(now, &text)
     }
 
     /// Ends the computation at `now`: nothing is under way, the runs planned are those
@@ -182,6 +194,15 @@ impl Tracker {
         }
         self.last_line = now;
         Some(self.line(now))
+    }
+}
+
+/// The time left as a person says it: "about 4 min left", "under 1 s left".
+fn left(t: Duration) -> String {
+    if t < Duration::from_secs(1) {
+        "under 1 s left".to_string()
+    } else {
+        format!("about {} left", duration(t))
     }
 }
 
@@ -300,7 +321,7 @@ impl Progress {
         b.overall.set_length(planned as u64);
         b.overall.set_position(done as u64);
         b.overall.set_message(match tracker.time_left(now) {
-            Some(t) if done < planned => format!("about {} left", duration(t)),
+            Some(t) if done < planned => left(t),
             _ => String::new(),
         });
         match tracker.current() {
@@ -396,7 +417,7 @@ impl Observer for Progress {
         let mut t = self.shared.tracker();
         let now = Instant::now();
         t.step(now);
-        let line = format!("[{}] {name}", t.summary(now));
+        let line = t.with_counts(now, name);
         self.say(&line);
         self.redraw(&t);
     }
