@@ -52,6 +52,7 @@ pub fn stop_on_ctrl_c(cancel: Cancel) {
 /// Runs `impactcal study`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let experiment = args.experiment()?;
+    crate::output::check_out_folder(&args.out)?;
     let progress = Progress::new();
     let done = thread_pool(args.threads)?.install(|| experiment.study_with(&args.out, &progress));
     progress.done();

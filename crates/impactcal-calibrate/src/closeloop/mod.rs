@@ -99,6 +99,7 @@ pub use noise_floor::NoiseFloor;
 pub use nuisance::Nuisance;
 pub use options::LoopOptions;
 pub use plan::{LoopShapes, estimated_peak};
+pub use setup::check_inputs;
 pub use result::{Added, ErrorSummary, Errors, LoopResult, ModelScore, Round, Stages, Verdict};
 
 use fit::Journaled;

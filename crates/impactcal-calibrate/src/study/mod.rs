@@ -150,6 +150,15 @@ pub fn run(
     };
 
     // 1. Baseline, test on the model's channels, noise, objective channels.
+    crate::memory::check_run_counts(
+        Guard::new(options.max_memory),
+        &[
+            ("study.halton_runs", options.halton_runs),
+            ("study.jitter_runs", options.jitter_runs),
+            ("study.reconcile_runs", options.reconcile_runs),
+        ],
+        space.dim(),
+    )?;
     observer.plan(1 + options.jitter_runs + options.halton_runs + options.reconcile_runs);
     let nominal_point = space.nominal();
     let nominal_raw = runs
