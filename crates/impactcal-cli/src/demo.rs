@@ -150,7 +150,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let channels = airframe.sensor_labels().len();
     if args.sensors > channels {
         return Err(CliError::input(format!(
-            "--sensors {}: the coarse airframe has {channels} sensor channels, and Table 2              places sensors on those of them its model predicts; give at most {channels}              (the source paper: 41)",
+            "--sensors {}: the coarse airframe has {channels} sensor channels, and Table 2 \
+             places sensors on those of them its model predicts; give at most {channels} \
+             (the source paper: 41)",
             args.sensors
         )));
     }

@@ -136,7 +136,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .count();
     if args.channels > vertical {
         return Err(CliError::input(format!(
-            "--channels {}: the coarse airframe has {vertical} vertical sensor channels; give              at most {vertical}",
+            "--channels {}: the coarse airframe has {vertical} vertical sensor channels; give \
+             at most {vertical}",
             args.channels
         )));
     }

@@ -413,6 +413,10 @@ impl Observer for Progress {
         self.redraw(&t);
     }
 
+    fn warning(&self, text: &str) {
+        self.say(&format!("warning: {text}"));
+    }
+
     fn step(&self, name: &str) {
         let mut t = self.shared.tracker();
         let now = Instant::now();

@@ -254,6 +254,7 @@ pub fn run_loop_on<M: Enrichable>(
         nuisance: fit.terms.report(&nominal.labels, options.units_tolerance),
         noise_floor: setting.floor,
         test_preparation: nominal.preparation,
+        dropped: nominal.dropped,
         candidates,
         indistinguishable,
         added,

@@ -98,6 +98,8 @@ pub(super) struct Nominal {
     pub preparation: TestPreparation,
     /// The channels compared.
     pub labels: Vec<String>,
+    /// The channels of either side left out of the comparison.
+    pub dropped: crate::metrics::Dropped,
 }
 
 /// Runs the model at its nominal point (journal stage `nominal`) and prepares the test on
@@ -119,6 +121,10 @@ pub(super) fn nominal<M: Enrichable>(
     let (test_m, masks, preparation) =
         prepared_test(test.histories, test.map, test.cfc, &raw, None)?;
     let labels = test_m.labels().to_vec();
+    let dropped = crate::study::channels::dropped(test.histories, test.map, &raw)?;
+    if let Some(w) = dropped.warning(labels.len()) {
+        runner.observer.warning(&w);
+    }
     Ok(Nominal {
         point,
         raw,
@@ -126,6 +132,7 @@ pub(super) fn nominal<M: Enrichable>(
         masks,
         preparation,
         labels,
+        dropped,
     })
 }
 

@@ -18,7 +18,8 @@ mod iso18571;
 mod pointwise;
 
 pub use compare::{
-    ChannelMetrics, ChannelPair, CompareOptions, Comparison, CurveMetrics, MeanIso, MeanTriple,
+    ChannelMetrics, ChannelPair, CompareOptions, Comparison, CurveMetrics, Dropped, MeanIso,
+    MeanTriple,
     Overall, compare,
 };
 pub use energy::{Russell, SpragueGeers};

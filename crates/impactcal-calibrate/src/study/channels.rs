@@ -121,6 +121,40 @@ fn lead_of(on_labels: &Histories, model: &Histories, most: usize) -> Result<Opti
 /// The test converted, filtered with `cfc` on its own time base, on the channels it shares
 /// with `model` (by label or through `map`, each divided by the map's gain), relabelled
 /// with the model's labels, in the model's channel order.
+/// The channels the study or loop leaves out of `test` (after the map's conversions) and
+/// of `model`: those no pair names (by label, or through the channel map).
+///
+/// # Errors
+/// The map's conversion errors.
+pub fn dropped(
+    test: &Histories,
+    map: Option<&ChannelMap>,
+    model: &Histories,
+) -> Result<crate::metrics::Dropped> {
+    let converted = match map {
+        Some(m) => m.convert(test)?,
+        None => test.clone(),
+    };
+    let pairs: Vec<(String, String)> = match map {
+        Some(m) => m
+            .entries
+            .iter()
+            .map(|e| (e.test_label.clone(), e.model_label.clone()))
+            .collect(),
+        None => converted
+            .labels()
+            .iter()
+            .filter(|l| model.index_of(l).is_some())
+            .map(|l| (l.clone(), l.clone()))
+            .collect(),
+    };
+    Ok(crate::metrics::Dropped::of(
+        converted.labels(),
+        model.labels(),
+        pairs.iter().map(|(t, m)| (t.as_str(), m.as_str())),
+    ))
+}
+
 fn on_model_labels(
     test: &Histories,
     map: Option<&ChannelMap>,

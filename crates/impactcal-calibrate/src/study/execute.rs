@@ -206,6 +206,9 @@ pub trait Observer: Sync {
     fn run_finished(&self) {}
     /// A stage without model runs (a fit, an analysis) starts.
     fn step(&self, _name: &str) {}
+    /// Something the person should know that does not stop the computation (channels
+    /// left out of the comparison, for example).
+    fn warning(&self, _text: &str) {}
 }
 
 /// An observer that says nothing.
