@@ -164,7 +164,10 @@ mod tests {
             ("r0-start", "calibration, starting points"),
             ("r0-cors", "calibration, CORS-RBF search"),
             ("r0-gn1-jac", "calibration, Gauss-Newton step 2, Jacobian"),
-            ("r2-gn0-try1", "recalibration 2, Gauss-Newton step 1, trial step 2"),
+            (
+                "r2-gn0-try1",
+                "recalibration 2, Gauss-Newton step 1, trial step 2",
+            ),
             (
                 "r1-warm-gn3-ext2",
                 "recalibration 1, second polish from the best start, Gauss-Newton step 4, \
@@ -174,7 +177,10 @@ mod tests {
                 "r1-control-cors",
                 "recalibration 1, control (without the addition), CORS-RBF search",
             ),
-            ("r0-candidates", "attribution 1, one run per candidate effect"),
+            (
+                "r0-candidates",
+                "attribution 1, one run per candidate effect",
+            ),
             ("holdout-enriched", "holdout, enriched model's run"),
             ("reconcile", "reconciliation, CORS-RBF search"),
             // Names it does not know stay as they are.

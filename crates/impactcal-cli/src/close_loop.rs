@@ -4,8 +4,8 @@
 use impactcal::calibrate::closeloop::{LoopResult, Verdict};
 
 use crate::error::CliError;
-use crate::simulate::thread_pool;
 use crate::progress::Progress;
+use crate::simulate::thread_pool;
 use crate::study::Args;
 
 /// Runs `impactcal close-loop`.

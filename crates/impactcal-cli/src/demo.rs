@@ -22,8 +22,8 @@ use serde::Serialize;
 
 use crate::error::CliError;
 use crate::output::write_text;
-use crate::simulate::thread_pool;
 use crate::progress::Progress;
+use crate::simulate::thread_pool;
 
 /// The demo's window (s): the airframe is predictable over it (docs/airframe.md,
 /// "Predictability"); later, its own noise grows by e every 4 ms.

@@ -22,8 +22,8 @@ use serde::Serialize;
 use crate::demo::Args;
 use crate::error::CliError;
 use crate::output::write_text;
-use crate::simulate::thread_pool;
 use crate::progress::Progress;
+use crate::simulate::thread_pool;
 
 /// The loop demo's window (s): the window of the coarse-airframe loop test. Over 25 ms
 /// the declared thicknesses, calibrated first, take up more of the damping's signature

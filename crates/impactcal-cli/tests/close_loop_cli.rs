@@ -148,7 +148,10 @@ fn progress_tells_the_story(err: &str, out: &Path, runs: usize) {
     let last = lines.last().unwrap();
     assert_eq!((last.0, last.1), (runs, runs), "{err}");
     assert!(last.2.starts_with("in "), "{err}");
-    assert_eq!(lines.first().map(|l| l.2.as_str()), Some("nominal run: 0/1 runs"));
+    assert_eq!(
+        lines.first().map(|l| l.2.as_str()),
+        Some("nominal run: 0/1 runs")
+    );
     let verdict = err.lines().find(|l| l.contains("verdict:")).unwrap();
     assert!(verdict.starts_with("verdict: attributed"), "{verdict}");
 }

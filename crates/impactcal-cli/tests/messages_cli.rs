@@ -168,7 +168,10 @@ fn metrics_on_part_of_the_channels_warns_and_says_so_in_the_json() {
     );
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["channels"].as_array().unwrap().len(), 3);
-    assert_eq!(v["dropped"]["test"], serde_json::json!(["42.x", "42.y", "42.z"]));
+    assert_eq!(
+        v["dropped"]["test"],
+        serde_json::json!(["42.x", "42.y", "42.z"])
+    );
     assert_eq!(v["dropped"]["model"], serde_json::json!([]));
 }
 

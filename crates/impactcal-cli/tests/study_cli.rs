@@ -102,15 +102,34 @@ fn a_killed_study_resumes_to_the_uninterrupted_result() {
         "{err}"
     );
     let steps: Vec<&str> = lines.iter().map(|(_, _, t)| t.as_str()).collect();
-    for step in ["M1", "sensor placement", "M2", "surrogates", "sensitivity", "before and after"] {
-        assert_eq!(steps.iter().filter(|t| **t == step).count(), 1, "{step}: {err}");
+    for step in [
+        "M1",
+        "sensor placement",
+        "M2",
+        "surrogates",
+        "sensitivity",
+        "before and after",
+    ] {
+        assert_eq!(
+            steps.iter().filter(|t| **t == step).count(),
+            1,
+            "{step}: {err}"
+        );
     }
-    assert!(lines.iter().all(|(done, planned, _)| done <= planned && *planned == 170), "{err}");
+    assert!(
+        lines
+            .iter()
+            .all(|(done, planned, _)| done <= planned && *planned == 170),
+        "{err}"
+    );
     let last = lines.last().unwrap();
     assert_eq!((last.0, last.1), (170, 170), "{err}");
     assert!(last.2.starts_with("in "), "{err}");
     // The memory plan's line and the notes are steps too.
-    assert!(steps[1].starts_with("memory: the study plans about"), "{err}");
+    assert!(
+        steps[1].starts_with("memory: the study plans about"),
+        "{err}"
+    );
     let notes = steps.iter().filter(|t| t.starts_with("note: ")).count();
     assert_eq!(lines.len(), stages.len() + 7 + notes + 1, "{err}");
 
@@ -367,15 +386,34 @@ fn a_study_on_the_process_pool_killed_and_resumed_is_identical() {
         "{err}"
     );
     let steps: Vec<&str> = lines.iter().map(|(_, _, t)| t.as_str()).collect();
-    for step in ["M1", "sensor placement", "M2", "surrogates", "sensitivity", "before and after"] {
-        assert_eq!(steps.iter().filter(|t| **t == step).count(), 1, "{step}: {err}");
+    for step in [
+        "M1",
+        "sensor placement",
+        "M2",
+        "surrogates",
+        "sensitivity",
+        "before and after",
+    ] {
+        assert_eq!(
+            steps.iter().filter(|t| **t == step).count(),
+            1,
+            "{step}: {err}"
+        );
     }
-    assert!(lines.iter().all(|(done, planned, _)| done <= planned && *planned == 170), "{err}");
+    assert!(
+        lines
+            .iter()
+            .all(|(done, planned, _)| done <= planned && *planned == 170),
+        "{err}"
+    );
     let last = lines.last().unwrap();
     assert_eq!((last.0, last.1), (170, 170), "{err}");
     assert!(last.2.starts_with("in "), "{err}");
     // The memory plan's line and the notes are steps too.
-    assert!(steps[1].starts_with("memory: the study plans about"), "{err}");
+    assert!(
+        steps[1].starts_with("memory: the study plans about"),
+        "{err}"
+    );
     let notes = steps.iter().filter(|t| t.starts_with("note: ")).count();
     assert_eq!(lines.len(), stages.len() + 7 + notes + 1, "{err}");
     let killed = dir.path().join("killed");

@@ -249,17 +249,24 @@ impl Experiment {
         match &self.spec {
             ModelSpec::Airframe { end_time, .. } => (
                 "`[model] end_time`".into(),
-                Some(end_time.unwrap_or(impactcal_shell::airframe::AirframeOptions::new(
-                    impactcal_shell::airframe::MeshDensity::Coarse,
-                )
-                .end_time)),
+                Some(
+                    end_time.unwrap_or(
+                        impactcal_shell::airframe::AirframeOptions::new(
+                            impactcal_shell::airframe::MeshDensity::Coarse,
+                        )
+                        .end_time,
+                    ),
+                ),
             ),
             ModelSpec::External { solver, .. } => (
                 "the template's end time and `[solver.output] end_time`".into(),
                 solver.output.end_time,
             ),
             ModelSpec::Deck { path, .. } => (
-                format!("the end time of `*CONTROL_TERMINATION` in {}", path.display()),
+                format!(
+                    "the end time of `*CONTROL_TERMINATION` in {}",
+                    path.display()
+                ),
                 None,
             ),
             _ => ("(the model's window is fixed)".into(), None),

@@ -28,8 +28,8 @@ use super::linalg::dot;
 use super::model_noise::ModelNoise;
 use super::nuisance::{self, Frame, Terms};
 use super::plan::Plan;
-use crate::progress::LoopRunEstimate;
 use crate::error::{CalibrateError, Result};
+use crate::progress::LoopRunEstimate;
 use crate::study::execute::{Dispatch, Observer, Outcomes, Runs};
 use crate::study::reconcile;
 use impactcal_runner::Runner;
@@ -92,12 +92,8 @@ impl<'a> Journaled<'a> {
             condition: self.condition,
         };
         self.used.set(self.used.get() + points.len());
-        Runs::open(&exec, self.dir, self.fingerprint, self.observer)?.stage_from(
-            stage,
-            first,
-            points,
-            announce,
-        )
+        Runs::open(&exec, self.dir, self.fingerprint, self.observer)?
+            .stage_from(stage, first, points, announce)
     }
 
     /// Runs `points` as runs `first..` of the stage `stage` run in parts, announced to the

@@ -87,8 +87,8 @@ use std::path::Path;
 use impactcal_core::{Cfc, Enrichable, Histories};
 
 use crate::error::Result;
-use crate::study::TestData;
 use crate::progress::LoopRunEstimate;
+use crate::study::TestData;
 use crate::study::execute::Observer;
 use impactcal_runner::Runner;
 
@@ -99,8 +99,8 @@ pub use noise_floor::NoiseFloor;
 pub use nuisance::Nuisance;
 pub use options::LoopOptions;
 pub use plan::{LoopShapes, estimated_peak};
-pub use setup::check_inputs;
 pub use result::{Added, ErrorSummary, Errors, LoopResult, ModelScore, Round, Stages, Verdict};
+pub use setup::check_inputs;
 
 use fit::Journaled;
 

@@ -46,8 +46,8 @@ use super::detection::{Detection, chi2_quantile, detect};
 use super::fit::{Ctx, Fit, calibrate};
 use super::options::LoopOptions;
 use super::result::{ModelScore, Round};
-use crate::progress::LoopRunEstimate;
 use crate::error::Result;
+use crate::progress::LoopRunEstimate;
 
 /// What forward selection ends with.
 pub(crate) struct Outcome {

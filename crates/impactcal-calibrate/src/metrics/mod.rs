@@ -19,8 +19,7 @@ mod pointwise;
 
 pub use compare::{
     ChannelMetrics, ChannelPair, CompareOptions, Comparison, CurveMetrics, Dropped, MeanIso,
-    MeanTriple,
-    Overall, compare,
+    MeanTriple, Overall, compare,
 };
 pub use energy::{Russell, SpragueGeers};
 pub use iso18571::{Grade, ISO18571_DT, Iso18571, Iso18571Rating};

@@ -30,7 +30,9 @@ pub fn progress_lines(stderr: &str) -> Vec<(usize, usize, String)> {
         .lines()
         .filter_map(|l| {
             let rest = l.strip_prefix("impactcal: [")?;
-            let (head, text) = rest.split_once("] ").unwrap_or((rest.trim_end_matches(']'), ""));
+            let (head, text) = rest
+                .split_once("] ")
+                .unwrap_or((rest.trim_end_matches(']'), ""));
             let counts = head.split(" runs").next()?;
             let (done, planned) = counts.split_once('/')?;
             Some((done.parse().ok()?, planned.parse().ok()?, text.to_string()))
