@@ -321,7 +321,7 @@ impl Progress {
         b.overall.set_length(planned as u64);
         b.overall.set_position(done as u64);
         b.overall.set_message(match tracker.time_left(now) {
-            Some(t) if done < planned => left(t),
+            Some(t) if done < planned => format!(", {}", left(t)),
             _ => String::new(),
         });
         match tracker.current() {
@@ -356,7 +356,7 @@ fn bars() -> Bars {
     };
     let overall = multi.add(ProgressBar::new(0));
     overall.set_style(style(
-        "overall [{bar:30}] {pos}/{len} runs, {elapsed} so far, {msg}",
+        "overall [{bar:30}] {pos}/{len} runs, {elapsed} so far{msg}",
     ));
     let stage = multi.add(ProgressBar::new(0));
     stage.set_style(style("  stage [{bar:30}] {pos}/{len} runs: {msg}"));
