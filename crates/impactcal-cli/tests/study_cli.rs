@@ -365,57 +365,11 @@ fn a_study_on_the_process_pool_killed_and_resumed_is_identical() {
     let dir = tempfile::tempdir().unwrap();
     let whole = dir.path().join("whole");
     let out = study(&config, &whole);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
-    // Progress off a terminal: the plan (1 nominal + 3 jitter + 160 ensemble + 6
-    // reconciliation runs), a line per stage of runs in words, a line per step, a last line.
-    let lines = progress_lines(&err);
-    let stages: Vec<&str> = lines
-        .iter()
-        .filter(|(_, _, t)| t.ends_with(" runs"))
-        .map(|(_, _, t)| t.as_str())
-        .collect();
-    assert_eq!(
-        stages,
-        [
-            "nominal run: 0/1 runs",
-            "jitter ensemble (the model's own noise): 0/3 runs",
-            "ensemble over the parameter space: 0/160 runs",
-            "reconciliation, CORS-RBF search: 0/6 runs",
-        ],
-        "{err}"
-    );
-    let steps: Vec<&str> = lines.iter().map(|(_, _, t)| t.as_str()).collect();
-    for step in [
-        "M1",
-        "sensor placement",
-        "M2",
-        "surrogates",
-        "sensitivity",
-        "before and after",
-    ] {
-        assert_eq!(
-            steps.iter().filter(|t| **t == step).count(),
-            1,
-            "{step}: {err}"
-        );
-    }
     assert!(
-        lines
-            .iter()
-            .all(|(done, planned, _)| done <= planned && *planned == 170),
-        "{err}"
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
-    let last = lines.last().unwrap();
-    assert_eq!((last.0, last.1), (170, 170), "{err}");
-    assert!(last.2.starts_with("in "), "{err}");
-    // The memory plan's line and the notes are steps too.
-    assert!(
-        steps[1].starts_with("memory: the study plans about"),
-        "{err}"
-    );
-    let notes = steps.iter().filter(|t| t.starts_with("note: ")).count();
-    assert_eq!(lines.len(), stages.len() + 7 + notes + 1, "{err}");
     let killed = dir.path().join("killed");
     let journal = killed.join("runs/ensemble/journal.jsonl");
     let done = kill_study_after(&config, &killed, &journal, 8);
