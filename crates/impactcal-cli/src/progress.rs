@@ -358,6 +358,8 @@ fn bars() -> Bars {
     overall.set_style(style(
         "overall [{bar:30}] {pos}/{len} runs, {elapsed} so far{msg}",
     ));
+    // The elapsed time moves while a long run holds every count still.
+    overall.enable_steady_tick(Duration::from_secs(1));
     let stage = multi.add(ProgressBar::new(0));
     stage.set_style(style("  stage [{bar:30}] {pos}/{len} runs: {msg}"));
     Bars {
