@@ -229,7 +229,7 @@ mod tests {
             None,
         );
         assert!(
-            e.contains("candidate `z`") && e.contains("it lists: c, m"),
+            e.contains("candidate `z`") && e.contains("the closest it lists: `c`, `m` (of 2)"),
             "{e}"
         );
         let e = message(
