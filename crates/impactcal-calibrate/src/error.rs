@@ -95,6 +95,28 @@ pub enum CalibrateError {
     /// From the runner that executes a study's runs (its journal, its executor).
     #[error(transparent)]
     Runner(#[from] impactcal_runner::RunnerError),
+    /// The test's record does not cover the model's window (the test is compared on the
+    /// model's time points and is never extrapolated).
+    #[error(
+        "the test record covers [{}, {}] s but the model's window is [{}, {}] s; the test \
+         must cover the whole window: {advice}",
+        to_ns(*test_start),
+        to_ns(*test_end),
+        to_ns(*model_start),
+        to_ns(*model_end)
+    )]
+    TestShorterThanModel {
+        /// First time of the test's record.
+        test_start: f64,
+        /// Last time of the test's record.
+        test_end: f64,
+        /// First time of the model's window.
+        model_start: f64,
+        /// Last time of the model's window.
+        model_end: f64,
+        /// What to change (the key that sets the model's window, where one is known).
+        advice: String,
+    },
     /// A stage whose memory estimate, beside what the process holds, exceeds the limit (the
     /// user's, or what the machine can still give): stopped before it allocates.
     #[error(
@@ -118,6 +140,12 @@ pub enum CalibrateError {
         /// What the stage's size grows with, and what to change.
         advice: String,
     },
+}
+
+/// A time in seconds rounded to the nanosecond, as messages print it (`0.0028`, not
+/// `0.0027999999999999995`).
+pub(crate) fn to_ns(t: f64) -> f64 {
+    (t * 1e9).round() / 1e9
 }
 
 /// `Result` with [`CalibrateError`].
@@ -162,6 +190,7 @@ impl CalibrateError {
             | CalibrateError::Report { .. }
             | CalibrateError::Study { .. }
             | CalibrateError::ForeignJournal { .. }
+            | CalibrateError::TestShorterThanModel { .. }
             | CalibrateError::Memory { .. } => ErrorKind::BadInput,
             CalibrateError::Render { .. } => ErrorKind::Numerical,
             CalibrateError::Shapes(e) => e.kind(),

@@ -75,6 +75,7 @@ pub mod closeloop;
 pub mod error;
 pub mod memory;
 pub mod metrics;
+pub mod progress;
 pub mod report;
 pub mod study;
 

@@ -231,6 +231,38 @@ impl Guard {
     }
 }
 
+/// Bytes a stage of runs holds per run beside the runs' histories, at least: the run's
+/// point (`8 d` bytes and a vector's 24), and its record in the runner (the result file's
+/// path and unit, the run's state: 232 bytes taken for them).
+pub(crate) fn run_record_bytes(dim: usize) -> u64 {
+    8 * dim as u64 + 256
+}
+
+/// Checks, before any run, that a stage of each of `counts` runs (`(option, runs)`, the
+/// option named as the message names it, e.g. `loop.jitter_runs`) can hold its points and
+/// run records ([`run_record_bytes`] for `dim` parameters) within `guard`'s limit.
+///
+/// # Errors
+/// [`CalibrateError::Memory`] naming the option and its value, the bytes, and what to
+/// change.
+pub(crate) fn check_run_counts(guard: Guard, counts: &[(&str, usize)], dim: usize) -> Result<()> {
+    for (option, runs) in counts {
+        let bytes = (*runs as u64).saturating_mul(run_record_bytes(dim));
+        guard.check(&Need {
+            stage: format!("{option} = {runs}"),
+            bytes,
+            advice: format!(
+                "a stage of {runs} runs holds at least {} for its points and run records \
+                 ({} bytes a run) before any run writes a value: give {option} a number of \
+                 runs the machine can hold",
+                human(bytes),
+                run_record_bytes(dim)
+            ),
+        })?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {

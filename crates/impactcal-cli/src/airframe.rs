@@ -67,7 +67,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let airframe = Airframe::new(options)?;
     let mut values = AirframeValues::nominal();
     for a in &args.set {
-        values.assign(a)?;
+        values.assign_in_range(a)?;
     }
     if let Some(path) = &args.out {
         let model = airframe.model(&values)?;

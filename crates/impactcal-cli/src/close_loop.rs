@@ -4,12 +4,14 @@
 use impactcal::calibrate::closeloop::{LoopResult, Verdict};
 
 use crate::error::CliError;
+use crate::progress::Progress;
 use crate::simulate::thread_pool;
-use crate::study::{Args, Progress};
+use crate::study::Args;
 
 /// Runs `impactcal close-loop`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let experiment = args.experiment()?;
+    crate::output::check_out_folder(&args.out)?;
     let progress = Progress::new();
     let done =
         thread_pool(args.threads)?.install(|| experiment.close_loop_with(&args.out, &progress));

@@ -22,8 +22,8 @@ use serde::Serialize;
 
 use crate::error::CliError;
 use crate::output::write_text;
+use crate::progress::Progress;
 use crate::simulate::thread_pool;
-use crate::study::Progress;
 
 /// The demo's window (s): the airframe is predictable over it (docs/airframe.md,
 /// "Predictability"); later, its own noise grows by e every 4 ms.
@@ -125,11 +125,37 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let started = Instant::now();
     let pool = thread_pool(args.threads)?;
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| CliError::io(format!("{}: {e}", args.out.display())))?;
+    crate::output::out_folder(&args.out)?;
     let mut options = AirframeOptions::new(MeshDensity::Coarse);
     options.end_time = END_TIME;
     let airframe = Airframe::new(options)?;
+    // Every option of both studies, before the test's run and Table 1's runs.
+    let table1 = StudyOptions {
+        halton_runs: args.table1_runs,
+        screen_only: true,
+        ..StudyOptions::default()
+    }
+    .check()
+    .map_err(|e| CliError::from(e).context("demo, Table 1"))?;
+    let table2 = StudyOptions {
+        halton_runs: args.table2_runs,
+        sensors: args.sensors,
+        shapes: 10.min(args.sensors),
+        sensitivity_samples: args.sensitivity_samples,
+        reconcile_runs: args.reconcile_runs,
+        ..StudyOptions::default()
+    }
+    .check()
+    .map_err(|e| CliError::from(e).context("demo, Table 2"))?;
+    let channels = airframe.sensor_labels().len();
+    if args.sensors > channels {
+        return Err(CliError::input(format!(
+            "--sensors {}: the coarse airframe has {channels} sensor channels, and Table 2 \
+             places sensors on those of them its model predicts; give at most {channels} \
+             (the source paper: 41)",
+            args.sensors
+        )));
+    }
     let names: Vec<String> = catalogue().into_iter().map(|a| a.name).collect();
     let full = space_of(&names)?;
     let model = AirframeModel::new(airframe.clone(), full.clone())?;
@@ -164,21 +190,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
         crate::output::print_finished(&done, "");
         Ok(done.result)
     };
-    let table1 = StudyOptions {
-        halton_runs: args.table1_runs,
-        screen_only: true,
-        ..StudyOptions::default()
-    }
-    .check()?;
-    let table2 = StudyOptions {
-        halton_runs: args.table2_runs,
-        sensors: args.sensors,
-        shapes: 10.min(args.sensors),
-        sensitivity_samples: args.sensitivity_samples,
-        reconcile_runs: args.reconcile_runs,
-        ..StudyOptions::default()
-    }
-    .check()?;
     eprintln!(
         "impactcal: Table 1 ({} runs): does M1 let this parameter set explain the test?",
         table1.halton_runs

@@ -9,7 +9,9 @@ use std::path::Path;
 use std::time::Instant;
 
 use impactcal::calibrate::closeloop::document::report;
-use impactcal::calibrate::closeloop::{Holdout, LoopOptions, LoopResult, run_loop_on};
+use impactcal::calibrate::closeloop::{
+    Holdout, LoopOptions, LoopResult, check_inputs, run_loop_on,
+};
 use impactcal::calibrate::report::{Block, Section, Table};
 use impactcal::calibrate::study::TestData;
 use impactcal::core::synthetic::{Measurement, measured};
@@ -20,8 +22,8 @@ use serde::Serialize;
 use crate::demo::Args;
 use crate::error::CliError;
 use crate::output::write_text;
+use crate::progress::Progress;
 use crate::simulate::thread_pool;
-use crate::study::Progress;
 
 /// The loop demo's window (s): the window of the coarse-airframe loop test. Over 25 ms
 /// the declared thicknesses, calibrated first, take up more of the damping's signature
@@ -123,11 +125,36 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         return Err(CliError::input("--channels: at least one sensor channel"));
     }
     let pool = thread_pool(args.threads)?;
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| CliError::io(format!("{}: {e}", args.out.display())))?;
+    crate::output::out_folder(&args.out)?;
     let mut o = AirframeOptions::new(MeshDensity::Coarse);
     o.end_time = args.end_time;
-    let model = AirframeModel::preset(Airframe::new(o)?, Preset::Table2)?;
+    let airframe = Airframe::new(o)?;
+    let vertical = airframe
+        .sensor_labels()
+        .iter()
+        .filter(|l| l.ends_with(".z"))
+        .count();
+    if args.channels > vertical {
+        return Err(CliError::input(format!(
+            "--channels {}: the coarse airframe has {vertical} vertical sensor channels; give \
+             at most {vertical}",
+            args.channels
+        )));
+    }
+    let model = AirframeModel::preset(airframe, Preset::Table2)?;
+    // Every option the loop checks, before the test's runs.
+    let options = LoopOptions {
+        ensemble: args.loop_ensemble,
+        reconcile: args.loop_reconcile,
+        recalibrate: args.loop_recalibrate,
+        max_added: args.max_added,
+        min_explained: args.loop_min_explained,
+        polish: args.loop_polish,
+        candidates: args.candidates.clone(),
+        seed: 1,
+        ..LoopOptions::default()
+    };
+    check_inputs(&model, &options).map_err(|e| CliError::from(e).context("demo --close-loop"))?;
     let truth = model.at_condition(&[("damping".into(), HIDDEN_DAMPING)])?;
     let speed = [("impact.vertical".to_string(), HOLDOUT_SPEED)];
     let x = model.space().nominal();
@@ -187,17 +214,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     test.write_csv(args.out.join("test.csv"))?;
     holdout.write_csv(args.out.join("holdout.csv"))?;
 
-    let options = LoopOptions {
-        ensemble: args.loop_ensemble,
-        reconcile: args.loop_reconcile,
-        recalibrate: args.loop_recalibrate,
-        max_added: args.max_added,
-        min_explained: args.loop_min_explained,
-        polish: args.loop_polish,
-        candidates: args.candidates.clone(),
-        seed: 1,
-        ..LoopOptions::default()
-    };
     let description = format!(
         "built-in airframe, coarse mesh, 0-{} s, Table2 declared",
         args.end_time
@@ -207,8 +223,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
          {HOLDOUT_SPEED})",
         channels.len()
     );
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| CliError::io(format!("{}: {e}", args.out.display())))?;
     let progress = Progress::new();
     let result = pool.install(|| {
         let test = TestData {

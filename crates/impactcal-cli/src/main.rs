@@ -19,6 +19,7 @@ mod noise;
 mod optimize;
 mod output;
 mod place;
+mod progress;
 mod sample;
 mod samples;
 mod shapes;

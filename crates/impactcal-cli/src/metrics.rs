@@ -56,6 +56,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ..CompareOptions::default()
     };
     let comparison = compare(&test, &model, &pairs, &options)?;
+    if let Some(w) = comparison.dropped.warning(pairs.len()) {
+        eprintln!("impactcal: warning: {w}");
+    }
     if let Some((t0, t1)) = window {
         let [u0, u1] = comparison.window;
         if u0 - t0 > comparison.dt || t1 - u1 > comparison.dt {

@@ -48,6 +48,39 @@ pub fn writer(out: Option<&Path>) -> Result<(Box<dyn Write>, String), CliError> 
     }
 }
 
+/// Refuses an output folder `out` that names a file (or lies under one), before anything
+/// runs.
+///
+/// # Errors
+/// Exit 2, saying which path is a file and what `--out` takes.
+pub fn check_out_folder(out: &Path) -> Result<(), CliError> {
+    let file = out
+        .ancestors()
+        .find(|a| !a.as_os_str().is_empty() && a.is_file());
+    match file {
+        Some(f) => Err(CliError::input(format!(
+            "--out {}: {} is a file; --out names a folder (created if needed) that will hold \
+             the run journal, the JSON and the report",
+            out.display(),
+            if f == out {
+                "it".to_string()
+            } else {
+                f.display().to_string()
+            }
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Creates the output folder `out` (and its parents) if needed.
+///
+/// # Errors
+/// As [`check_out_folder`]; an I/O error when the folder cannot be created.
+pub fn out_folder(out: &Path) -> Result<(), CliError> {
+    check_out_folder(out)?;
+    std::fs::create_dir_all(out).map_err(|e| CliError::io(format!("{}: {e}", out.display())))
+}
+
 /// Prints a finished study's or loop's lead lines (its verdicts in a few sentences) on
 /// standard error, then `<prefix>wrote <json> and <report.html>`.
 pub fn print_finished<R>(done: &impactcal::experiment::Finished<R>, prefix: &str) {

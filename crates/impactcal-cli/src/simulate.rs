@@ -87,7 +87,7 @@ impl Source {
         let airframe = Airframe::new(options)?;
         let mut values = AirframeValues::nominal();
         for a in &self.set {
-            values.assign(a)?;
+            values.assign_in_range(a)?;
         }
         Ok((airframe, values))
     }

@@ -3,17 +3,14 @@
 //! executors run for a study's and a loop's runs alike). The file's schema, the model
 //! assembly and the study live in the library (`impactcal::experiment`; docs/study.md).
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::sync::Mutex;
 
 use clap::Args as ClapArgs;
-use impactcal::calibrate::study::Observer;
 use impactcal::experiment::{Experiment, POINT_OUTPUT, read_record};
 use impactcal::runner::Cancel;
-use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::error::CliError;
+use crate::progress::Progress;
 use crate::simulate::thread_pool;
 
 /// Arguments of `impactcal study` and `impactcal close-loop`.
@@ -55,6 +52,7 @@ pub fn stop_on_ctrl_c(cancel: Cancel) {
 /// Runs `impactcal study`.
 pub fn run(args: Args) -> Result<(), CliError> {
     let experiment = args.experiment()?;
+    crate::output::check_out_folder(&args.out)?;
     let progress = Progress::new();
     let done = thread_pool(args.threads)?.install(|| experiment.study_with(&args.out, &progress));
     progress.done();
@@ -89,70 +87,4 @@ pub fn run_point(args: PointArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::from(e).context(args.params.display()))?;
     h.write_csv(&args.out)?;
     Ok(())
-}
-
-/// Progress on stderr: a bar per stage of runs on a terminal, a line per stage otherwise.
-pub struct Progress {
-    bar: Mutex<Option<ProgressBar>>,
-    terminal: bool,
-}
-
-impl Progress {
-    /// A progress display for this process's stderr.
-    pub fn new() -> Progress {
-        Progress {
-            bar: Mutex::new(None),
-            terminal: std::io::stderr().is_terminal(),
-        }
-    }
-
-    /// Finishes the current bar.
-    pub fn done(&self) {
-        if let Ok(mut b) = self.bar.lock()
-            && let Some(bar) = b.take()
-        {
-            bar.finish();
-        }
-    }
-}
-
-impl Observer for Progress {
-    fn stage(&self, name: &str, total: usize, reused: usize) {
-        self.done();
-        let reuse = if reused > 0 {
-            format!(" ({reused} from the journal)")
-        } else {
-            String::new()
-        };
-        if !self.terminal {
-            eprintln!("impactcal: {name}: {total} runs{reuse}");
-            return;
-        }
-        let bar = ProgressBar::new(total as u64);
-        if let Ok(style) =
-            ProgressStyle::with_template("{msg:>10} [{bar:40}] {pos}/{len} runs {elapsed}")
-        {
-            bar.set_style(style.progress_chars("=> "));
-        }
-        bar.set_message(name.to_string());
-        bar.set_position(reused as u64);
-        if let Ok(mut b) = self.bar.lock() {
-            *b = Some(bar);
-        }
-    }
-
-    fn run_finished(&self) {
-        if let Ok(b) = self.bar.lock()
-            && let Some(bar) = b.as_ref()
-        {
-            bar.inc(1);
-        }
-    }
-
-    fn step(&self, name: &str) {
-        self.done();
-        if !self.terminal {
-            eprintln!("impactcal: {name}");
-        }
-    }
 }

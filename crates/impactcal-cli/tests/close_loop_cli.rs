@@ -8,7 +8,7 @@ mod common;
 
 use std::path::Path;
 
-use common::impactcal;
+use common::{impactcal, impactcal_with, progress_lines};
 use impactcal::core::drop_tower::DropTower;
 use impactcal::core::synthetic::{Measurement, measured};
 use impactcal::core::{Enrichable, Model};
@@ -48,7 +48,11 @@ fn config(dir: &Path, text: &str) -> String {
 /// returns its `loop.json` and what it printed on stderr.
 fn close_loop(cfg: &str, out: &Path) -> (serde_json::Value, String) {
     let out = out.to_str().unwrap();
-    let o = impactcal(&["close-loop", "--config", cfg, "--out", out]);
+    // No periodic progress lines: the lines are counted.
+    let o = impactcal_with(
+        &["close-loop", "--config", cfg, "--out", out],
+        &[("IMPACTCAL_PROGRESS_SECONDS", "1e6")],
+    );
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert!(o.status.success(), "{err}");
     let text = std::fs::read_to_string(Path::new(out).join("loop.json")).unwrap();
@@ -82,6 +86,74 @@ fn finds_the_hidden_damping_and_writes_the_report() {
     assert!(v["runs"].as_u64().unwrap() > 20);
     assert!(out.join("report.html").exists() && out.join("report.md").exists());
     assert!(err.contains("verdict: attributed"));
+    progress_tells_the_story(&err, &out, v["runs"].as_u64().unwrap() as usize);
+}
+
+/// Whether a progress text is a stage of runs: `<title>: <done>/<total> runs[ (...)]`.
+fn is_stage(text: &str) -> bool {
+    text.rsplit_once(": ").is_some_and(|(_, counts)| {
+        counts
+            .split_once(" runs")
+            .and_then(|(c, _)| c.split_once('/'))
+            .is_some_and(|(a, b)| a.parse::<usize>().is_ok() && b.parse::<usize>().is_ok())
+    })
+}
+
+/// The loop's progress off a terminal: a line per stage of runs (one per journal stage, a
+/// stage run in parts counted once) and per step, stages in words (no journal name), runs
+/// done never past runs planned nor going back, and the last count the loop's runs; the
+/// verdict on a line of its own after them.
+fn progress_tells_the_story(err: &str, out: &Path, runs: usize) {
+    let lines = progress_lines(err);
+    let mut stages = std::collections::BTreeSet::new();
+    for entry in std::fs::read_dir(out.join("runs")).unwrap() {
+        let entry = entry.unwrap();
+        if !entry.file_type().unwrap().is_dir() {
+            continue;
+        }
+        let name = entry.file_name().to_string_lossy().to_string();
+        // A stage run in parts: `<stage>-<first run>` after the first part.
+        let whole = match name.rsplit_once('-') {
+            Some((stage, first)) if stage.ends_with("cors") && first.parse::<usize>().is_ok() => {
+                stage.to_string()
+            }
+            _ => name,
+        };
+        stages.insert(whole);
+    }
+    let stage_lines: Vec<&(usize, usize, String)> =
+        lines.iter().filter(|(_, _, t)| is_stage(t)).collect();
+    assert_eq!(stage_lines.len(), stages.len(), "{stages:?}\n{err}");
+    for (_, _, text) in &lines {
+        assert!(!text.contains("-gn") && !text.contains("r0-"), "{text}");
+    }
+    assert!(
+        stage_lines
+            .iter()
+            .any(|(_, _, t)| t.starts_with("calibration, Gauss-Newton step 1, Jacobian: 0/2 runs")),
+        "{err}"
+    );
+    assert!(
+        stage_lines
+            .iter()
+            .any(|(_, _, t)| t.starts_with("calibration, CORS-RBF search: 0/24 runs")),
+        "{err}"
+    );
+    let mut before = 0;
+    for (done, planned, text) in &lines {
+        assert!(done <= planned, "{done}/{planned} {text}");
+        assert!(*done >= before, "{text}");
+        before = *done;
+    }
+    let last = lines.last().unwrap();
+    assert_eq!((last.0, last.1), (runs, runs), "{err}");
+    assert!(last.2.starts_with("in "), "{err}");
+    assert_eq!(
+        lines.first().map(|l| l.2.as_str()),
+        Some("nominal run: 0/1 runs")
+    );
+    let verdict = err.lines().find(|l| l.contains("verdict:")).unwrap();
+    assert!(verdict.starts_with("verdict: attributed"), "{verdict}");
 }
 
 #[test]
@@ -188,7 +260,7 @@ fn a_memory_limit_below_the_plan_stops_the_loop_before_its_stages() {
     assert!(o.status.success(), "{err}");
     assert!(err.contains("memory: the loop plans about"), "{err}");
     assert!(
-        err.contains("nominal: 1 runs (1 from the journal)"),
+        err.contains("nominal run: 0/1 runs (1 from the journal)"),
         "{err}"
     );
 }

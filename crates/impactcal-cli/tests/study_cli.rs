@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{example_file, impactcal};
+use common::{example_file, impactcal, impactcal_with, progress_lines};
 
 /// Writes a study file and the strip deck's nominal histories (the test) into `dir`.
 fn strip_study(dir: &Path, study: &str) -> PathBuf {
@@ -56,7 +56,8 @@ fn study_with(config: &Path, out: &Path, extra: &[&str]) -> std::process::Output
         out.to_str().unwrap(),
     ];
     args.extend_from_slice(extra);
-    impactcal(&args)
+    // No periodic progress lines: the lines are counted.
+    impactcal_with(&args, &[("IMPACTCAL_PROGRESS_SECONDS", "1e6")])
 }
 
 /// The results a runner journal records (complete lines only).
@@ -80,11 +81,57 @@ fn a_killed_study_resumes_to_the_uninterrupted_result() {
     let config = strip_study(dir.path(), STRIP);
     let whole = dir.path().join("whole");
     let out = study(&config, &whole);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    // Progress off a terminal: the plan (1 nominal + 3 jitter + 160 ensemble + 6
+    // reconciliation runs), a line per stage of runs in words, a line per step, a last line.
+    let lines = progress_lines(&err);
+    let stages: Vec<&str> = lines
+        .iter()
+        .filter(|(_, _, t)| t.ends_with(" runs"))
+        .map(|(_, _, t)| t.as_str())
+        .collect();
+    assert_eq!(
+        stages,
+        [
+            "nominal run: 0/1 runs",
+            "jitter ensemble (the model's own noise): 0/3 runs",
+            "ensemble over the parameter space: 0/160 runs",
+            "reconciliation, CORS-RBF search: 0/6 runs",
+        ],
+        "{err}"
     );
+    let steps: Vec<&str> = lines.iter().map(|(_, _, t)| t.as_str()).collect();
+    for step in [
+        "M1",
+        "sensor placement",
+        "M2",
+        "surrogates",
+        "sensitivity",
+        "before and after",
+    ] {
+        assert_eq!(
+            steps.iter().filter(|t| **t == step).count(),
+            1,
+            "{step}: {err}"
+        );
+    }
+    assert!(
+        lines
+            .iter()
+            .all(|(done, planned, _)| done <= planned && *planned == 170),
+        "{err}"
+    );
+    let last = lines.last().unwrap();
+    assert_eq!((last.0, last.1), (170, 170), "{err}");
+    assert!(last.2.starts_with("in "), "{err}");
+    // The memory plan's line and the notes are steps too.
+    assert!(
+        steps[1].starts_with("memory: the study plans about"),
+        "{err}"
+    );
+    let notes = steps.iter().filter(|t| t.starts_with("note: ")).count();
+    assert_eq!(lines.len(), stages.len() + 7 + notes + 1, "{err}");
 
     let killed = dir.path().join("killed");
     let done = kill_study_after(
@@ -347,7 +394,9 @@ fn a_study_on_the_process_pool_killed_and_resumed_is_identical() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
-        stderr.contains(&format!("ensemble: 40 runs ({done} from the journal)")),
+        stderr.contains(&format!(
+            "ensemble over the parameter space: 0/40 runs ({done} from the journal)"
+        )),
         "{stderr}"
     );
     let a = std::fs::read_to_string(whole.join("study.json")).unwrap();

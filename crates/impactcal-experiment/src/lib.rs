@@ -33,6 +33,7 @@ pub mod schema;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use impactcal_calibrate::CalibrateError;
 use impactcal_calibrate::closeloop::{Holdout, LoopOptions, LoopResult, run_loop_on};
 use impactcal_calibrate::report::{Report, ReportFiles};
 use impactcal_calibrate::study::document::Geometry;
@@ -240,6 +241,95 @@ impl Experiment {
         })
     }
 
+    /// What sets the model's window, and its end where the file gives it before any run:
+    /// the airframe's `[model] end_time` (default 0.08 s), an external solver's
+    /// `[solver.output] end_time`; a deck's `*CONTROL_TERMINATION` and the drop tower's
+    /// fixed window are known once the model runs.
+    fn window(&self) -> (String, Option<f64>) {
+        match &self.spec {
+            ModelSpec::Airframe { end_time, .. } => (
+                "`[model] end_time`".into(),
+                Some(
+                    end_time.unwrap_or(
+                        impactcal_shell::airframe::AirframeOptions::new(
+                            impactcal_shell::airframe::MeshDensity::Coarse,
+                        )
+                        .end_time,
+                    ),
+                ),
+            ),
+            ModelSpec::External { solver, .. } => (
+                "the template's end time and `[solver.output] end_time`".into(),
+                solver.output.end_time,
+            ),
+            ModelSpec::Deck { path, .. } => (
+                format!(
+                    "the end time of `*CONTROL_TERMINATION` in {}",
+                    path.display()
+                ),
+                None,
+            ),
+            _ => ("(the model's window is fixed)".into(), None),
+        }
+    }
+
+    /// The advice of a test that does not cover the model's window, naming what sets the
+    /// window in this file.
+    fn window_advice(&self, test_end: f64) -> String {
+        let end = (test_end * 1e9).round() / 1e9;
+        match self.window() {
+            (key, _) if key.starts_with('(') => {
+                format!("give a record that reaches the model's end {key}")
+            }
+            (key, _) => format!("set {key} to at most {end} s, or give a longer record"),
+        }
+    }
+
+    /// Refuses, before any run, a test whose record ends before the model's window where
+    /// the file gives the window's end ([`Experiment::window`]); fills in the advice of a
+    /// study's or loop's [`CalibrateError::TestShorterThanModel`] otherwise.
+    fn check_window(&self, test: &Histories) -> Result<()> {
+        let test_end = test.start() + test.samples().saturating_sub(1) as f64 * test.dt();
+        match self.window() {
+            (_, Some(end)) if test_end < end - 1e-6 * test.dt() => {
+                Err(self.in_window(CalibrateError::TestShorterThanModel {
+                    test_start: test.start(),
+                    test_end,
+                    model_start: 0.0,
+                    model_end: end,
+                    advice: String::new(),
+                }))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// `e` as an error of this file; a test shorter than the model's window with this
+    /// file's advice.
+    fn in_window(&self, e: CalibrateError) -> ExperimentError {
+        let e = match e {
+            CalibrateError::TestShorterThanModel {
+                test_start,
+                test_end,
+                model_start,
+                model_end,
+                advice,
+            } => CalibrateError::TestShorterThanModel {
+                test_start,
+                test_end,
+                model_start,
+                model_end,
+                advice: if test_end < model_end {
+                    self.window_advice(test_end)
+                } else {
+                    advice
+                },
+            },
+            other => other,
+        };
+        ExperimentError::from(e).in_section(&self.name, "test")
+    }
+
     /// Runs the study in `out` (created if needed; a journal there of the same study is
     /// reused) and writes `study.json` and the report.
     ///
@@ -258,6 +348,7 @@ impl Experiment {
         let options = self.study_options()?;
         let built = self.build()?;
         let measured = self.measured()?;
+        self.check_window(&measured.test)?;
         notify(observer, built.notes.iter().chain(&measured.notes));
         let runner = self.study_runner(&built)?;
         std::fs::create_dir_all(out).map_err(io(out))?;
@@ -284,7 +375,10 @@ impl Experiment {
                 "an external solver needs an executor",
             )),
         }
-        .map_err(|e| ExperimentError::from(e).in_section(&self.name, "study"))?;
+        .map_err(|e| match e {
+            CalibrateError::TestShorterThanModel { .. } => self.in_window(e),
+            e => ExperimentError::from(e).in_section(&self.name, "study"),
+        })?;
         write_study(result, built.geometry.as_ref(), out)
     }
 
@@ -407,6 +501,7 @@ impl Experiment {
             });
         };
         let measured = self.measured()?;
+        self.check_window(&measured.test)?;
         notify(observer, built.notes.iter().chain(&measured.notes));
         let worker = self.worker()?;
         std::fs::create_dir_all(out).map_err(io(out))?;
@@ -429,7 +524,10 @@ impl Experiment {
             observer,
             worker.as_ref(),
         )
-        .map_err(|e| ExperimentError::from(e).in_section(&self.name, "loop"))?;
+        .map_err(|e| match e {
+            CalibrateError::TestShorterThanModel { .. } => self.in_window(e),
+            e => ExperimentError::from(e).in_section(&self.name, "loop"),
+        })?;
         write_loop(result, out)
     }
 

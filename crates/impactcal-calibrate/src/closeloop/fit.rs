@@ -29,6 +29,7 @@ use super::model_noise::ModelNoise;
 use super::nuisance::{self, Frame, Terms};
 use super::plan::Plan;
 use crate::error::{CalibrateError, Result};
+use crate::progress::LoopRunEstimate;
 use crate::study::execute::{Dispatch, Observer, Outcomes, Runs};
 use crate::study::reconcile;
 use impactcal_runner::Runner;
@@ -47,6 +48,8 @@ pub(crate) struct Journaled<'a> {
     pub condition: &'a [(String, f64)],
     /// The loop's memory plan, once the nominal run has given its shapes.
     pub plan: Option<&'a Plan>,
+    /// The loop's estimate of its runs, told to the observer as stages end.
+    pub estimate: Option<&'a LoopRunEstimate>,
 }
 
 impl<'a> Journaled<'a> {
@@ -58,17 +61,27 @@ impl<'a> Journaled<'a> {
         }
     }
 
+    /// Tells the observer the loop is estimated at the runs used so far and `rest` more
+    /// (`rest` from [`estimate`](Self::estimate); nothing without one).
+    pub fn replan(&self, rest: impl FnOnce(&LoopRunEstimate) -> usize) {
+        if let Some(e) = self.estimate {
+            self.observer.plan(self.used.get() + rest(e));
+        }
+    }
+
     /// Runs `points` of `model` as runs `first..` of journal stage `stage` (finished runs are
-    /// read back).
+    /// read back); `announce`: tell the observer a stage starts (else a part of the stage
+    /// announced last starts).
     ///
     /// # Errors
     /// Journal errors.
-    pub fn stage_from<M: Model>(
+    fn runs<M: Model>(
         &self,
         model: &M,
         stage: &str,
         first: usize,
         points: &[Vec<f64>],
+        announce: bool,
     ) -> Result<Outcomes> {
         if let Some(plan) = self.plan {
             plan.check(super::plan::RUNS, stage)?;
@@ -79,20 +92,31 @@ impl<'a> Journaled<'a> {
             condition: self.condition,
         };
         self.used.set(self.used.get() + points.len());
-        Runs::open(&exec, self.dir, self.fingerprint, self.observer)?.stage_from(
-            stage,
-            first,
-            points,
-            first == 0,
-        )
+        Runs::open(&exec, self.dir, self.fingerprint, self.observer)?
+            .stage_from(stage, first, points, announce)
     }
 
-    /// [`stage_from`](Self::stage_from) for a whole stage.
+    /// Runs `points` as runs `first..` of the stage `stage` run in parts, announced to the
+    /// observer beforehand with its whole size.
+    ///
+    /// # Errors
+    /// Journal errors.
+    pub fn part<M: Model>(
+        &self,
+        model: &M,
+        stage: &str,
+        first: usize,
+        points: &[Vec<f64>],
+    ) -> Result<Outcomes> {
+        self.runs(model, stage, first, points, false)
+    }
+
+    /// Runs `points` of `model` as the whole journal stage `stage`.
     ///
     /// # Errors
     /// Journal errors.
     pub fn stage<M: Model>(&self, model: &M, stage: &str, points: &[Vec<f64>]) -> Result<Outcomes> {
-        self.stage_from(model, stage, 0, points)
+        self.runs(model, stage, 0, points, true)
     }
 }
 
@@ -210,8 +234,9 @@ pub(crate) fn calibrate<M: Model>(
         let n = ctx.frame.test.len() as f64;
         let error = |h: &Histories| -> Result<f64> { Ok(ctx.profile(&ctx.y_of(h)?).1 / n) };
         let stage = format!("{prefix}-cors");
+        ctx.runner.observer.stage(&stage, budget, 0);
         let mut run = |first: usize, pts: &[Vec<f64>]| -> Result<Outcomes> {
-            ctx.runner.stage_from(model, &stage, first, pts)
+            ctx.runner.part(model, &stage, first, pts)
         };
         let best = reconcile::reconcile(
             space,

@@ -87,6 +87,7 @@ use std::path::Path;
 use impactcal_core::{Cfc, Enrichable, Histories};
 
 use crate::error::Result;
+use crate::progress::LoopRunEstimate;
 use crate::study::TestData;
 use crate::study::execute::Observer;
 use impactcal_runner::Runner;
@@ -99,6 +100,7 @@ pub use nuisance::Nuisance;
 pub use options::LoopOptions;
 pub use plan::{LoopShapes, estimated_peak};
 pub use result::{Added, ErrorSummary, Errors, LoopResult, ModelScore, Round, Stages, Verdict};
+pub use setup::check_inputs;
 
 use fit::Journaled;
 
@@ -168,6 +170,17 @@ pub fn run_loop_on<M: Enrichable>(
     let holdout_models = setup::checked_inputs(model, options, holdout)?;
     let fp = fingerprint(description, model.space(), options, test, holdout);
     let used = Cell::new(0usize);
+    let allowed = model
+        .candidates()
+        .iter()
+        .filter(|c| options.allows(c.name()))
+        .count();
+    let estimate = LoopRunEstimate::new(
+        options,
+        model.space().dim(),
+        allowed,
+        holdout_models.is_some(),
+    );
     let runner = Journaled {
         dir,
         fingerprint: &fp,
@@ -176,7 +189,9 @@ pub fn run_loop_on<M: Enrichable>(
         worker,
         condition: &[],
         plan: None,
+        estimate: Some(&estimate),
     };
+    runner.replan(|e| 1 + e.after_nominal());
     let nominal = setup::nominal(&runner, model, test)?;
     let threads = if worker.is_some() {
         0
@@ -239,6 +254,7 @@ pub fn run_loop_on<M: Enrichable>(
         nuisance: fit.terms.report(&nominal.labels, options.units_tolerance),
         noise_floor: setting.floor,
         test_preparation: nominal.preparation,
+        dropped: nominal.dropped,
         candidates,
         indistinguishable,
         added,

@@ -160,6 +160,10 @@ pub struct LoopResult {
     /// The masks and offsets applied to the test before any comparison.
     #[serde(default)]
     pub test_preparation: crate::study::channels::TestPreparation,
+    /// Channels of the test without a model channel and of the model without a test
+    /// channel: not compared.
+    #[serde(default)]
+    pub dropped: crate::metrics::Dropped,
     /// The first attribution's ranking.
     pub candidates: Vec<Score>,
     /// Candidate pairs these sensors cannot tell apart (first attribution).

@@ -49,6 +49,7 @@ use super::fit::{Ctx, Fit, calibrate};
 use super::options::LoopOptions;
 use super::result::{ModelScore, Round};
 use crate::error::Result;
+use crate::progress::LoopRunEstimate;
 
 /// What forward selection ends with.
 pub(crate) struct Outcome {
@@ -223,11 +224,15 @@ pub(crate) fn forward<M: Enrichable>(
             ControlFlow::Break(why) => break why,
         };
         let next_round = state.rounds.len();
+        let d = state.cur.space().dim();
+        ctx.runner
+            .replan(|e| e.recalibrations(d) + e.holdout_runs());
         let tried = selection.recalibrations(&state, p, best, next_round)?;
         if let Some(why) = selection.conclude(&mut state, tried, best, trial)? {
             break why;
         }
     };
+    ctx.runner.replan(LoopRunEstimate::holdout_runs);
     Ok(state.outcome(stopped))
 }
 
@@ -297,10 +302,22 @@ impl<M: Enrichable> Selection<'_, '_, M> {
     /// Those of [`attribute`].
     fn attribution(&self, state: &State<M>) -> Result<Option<Attribution>> {
         let r = state.rounds.len();
-        if r > 0 && !state.det.model_form_error {
+        let o = self.options;
+        let attributes = r == 0 || state.det.model_form_error;
+        let may_add = state.det.model_form_error && state.added.len() < o.max_added;
+        let allowed = state
+            .cur
+            .candidates()
+            .iter()
+            .filter(|c| o.allows(c.name()))
+            .count();
+        let d = state.cur.space().dim();
+        self.ctx
+            .runner
+            .replan(|e| e.rest_of_round(d, if attributes { allowed } else { 0 }, may_add));
+        if !attributes {
             return Ok(None);
         }
-        let o = self.options;
         self.ctx.runner.observer.step("attribution");
         attribute(
             self.ctx,

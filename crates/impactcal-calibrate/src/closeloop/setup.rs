@@ -4,6 +4,8 @@
 
 use impactcal_core::{ChannelMap, Enrichable, Histories};
 
+use crate::study::subspace::near;
+
 use super::Holdout;
 use super::fit::Journaled;
 use super::options::LoopOptions;
@@ -13,32 +15,38 @@ use crate::memory::Guard;
 use crate::study::TestData;
 use crate::study::channels::{TestPreparation, prepared_test};
 
-/// Checks the options against the model's space and candidates, and builds the model at
-/// the holdout's condition (returned beside the holdout).
+/// Checks a loop's options against `model` before any run: the options and run budgets
+/// ([`LoopOptions::check_budgets`] against the model's dimension), every candidate `options` names
+/// (one the model does not list is refused with the closest names it does list), and that
+/// at least one candidate is left to consider; and that a stage of each run count the
+/// options give can hold its points and run records in memory.
 ///
 /// # Errors
-/// [`LoopOptions::check_budgets`]'s errors; [`CalibrateError::Study`] for a candidate the model
-/// does not list, no candidate left to consider, a holdout condition
-/// the model cannot take.
-pub(super) fn checked_inputs<'h, M: Enrichable>(
-    model: &M,
-    options: &LoopOptions,
-    holdout: Option<Holdout<'h>>,
-) -> Result<Option<(Holdout<'h>, M)>> {
+/// [`LoopOptions::check_budgets`]'s errors; [`CalibrateError::Memory`] for a run count whose
+/// stage cannot be held; [`CalibrateError::Study`] for a candidate the model
+/// does not list or an empty candidate list.
+pub fn check_inputs<M: Enrichable>(model: &M, options: &LoopOptions) -> Result<()> {
     options.check_budgets(model.space().dim())?;
+    crate::memory::check_run_counts(
+        Guard::new(options.max_memory),
+        &[
+            ("loop.jitter_runs", options.ensemble),
+            ("loop.reconcile_runs", options.reconcile),
+            ("loop.recalibrate_runs", options.recalibrate),
+        ],
+        model.space().dim() + options.max_added,
+    )?;
     let listed = model.candidates();
-    if let Some(names) = &options.candidates {
-        for n in names {
-            if !listed.iter().any(|c| c.name() == n) {
+    let names: Vec<&str> = listed.iter().map(|c| c.name()).collect();
+    if let Some(asked) = &options.candidates {
+        for n in asked {
+            if !names.contains(&n.as_str()) {
                 return Err(CalibrateError::study(
                     format!("candidate `{n}`"),
                     format!(
-                        "not a candidate of the model (it lists: {})",
-                        listed
-                            .iter()
-                            .map(|c| c.name())
-                            .collect::<Vec<_>>()
-                            .join(", ")
+                        "not a candidate of the model; the closest it lists: {} (of {})",
+                        near(n, &names),
+                        names.len()
                     ),
                 ));
             }
@@ -50,6 +58,21 @@ pub(super) fn checked_inputs<'h, M: Enrichable>(
             "empty: the loop has no candidate effect to attribute a residual to",
         ));
     }
+    Ok(())
+}
+
+/// Checks the options against the model's space and candidates, and builds the model at
+/// the holdout's condition (returned beside the holdout).
+///
+/// # Errors
+/// As [`check_inputs`]; [`CalibrateError::Study`] for a holdout condition the model cannot
+/// take.
+pub(super) fn checked_inputs<'h, M: Enrichable>(
+    model: &M,
+    options: &LoopOptions,
+    holdout: Option<Holdout<'h>>,
+) -> Result<Option<(Holdout<'h>, M)>> {
+    check_inputs(model, options)?;
     holdout
         .map(|h| {
             let at = model.at_condition(h.set).map_err(|e| {
@@ -75,6 +98,8 @@ pub(super) struct Nominal {
     pub preparation: TestPreparation,
     /// The channels compared.
     pub labels: Vec<String>,
+    /// The channels of either side left out of the comparison.
+    pub dropped: crate::metrics::Dropped,
 }
 
 /// Runs the model at its nominal point (journal stage `nominal`) and prepares the test on
@@ -96,6 +121,10 @@ pub(super) fn nominal<M: Enrichable>(
     let (test_m, masks, preparation) =
         prepared_test(test.histories, test.map, test.cfc, &raw, None)?;
     let labels = test_m.labels().to_vec();
+    let dropped = crate::study::channels::dropped(test.histories, test.map, &raw)?;
+    if let Some(w) = dropped.warning(labels.len()) {
+        runner.observer.warning(&w);
+    }
     Ok(Nominal {
         point,
         raw,
@@ -103,6 +132,7 @@ pub(super) fn nominal<M: Enrichable>(
         masks,
         preparation,
         labels,
+        dropped,
     })
 }
 
@@ -199,7 +229,7 @@ mod tests {
             None,
         );
         assert!(
-            e.contains("candidate `z`") && e.contains("it lists: c, m"),
+            e.contains("candidate `z`") && e.contains("the closest it lists: `c`, `m` (of 2)"),
             "{e}"
         );
         let e = message(

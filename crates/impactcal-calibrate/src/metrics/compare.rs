@@ -1,5 +1,7 @@
 //! All metrics of a model against a test, channel by channel and over channels.
 
+use std::collections::BTreeSet;
+
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -275,6 +277,78 @@ pub struct Comparison {
     pub samples: usize,
     /// Time step of the comparison (the test's).
     pub dt: f64,
+    /// The channels of either side that no pair names: not compared.
+    pub dropped: Dropped,
+}
+
+/// The channels a comparison leaves out: the test's channels no pair names (measured data
+/// that is not compared) and the model's channels no pair names (outputs the test does not
+/// have), each in its file's order.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct Dropped {
+    /// Test channels without a model channel.
+    pub test: Vec<String>,
+    /// Model channels without a test channel.
+    pub model: Vec<String>,
+}
+
+impl Dropped {
+    /// The channels of `test` and `model` outside the pairs' labels.
+    pub fn of<'a>(
+        test: &[String],
+        model: &[String],
+        paired: impl Iterator<Item = (&'a str, &'a str)>,
+    ) -> Dropped {
+        let (paired_test, paired_model): (BTreeSet<&str>, BTreeSet<&str>) = paired.unzip();
+        let outside = |labels: &[String], paired: &BTreeSet<&str>| {
+            labels
+                .iter()
+                .filter(|l| !paired.contains(&l.as_str()))
+                .cloned()
+                .collect()
+        };
+        Dropped {
+            test: outside(test, &paired_test),
+            model: outside(model, &paired_model),
+        }
+    }
+
+    /// Whether nothing was left out.
+    pub fn is_empty(&self) -> bool {
+        self.test.is_empty() && self.model.is_empty()
+    }
+
+    /// The warning a person reads, `None` when nothing was left out: what was compared of
+    /// each side and the first names left out, e.g. "compared 3 of the test's 6 channels:
+    /// the test's `b`, `c`, `d` have no model channel (add them to the model's output or
+    /// map them with a channel map)".
+    pub fn warning(&self, compared: usize) -> Option<String> {
+        let names = |v: &[String]| {
+            let mut s: Vec<String> = v.iter().take(5).map(|l| format!("`{l}`")).collect();
+            if v.len() > 5 {
+                s.push(format!("and {} more", v.len() - 5));
+            }
+            s.join(", ")
+        };
+        let mut parts = Vec::new();
+        if !self.test.is_empty() {
+            parts.push(format!(
+                "compared {compared} of the test's {} channels: the test's {} have no model \
+                 channel (give the model that output, or pair them with a channel map)",
+                compared + self.test.len(),
+                names(&self.test)
+            ));
+        }
+        if !self.model.is_empty() {
+            parts.push(format!(
+                "{} of the model's {} channels are not in the test ({}) and are not compared",
+                self.model.len(),
+                self.model.len() + compared,
+                names(&self.model)
+            ));
+        }
+        (!parts.is_empty()).then(|| parts.join("; "))
+    }
 }
 
 /// Compares the model with the test on every channel pair: filters both sides with the same
@@ -357,6 +431,13 @@ pub fn compare(
         window: [t.start(), t.start() + (t.samples() - 1) as f64 * dt],
         samples: t.samples(),
         dt,
+        dropped: Dropped::of(
+            test.labels(),
+            model.labels(),
+            pairs
+                .iter()
+                .map(|p| (p.test_label.as_str(), p.model_label.as_str())),
+        ),
     })
 }
 

@@ -18,8 +18,8 @@ mod iso18571;
 mod pointwise;
 
 pub use compare::{
-    ChannelMetrics, ChannelPair, CompareOptions, Comparison, CurveMetrics, MeanIso, MeanTriple,
-    Overall, compare,
+    ChannelMetrics, ChannelPair, CompareOptions, Comparison, CurveMetrics, Dropped, MeanIso,
+    MeanTriple, Overall, compare,
 };
 pub use energy::{Russell, SpragueGeers};
 pub use iso18571::{Grade, ISO18571_DT, Iso18571, Iso18571Rating};

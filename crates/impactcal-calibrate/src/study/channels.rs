@@ -17,8 +17,8 @@ use crate::error::{CalibrateError, Result};
 ///
 /// # Errors
 /// [`CalibrateError::Study`] when the test shares no channel with the model; the map's
-/// and the filter's errors; `CoreError::OutsideModelTime` (read: the test does not cover
-/// the model's window) when the model's window reaches past the test's record.
+/// and the filter's errors; [`CalibrateError::TestShorterThanModel`] when the model's window
+/// reaches past the test's record.
 pub fn test_on_model(
     test: &Histories,
     map: Option<&ChannelMap>,
@@ -29,7 +29,35 @@ pub fn test_on_model(
 }
 
 /// A test already on the model's labels (`on_model_labels`) on the model's time points.
+///
+/// # Errors
+/// [`CalibrateError::TestShorterThanModel`] when the test's record does not cover the
+/// model's window (within a millionth of a step).
 fn window_of(on_labels: &Histories, model: &Histories) -> Result<Histories> {
+    let last = |h: &Histories| h.start() + (h.samples().saturating_sub(1)) as f64 * h.dt();
+    let (test_start, test_end) = (on_labels.start(), last(on_labels));
+    let (model_start, model_end) = (model.start(), last(model));
+    let slack = 1e-6 * model.dt().min(on_labels.dt());
+    if test_start > model_start + slack || test_end < model_end - slack {
+        return Err(CalibrateError::TestShorterThanModel {
+            test_start,
+            test_end,
+            model_start,
+            model_end,
+            advice: if test_end < model_end - slack {
+                format!(
+                    "end the model's window by {} s, or give a longer record",
+                    crate::error::to_ns(test_end)
+                )
+            } else {
+                format!(
+                    "start the model's window at {} s or later, or give a record that starts \
+                     earlier",
+                    crate::error::to_ns(test_start)
+                )
+            },
+        });
+    }
     let what = "the test against the model's window (the test must cover it)";
     Ok(interpolate_onto(
         on_labels,
@@ -93,6 +121,40 @@ fn lead_of(on_labels: &Histories, model: &Histories, most: usize) -> Result<Opti
 /// The test converted, filtered with `cfc` on its own time base, on the channels it shares
 /// with `model` (by label or through `map`, each divided by the map's gain), relabelled
 /// with the model's labels, in the model's channel order.
+/// The channels the study or loop leaves out of `test` (after the map's conversions) and
+/// of `model`: those no pair names (by label, or through the channel map).
+///
+/// # Errors
+/// The map's conversion errors.
+pub fn dropped(
+    test: &Histories,
+    map: Option<&ChannelMap>,
+    model: &Histories,
+) -> Result<crate::metrics::Dropped> {
+    let converted = match map {
+        Some(m) => m.convert(test)?,
+        None => test.clone(),
+    };
+    let pairs: Vec<(String, String)> = match map {
+        Some(m) => m
+            .entries
+            .iter()
+            .map(|e| (e.test_label.clone(), e.model_label.clone()))
+            .collect(),
+        None => converted
+            .labels()
+            .iter()
+            .filter(|l| model.index_of(l).is_some())
+            .map(|l| (l.clone(), l.clone()))
+            .collect(),
+    };
+    Ok(crate::metrics::Dropped::of(
+        converted.labels(),
+        model.labels(),
+        pairs.iter().map(|(t, m)| (t.as_str(), m.as_str())),
+    ))
+}
+
 fn on_model_labels(
     test: &Histories,
     map: Option<&ChannelMap>,

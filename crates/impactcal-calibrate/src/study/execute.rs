@@ -184,14 +184,31 @@ fn in_process() -> Solver {
     }
 }
 
-/// What a study tells the person waiting for it. All methods default to nothing.
+/// What a study or a loop tells the person waiting for it. All methods default to nothing.
+///
+/// The calls come in this order: [`plan`](Self::plan) whenever the estimate of the whole
+/// computation's runs changes; [`stage`](Self::stage) when a stage of runs starts (its
+/// journal name, which [`stage_title`](crate::progress::stage_title) puts in words); then, for each
+/// part of a stage run in parts after the first, [`part`](Self::part); and
+/// [`run_finished`](Self::run_finished) once per run, the runs read back from the journal
+/// first. A stage's runs number `total` when it is announced; the runs a part adds are
+/// within that total.
 pub trait Observer: Sync {
+    /// The whole computation is estimated at `runs` model runs, those already finished
+    /// included (an estimate, revised as stages end: a loop cannot know its rounds ahead).
+    fn plan(&self, _runs: usize) {}
     /// A stage of `total` runs starts; `reused` of them come from the journal.
     fn stage(&self, _name: &str, _total: usize, _reused: usize) {}
-    /// One more run of the current stage finished.
+    /// A further part of the current stage starts; `reused` of its runs come from the
+    /// journal (they are reported first, through [`run_finished`](Self::run_finished)).
+    fn part(&self, _reused: usize) {}
+    /// One more run of the current stage finished (from the journal or run now).
     fn run_finished(&self) {}
     /// A stage without model runs (a fit, an analysis) starts.
     fn step(&self, _name: &str) {}
+    /// Something the person should know that does not stop the computation (channels
+    /// left out of the comparison, for example).
+    fn warning(&self, _text: &str) {}
 }
 
 /// An observer that says nothing.
@@ -291,6 +308,8 @@ impl<'a> Runs<'a> {
         let opened = |reused: usize| {
             if announce {
                 self.observer.stage(stage, points.len(), reused);
+            } else {
+                self.observer.part(reused);
             }
         };
         // Each run's histories are dropped as it finishes: they stay in its result file.

@@ -140,6 +140,15 @@ pub fn run(
     observer: &dyn Observer,
 ) -> Result<StudyResult> {
     let space = model_runs.space().clone();
+    crate::memory::check_run_counts(
+        Guard::new(options.max_memory),
+        &[
+            ("study.halton_runs", options.halton_runs),
+            ("study.jitter_runs", options.jitter_runs),
+            ("study.reconcile_runs", options.reconcile_runs),
+        ],
+        space.dim(),
+    )?;
     let fp = fingerprint(model_runs, description, test, options);
     let runs = Runs::open(model_runs, dir, &fp, observer)?;
     let prep = |h: &Histories| -> Result<Histories> {
@@ -150,6 +159,7 @@ pub fn run(
     };
 
     // 1. Baseline, test on the model's channels, noise, objective channels.
+    observer.plan(1 + options.jitter_runs + options.halton_runs + options.reconcile_runs);
     let nominal_point = space.nominal();
     let nominal_raw = runs
         .stage("nominal", std::slice::from_ref(&nominal_point))?
@@ -159,6 +169,10 @@ pub fn run(
         crate::closeloop::noise_floor::onset(baseline.data(), baseline.samples()).saturating_sub(3);
     let (test_m, _masks, preparation) =
         prepared_test(test.histories, test.map, test.cfc, &nominal_raw, Some(pre))?;
+    let dropped = channels::dropped(test.histories, test.map, &nominal_raw)?;
+    if let Some(w) = dropped.warning(test_m.channels()) {
+        observer.warning(&w);
+    }
     // The memory plan, from the shapes the nominal run gives (every shared channel taken as
     // an objective one), checked before any other stage.
     let mut plan = Plan {
@@ -331,6 +345,7 @@ pub fn run(
             objective: objective.clone(),
             unpredictable,
             kept_unpredictable: options.keep_unpredictable,
+            dropped,
         },
         noise: NoiseSummary {
             runs: noise_ok.len(),

@@ -77,6 +77,10 @@ pub struct ChannelsSummary {
     pub unpredictable: Vec<String>,
     /// Whether unpredictable channels were kept in the objective.
     pub kept_unpredictable: bool,
+    /// Channels of the test without a model channel and of the model without a test
+    /// channel: not compared.
+    #[serde(default)]
+    pub dropped: crate::metrics::Dropped,
 }
 
 /// The jitter ensemble's findings.

@@ -13,6 +13,33 @@ pub fn impactcal(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
+/// Runs the `impactcal` binary with `args` and the environment variables `vars` set.
+pub fn impactcal_with(args: &[&str], vars: &[(&str, &str)]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_impactcal"))
+        .args(args)
+        .envs(vars.iter().copied())
+        .output()
+        .expect("the binary runs")
+}
+
+/// The progress lines `impactcal` printed on a stderr that is not a terminal (`impactcal:
+/// [<done>/<planned> runs...] ...`): each with its runs done and planned, and its text after
+/// the bracket.
+pub fn progress_lines(stderr: &str) -> Vec<(usize, usize, String)> {
+    stderr
+        .lines()
+        .filter_map(|l| {
+            let rest = l.strip_prefix("impactcal: [")?;
+            let (head, text) = rest
+                .split_once("] ")
+                .unwrap_or((rest.trim_end_matches(']'), ""));
+            let counts = head.split(" runs").next()?;
+            let (done, planned) = counts.split_once('/')?;
+            Some((done.parse().ok()?, planned.parse().ok()?, text.to_string()))
+        })
+        .collect()
+}
+
 /// A file of `examples/<folder>/` of the repository.
 pub fn example_file(folder: &str, name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

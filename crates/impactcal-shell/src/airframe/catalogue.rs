@@ -495,6 +495,35 @@ impl AirframeValues {
             .zip(self.values.iter().copied())
     }
 
+    /// Applies an assignment `name=value` as [`assign`](Self::assign) does, and refuses a
+    /// value outside the quantity's study range in the catalogue (`lower..=upper`), which
+    /// is the range the airframe is meant to run in (a value far outside, such as a
+    /// thickness of `1e9`, makes the explicit solver unstable rather than giving an answer).
+    ///
+    /// # Errors
+    /// As [`assign`](Self::assign); [`ShellError::Value`] naming the quantity, the value and
+    /// its range with the unit.
+    pub fn assign_in_range(&mut self, text: &str) -> Result<()> {
+        let mut changed = self.clone();
+        changed.assign(text)?;
+        let name = text.split_once('=').map_or(text, |(n, _)| n).trim();
+        let value = changed.get(name)?;
+        if let Some(a) = catalogue().into_iter().find(|a| a.name == name)
+            && !(a.lower <= value && value <= a.upper)
+        {
+            return Err(ShellError::value(
+                format!("airframe quantity `{name}`"),
+                format!(
+                    "{value} lies outside its range {} to {} {} (nominal {}); give a value in \
+                     that range (`impactcal airframe --list` lists every range)",
+                    a.lower, a.upper, a.unit, a.nominal
+                ),
+            ));
+        }
+        *self = changed;
+        Ok(())
+    }
+
     fn index(&self, name: &str) -> Result<usize> {
         self.names
             .iter()
