@@ -47,6 +47,9 @@ pub(crate) struct Journaled<'a> {
     pub condition: &'a [(String, f64)],
     /// The loop's memory plan, once the nominal run has given its shapes.
     pub plan: Option<&'a Plan>,
+    /// The channels each new run stores in its `result.csv` (`None`: all): the compared
+    /// ones once the nominal run has named them.
+    pub stored: Option<&'a [String]>,
 }
 
 impl<'a> Journaled<'a> {
@@ -54,6 +57,14 @@ impl<'a> Journaled<'a> {
     pub fn at(self, set: &'a [(String, f64)]) -> Self {
         Journaled {
             condition: set,
+            ..self
+        }
+    }
+
+    /// The same runner storing every channel of its runs.
+    pub fn keeping_all(self) -> Self {
+        Journaled {
+            stored: None,
             ..self
         }
     }
@@ -79,12 +90,9 @@ impl<'a> Journaled<'a> {
             condition: self.condition,
         };
         self.used.set(self.used.get() + points.len());
-        Runs::open(&exec, self.dir, self.fingerprint, self.observer)?.stage_from(
-            stage,
-            first,
-            points,
-            first == 0,
-        )
+        Runs::open(&exec, self.dir, self.fingerprint, self.observer)?
+            .storing(self.stored.map(<[String]>::to_vec))
+            .stage_from(stage, first, points, first == 0)
     }
 
     /// [`stage_from`](Self::stage_from) for a whole stage.

@@ -176,6 +176,7 @@ pub fn run_loop_on<M: Enrichable>(
         worker,
         condition: &[],
         plan: None,
+        stored: None,
     };
     let nominal = setup::nominal(&runner, model, test)?;
     let threads = if worker.is_some() {
@@ -185,8 +186,11 @@ pub fn run_loop_on<M: Enrichable>(
     };
     let plan = setup::plan(model, &nominal, options, threads)?;
     observer.step(&plan.line());
+    // Every later run is read on the compared channels only: unless asked to keep every
+    // channel, that is all a run stores.
     let runner = Journaled {
         plan: Some(&plan),
+        stored: (!options.keep_all_channels).then_some(nominal.labels.as_slice()),
         ..runner
     };
     let setting = frame::nuisance(runner, model, &nominal, test.cfc, options)?;

@@ -168,6 +168,7 @@ pub fn journaled<'a>(dir: &'a Path, used: &'a Cell<usize>) -> Journaled<'a> {
         worker: None,
         condition: &[],
         plan: None,
+        stored: None,
     }
 }
 
