@@ -28,6 +28,11 @@ pub struct SensorsResult {
     pub expansion_rel_error: Option<f64>,
     /// Condition number of the expansion's fit.
     pub expansion_condition: Option<f64>,
+    /// Chosen sensors whose information other candidates repeat (on a symmetric structure,
+    /// their mirror images), each with those candidates: the placement counted each such
+    /// set once ([`impactcal_sensors::PlacementOptions::equivalence_tolerance`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub equivalents: Vec<impactcal_sensors::Equivalent>,
     /// Why fewer shapes were kept than the options ask for: the ensemble's data has a lower
     /// numerical rank (absent when the requested number was kept).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -142,6 +147,12 @@ pub fn place_sensors(
         condition_number: placement.condition_number,
         expansion_rel_error,
         expansion_condition,
+        equivalents: placement
+            .equivalents
+            .iter()
+            .filter(|e| e.chosen)
+            .cloned()
+            .collect(),
         note,
     })
 }
