@@ -131,9 +131,9 @@ pub(crate) fn classes(
     // noise-weighted signal; members within a relative 1e-9 of it count as equal, and the
     // first of them in candidate order stands.
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for b in 0..n {
-        if let Some(a) = rep_of[b] {
-            members[a].push(b);
+    for (b, rep) in rep_of.iter().enumerate() {
+        if let Some(a) = rep {
+            members[*a].push(b);
         }
     }
     for root in 0..n {
