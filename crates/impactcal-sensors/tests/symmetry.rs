@@ -38,29 +38,31 @@ fn mode(p: usize, q: usize, i: usize, j: usize) -> f64 {
         * (q as f64 * j as f64 * PI / (NY + 1) as f64).sin()
 }
 
+/// The nodes `(i, j)` in candidate order: all of them, or those on or below the mid-line.
+fn grid(half_only: bool) -> impl Iterator<Item = (usize, usize)> {
+    (1..=NX)
+        .flat_map(|i| (1..=NY).map(move |j| (i, j)))
+        .filter(move |&(_, j)| !half_only || j == lower(j))
+}
+
 /// Out-of-plane DOFs `<node>.z` of every node (or of the lower half only), each row the
 /// lower-half node's row times `1 + asym * e` for a fixed pattern `e` in `[-1, 1]` on the
 /// upper half (`asym = 0`: exact mirror images).
 fn membrane(half_only: bool, asym: f64) -> CandidateShapes {
     let mut labels = Vec::new();
     let mut rows = Vec::new();
-    for i in 1..=NX {
-        for j in 1..=NY {
-            if half_only && j != lower(j) {
-                continue;
+    for (i, j) in grid(half_only) {
+        let mut row: Vec<f64> = MODES
+            .iter()
+            .map(|&(p, q)| mode(p, q, i, lower(j)))
+            .collect();
+        if j != lower(j) {
+            for (m, v) in row.iter_mut().enumerate() {
+                *v *= 1.0 + asym * ((7 * i + 3 * j + 5 * m) as f64).sin();
             }
-            let mut row: Vec<f64> = MODES
-                .iter()
-                .map(|&(p, q)| mode(p, q, i, lower(j)))
-                .collect();
-            if j != lower(j) {
-                for (m, v) in row.iter_mut().enumerate() {
-                    *v *= 1.0 + asym * ((7 * i + 3 * j + 5 * m) as f64).sin();
-                }
-            }
-            labels.push(format!("{}.z", node(i, j)));
-            rows.push(row);
         }
+        labels.push(format!("{}.z", node(i, j)));
+        rows.push(row);
     }
     CandidateShapes::from_rows(labels, &rows).unwrap()
 }
@@ -179,27 +181,22 @@ fn mirror_nodes_are_one_triaxial_candidate() {
     let build = |half_only: bool| {
         let mut labels = Vec::new();
         let mut rows = Vec::new();
-        for i in 1..=NX {
-            for j in 1..=NY {
-                if half_only && j != lower(j) {
-                    continue;
-                }
-                let jl = lower(j);
-                let sign = if j == jl { 1.0 } else { -1.0 };
-                let x: Vec<f64> = MODES
-                    .iter()
-                    .map(|&(p, q)| 0.5 * mode(2 * p, q, i, jl))
-                    .collect();
-                // sin(2 q j pi / (NY + 1)) is odd about the mid-line.
-                let y: Vec<f64> = MODES
-                    .iter()
-                    .map(|&(p, q)| sign * 0.3 * mode(p, 2 * q, i, jl))
-                    .collect();
-                let z: Vec<f64> = MODES.iter().map(|&(p, q)| mode(p, q, i, jl)).collect();
-                for (axis, row) in [("x", x), ("y", y), ("z", z)] {
-                    labels.push(format!("{}.{axis}", node(i, j)));
-                    rows.push(row);
-                }
+        for (i, j) in grid(half_only) {
+            let jl = lower(j);
+            let sign = if j == jl { 1.0 } else { -1.0 };
+            let x: Vec<f64> = MODES
+                .iter()
+                .map(|&(p, q)| 0.5 * mode(2 * p, q, i, jl))
+                .collect();
+            // sin(2 q j pi / (NY + 1)) is odd about the mid-line.
+            let y: Vec<f64> = MODES
+                .iter()
+                .map(|&(p, q)| sign * 0.3 * mode(p, 2 * q, i, jl))
+                .collect();
+            let z: Vec<f64> = MODES.iter().map(|&(p, q)| mode(p, q, i, jl)).collect();
+            for (axis, row) in [("x", x), ("y", y), ("z", z)] {
+                labels.push(format!("{}.{axis}", node(i, j)));
+                rows.push(row);
             }
         }
         CandidateShapes::from_rows(labels, &rows).unwrap()
