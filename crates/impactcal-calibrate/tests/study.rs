@@ -455,3 +455,52 @@ fn the_report_document_holds_the_study_numbers() {
     );
     assert!(e.calibrated.prediction_error <= e.baseline.prediction_error);
 }
+
+/// The header of run `index` of stage `stage`: its channel labels.
+fn stored(dir: &Path, stage: &str, index: usize) -> Vec<String> {
+    let text =
+        std::fs::read_to_string(dir.join(format!("runs/{stage}/{index}/result.csv"))).unwrap();
+    let header = text.lines().next().unwrap();
+    header.split(',').skip(1).map(String::from).collect()
+}
+
+/// A test of the z channels only: the ensemble and reconciliation runs store those (the
+/// objective channels), the nominal and jitter runs every channel; keeping every channel
+/// gives the same result, number for number.
+#[test]
+fn runs_store_the_objective_channels_and_keeping_all_changes_no_number() {
+    let model = Drop::new(10.0);
+    let full = model.simulate(&[1.1, 0.9, 1.05]).unwrap();
+    let z: Vec<String> = full
+        .labels()
+        .iter()
+        .filter(|l| l.ends_with(".z"))
+        .cloned()
+        .collect();
+    let test = full.select(&z).unwrap();
+    let lean_dir = tempfile::tempdir().unwrap();
+    let lean = run(&model, &test, options(10, 4), lean_dir.path()).unwrap();
+    assert_eq!(lean.channels.objective, z);
+    assert_eq!(stored(lean_dir.path(), "ensemble", 0), z);
+    assert_eq!(stored(lean_dir.path(), "reconcile-0", 0), z);
+    assert_eq!(stored(lean_dir.path(), "nominal", 0), full.labels());
+    assert_eq!(stored(lean_dir.path(), "noise", 0), full.labels());
+
+    let all_dir = tempfile::tempdir().unwrap();
+    let o = StudyOptions {
+        keep_all_channels: true,
+        ..options(10, 4)
+    };
+    let all = run(&model, &test, o, all_dir.path()).unwrap();
+    assert_eq!(stored(all_dir.path(), "ensemble", 0), full.labels());
+    assert_eq!(stored(all_dir.path(), "reconcile-0", 0), full.labels());
+    // Only the option (and so the fingerprint) differs.
+    let strip = |r: &study::StudyResult| {
+        let mut v = serde_json::to_value(r).unwrap();
+        let o = v.as_object_mut().unwrap();
+        o.remove("options");
+        o.remove("fingerprint");
+        v
+    };
+    assert_eq!(strip(&lean), strip(&all));
+}

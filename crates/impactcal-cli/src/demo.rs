@@ -99,6 +99,10 @@ pub struct Args {
     /// airframe's undeclared quantities when absent).
     #[arg(long, value_delimiter = ',')]
     pub candidates: Option<Vec<String>>,
+    /// Keep every channel of every run in its `result.csv` (by default a run after the
+    /// nominal and jitter runs stores only the channels compared).
+    #[arg(long)]
+    pub keep_all_channels: bool,
 }
 
 #[derive(Serialize)]
@@ -133,6 +137,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let table1 = StudyOptions {
         halton_runs: args.table1_runs,
         screen_only: true,
+        keep_all_channels: args.keep_all_channels,
         ..StudyOptions::default()
     }
     .check()
@@ -143,6 +148,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         shapes: 10.min(args.sensors),
         sensitivity_samples: args.sensitivity_samples,
         reconcile_runs: args.reconcile_runs,
+        keep_all_channels: args.keep_all_channels,
         ..StudyOptions::default()
     }
     .check()

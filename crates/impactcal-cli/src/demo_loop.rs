@@ -152,6 +152,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         polish: args.loop_polish,
         candidates: args.candidates.clone(),
         seed: 1,
+        keep_all_channels: args.keep_all_channels,
         ..LoopOptions::default()
     };
     check_inputs(&model, &options).map_err(|e| CliError::from(e).context("demo --close-loop"))?;

@@ -94,6 +94,45 @@ fn the_closed_loop_demo_finds_the_nuisance_terms_reveals_and_resumes() {
             assert!(e["m2_shapes"].as_u64().unwrap() <= 6);
         }
     }
+    // The nominal runs keep every channel of the airframe; every other run stores the six
+    // channels compared.
+    let header = |run: &Path| -> Vec<String> {
+        let text = std::fs::read_to_string(run.join("result.csv")).unwrap();
+        let mut labels: Vec<String> = text
+            .lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .skip(1)
+            .map(String::from)
+            .collect();
+        labels.sort();
+        labels
+    };
+    let mut compared: Vec<String> = d["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap().to_string())
+        .collect();
+    compared.sort();
+    let runs = dir.path().join("runs");
+    let mut stages = 0;
+    for stage in std::fs::read_dir(&runs).unwrap() {
+        let stage = stage.unwrap().path();
+        if !stage.is_dir() {
+            continue;
+        }
+        stages += 1;
+        let name = stage.file_name().unwrap().to_string_lossy().to_string();
+        let h = header(&stage.join("0"));
+        if name == "nominal" || name == "holdout-nominal" {
+            assert_eq!(h.len(), 1215, "{name}");
+        } else {
+            assert_eq!(h, compared, "{name}");
+        }
+    }
+    assert!(stages > 5, "{stages} stages");
     // Run again in the same folder: every run is read back, the result is the same.
     let first = std::fs::read_to_string(dir.path().join("loop.json")).unwrap();
     demo(dir.path());

@@ -219,6 +219,7 @@ pub const SECTIONS: &[(&str, Option<&[&str]>)] = &[
             "noise_fraction",
             "keep_unpredictable",
             "screen_only",
+            "keep_all_channels",
         ]),
     ),
     (
@@ -241,6 +242,7 @@ pub const SECTIONS: &[(&str, Option<&[&str]>)] = &[
             "noise_band_cfc",
             "fit_gains",
             "m1_members",
+            "keep_all_channels",
         ]),
     ),
 ];

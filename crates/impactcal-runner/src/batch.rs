@@ -48,6 +48,7 @@ pub struct Batch {
     retries: u32,
     identity: Option<String>,
     set: BTreeMap<String, f64>,
+    stored: Option<Vec<String>>,
 }
 
 impl Batch {
@@ -154,6 +155,7 @@ impl Batch {
             retries: 2,
             identity: None,
             set: held,
+            stored: None,
         })
     }
 
@@ -203,6 +205,23 @@ impl Batch {
     pub fn with_identity(mut self, identity: impl Into<String>) -> Self {
         self.identity = Some(identity.into());
         self
+    }
+
+    /// The same batch keeping only the channels `labels` (in this order) of each run in its
+    /// `result.csv`, as read from the solver's output; `None` keeps every channel (the
+    /// default). A caller that compares a few channels of a model with many (24 of an
+    /// airframe's 1,215) stores what it uses: the file holds `labels.len()` columns instead of
+    /// the model's all. The solver's own output files are left as the solver wrote them. A
+    /// run whose output lacks one of `labels` fails, naming the label.
+    #[must_use]
+    pub fn with_stored_channels(mut self, labels: Option<Vec<String>>) -> Self {
+        self.stored = labels;
+        self
+    }
+
+    /// The channels each run's `result.csv` keeps (`None`: all).
+    pub fn stored_channels(&self) -> Option<&[String]> {
+        self.stored.as_deref()
     }
 
     /// `<out>/runs/<study>`: the runs' directories and the journal.
@@ -642,6 +661,14 @@ impl<'a> Driver<'a> {
                 status: describe_status(status),
                 stderr: dir.join(workdir::STDERR),
             })
+        };
+        let outcome = match (outcome, &self.batch.stored) {
+            (Ok(h), Some(labels)) => h.select(labels).map_err(|e| RunnerError::Output {
+                run: index,
+                path: dir.join(&self.batch.solver.output.file),
+                message: format!("the channels to store: {e}"),
+            }),
+            (outcome, _) => outcome,
         };
         let outcome = match outcome {
             Ok(h) => {

@@ -228,3 +228,77 @@ fn an_in_process_solver_runs_on_the_rendered_deck_in_the_run_directory() {
     let again = runner.run(&batch, Hooks::default()).unwrap();
     assert_eq!(again.reused, [true, false, true]);
 }
+
+/// Three channels `<n>.z = n a sin(b t) / 3`.
+struct Three(ParameterSpace);
+
+impl Model for Three {
+    fn space(&self) -> &ParameterSpace {
+        &self.0
+    }
+    fn simulate(&self, p: &[f64]) -> impactcal_core::Result<Histories> {
+        let ch = |n: f64| -> Vec<f64> {
+            (0..50)
+                .map(|k| n * p[0] * (p[1] * k as f64 * 1e-3).sin() / 3.0)
+                .collect()
+        };
+        Histories::from_channels(
+            vec!["1.z".into(), "2.z".into(), "3.z".into()],
+            vec![ch(1.0), ch(2.0), ch(3.0)],
+            1e-3 / 3.0,
+            0.0,
+            "in/s",
+        )
+    }
+}
+
+/// A batch storing two of three channels writes only those (in the order asked for) to
+/// each `result.csv`, with the bits the model gave; a channel the model lacks fails every
+/// run naming the label.
+#[test]
+fn stored_channels_are_the_only_ones_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = Three(wave().0);
+    let points = vec![vec![1.0, 100.0], vec![0.5, 300.0]];
+    let stored = vec!["3.z".to_string(), "1.z".to_string()];
+    let batch = Batch::for_space(dir.path(), "kept", in_process(), model.space(), &points)
+        .unwrap()
+        .with_stored_channels(Some(stored.clone()));
+    assert_eq!(batch.stored_channels(), Some(stored.as_slice()));
+    let solver = ModelSolver(&model);
+    let hooks = Hooks {
+        in_process: Some(&solver),
+        opened: None,
+        finished: None,
+    };
+    let report = run_batch_with(&batch, &Executor::Local, &Cancel::new(), hooks).unwrap();
+    for (i, p) in points.iter().enumerate() {
+        let h = report.histories(i).unwrap();
+        assert_eq!(h.labels(), stored.as_slice());
+        let full = model.simulate(p).unwrap();
+        for l in &stored {
+            assert_eq!(
+                h.channel_by_label(l).unwrap(),
+                full.channel_by_label(l).unwrap()
+            );
+        }
+        let header =
+            std::fs::read_to_string(dir.path().join(format!("runs/kept/{i}/result.csv"))).unwrap();
+        assert!(header.starts_with("time,3.z,1.z\n"), "{}", &header[..40]);
+    }
+
+    let missing = Batch::for_space(dir.path(), "missing", in_process(), model.space(), &points)
+        .unwrap()
+        .with_retries(0)
+        .with_stored_channels(Some(vec!["4.z".to_string()]));
+    let hooks = Hooks {
+        in_process: Some(&solver),
+        opened: None,
+        finished: None,
+    };
+    let report = run_batch_with(&missing, &Executor::Local, &Cancel::new(), hooks).unwrap();
+    for r in &report.runs {
+        let e = r.as_ref().unwrap_err().to_string();
+        assert!(e.contains("4.z") && e.contains("channels to store"), "{e}");
+    }
+}

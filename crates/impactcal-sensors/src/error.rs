@@ -43,14 +43,26 @@ pub enum SensorsError {
         shapes: usize,
     },
     /// The target count exceeds what is available.
-    #[error("target of {target} {unit} exceeds the {available} usable {unit}")]
+    #[error(
+        "target of {target} {unit} exceeds the {available} usable {unit}{}",
+        if *equivalent > 0 {
+            format!(
+                " ({equivalent} more repeat the information of others, such as mirror images on a \
+                 symmetric structure, and count as one with them; see the equivalence tolerance)"
+            )
+        } else {
+            String::new()
+        }
+    )]
     TargetAboveCandidates {
         /// The target count.
         target: usize,
         /// `"sensors"` or `"nodes"`.
         unit: &'static str,
-        /// What is available.
+        /// What is available, counting each set of equivalent candidates once.
         available: usize,
+        /// Usable candidates left out as equivalent to another.
+        equivalent: usize,
     },
     /// The shape matrix (restricted to the usable candidates and weighted) does not have
     /// full column rank.

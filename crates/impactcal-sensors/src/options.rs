@@ -54,6 +54,7 @@ pub struct PlacementOptions {
     pub(crate) max_swaps: usize,
     pub(crate) refresh_every: usize,
     pub(crate) rank_tolerance: f64,
+    pub(crate) equivalence_tolerance: f64,
 }
 
 /// The unchecked serialised form of [`PlacementOptions`].
@@ -69,6 +70,16 @@ struct OptionsData {
     max_swaps: usize,
     refresh_every: usize,
     rank_tolerance: f64,
+    #[serde(default = "default_equivalence")]
+    equivalence_tolerance: f64,
+}
+
+/// The default of [`PlacementOptions::equivalence_tolerance`]: `1 - |cos theta|` of
+/// `5e-7`, an angle `theta` of `1e-3` between whitened rows.
+pub const DEFAULT_EQUIVALENCE_TOLERANCE: f64 = 5e-7;
+
+fn default_equivalence() -> f64 {
+    DEFAULT_EQUIVALENCE_TOLERANCE
 }
 
 impl TryFrom<OptionsData> for PlacementOptions {
@@ -82,7 +93,8 @@ impl TryFrom<OptionsData> for PlacementOptions {
             .swap_refinement(d.swap_refinement)
             .max_swaps(d.max_swaps)
             .refresh_every(d.refresh_every)
-            .rank_tolerance(d.rank_tolerance)?;
+            .rank_tolerance(d.rank_tolerance)?
+            .equivalence_tolerance(d.equivalence_tolerance)?;
         if let Some(sigma) = d.noise {
             o = o.noise(sigma)?;
         }
@@ -93,7 +105,8 @@ impl TryFrom<OptionsData> for PlacementOptions {
 impl PlacementOptions {
     /// Options for `target` sensors with the defaults: per DOF, backward elimination, no
     /// constraints, equal noise, no swaps (at most 1000 when turned on), a fresh
-    /// recomputation every 100 steps, rank tolerance `1e-10`.
+    /// recomputation every 100 steps, rank tolerance `1e-10`, candidates repeating the
+    /// information of another merged at the [`DEFAULT_EQUIVALENCE_TOLERANCE`].
     pub fn new(target: usize) -> Self {
         PlacementOptions {
             target,
@@ -106,6 +119,7 @@ impl PlacementOptions {
             max_swaps: 1000,
             refresh_every: 100,
             rank_tolerance: 1e-10,
+            equivalence_tolerance: DEFAULT_EQUIVALENCE_TOLERANCE,
         }
     }
 
@@ -248,6 +262,27 @@ impl PlacementOptions {
         Ok(self)
     }
 
+    /// When two candidates count as one: a candidate (or node) whose whitened row (rows)
+    /// lies within `1 - |cos theta| <= tolerance` of another's direction (span) repeats that
+    /// candidate's information, and the placement keeps one of each such set (the one of
+    /// largest noise-weighted signal, else the first), listing the others as equivalents
+    /// (see [`Placement::equivalents`](crate::Placement::equivalents)). On a symmetric
+    /// structure this is what keeps a sensor's mirror image out: the two rows are equal and
+    /// effective independence would otherwise pay for both. The default
+    /// [`DEFAULT_EQUIVALENCE_TOLERANCE`] (`5e-7`) is an angle of `1e-3`: two channels whose
+    /// responses differ by less than 0.1 % of their signal (60 dB), below what impact
+    /// instrumentation resolves, are one. `0` merges nothing (plain effective
+    /// independence, which counts a repeat as a second measurement of the same quantity).
+    ///
+    /// # Errors
+    /// [`CoreError::InvalidOption`](impactcal_core::CoreError::InvalidOption) for a value
+    /// that is negative, not finite, or 1 or more (every row would be one).
+    pub fn equivalence_tolerance(mut self, tolerance: f64) -> Result<Self> {
+        self.equivalence_tolerance = tolerance;
+        self.check_ref()?;
+        Ok(self)
+    }
+
     /// Number of sensors to keep: DOFs, or nodes with [`Grouping::Node`].
     pub fn target(&self) -> usize {
         self.target
@@ -299,7 +334,8 @@ impl ParamGuard for PlacementOptions {
     /// # Errors
     /// [`CoreError::InvalidOption`] naming the option: an empty label in `keep` or
     /// `exclude`, a noise level that is not finite and positive (`noise level <i>
-    /// (0-based)`), a `rank tolerance` that is negative or not finite.
+    /// (0-based)`), a `rank tolerance` that is negative or not finite, an `equivalence
+    /// tolerance` outside `[0, 1)`.
     fn check_ref(&self) -> impactcal_core::Result<()> {
         for (option, labels) in [("keep", &self.keep), ("exclude", &self.exclude)] {
             if labels.iter().any(|l| l.trim().is_empty()) {
@@ -324,6 +360,15 @@ impl ParamGuard for PlacementOptions {
                 "rank tolerance",
                 self.rank_tolerance,
                 "must be finite and non-negative",
+            ));
+        }
+        if !(self.equivalence_tolerance.is_finite()
+            && (0.0..1.0).contains(&self.equivalence_tolerance))
+        {
+            return Err(CoreError::invalid_option(
+                "equivalence tolerance",
+                self.equivalence_tolerance,
+                "must be finite, at least 0 (0: merge nothing) and below 1",
             ));
         }
         Ok(())
@@ -353,6 +398,16 @@ mod tests {
         assert_eq!(key(o().exclude([""])), "exclude");
         assert_eq!(key(o().noise(vec![1.0, 0.0])), "noise level 1 (0-based)");
         assert_eq!(key(o().rank_tolerance(f64::NAN)), "rank tolerance");
+        assert_eq!(
+            key(o().equivalence_tolerance(-1e-3)),
+            "equivalence tolerance"
+        );
+        assert_eq!(key(o().equivalence_tolerance(1.0)), "equivalence tolerance");
+        assert_eq!(
+            key(o().equivalence_tolerance(f64::INFINITY)),
+            "equivalence tolerance"
+        );
+        assert!(o().equivalence_tolerance(0.0).is_ok());
         let bad = PlacementOptions {
             rank_tolerance: -1.0,
             ..o()

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use crate::candidates::{Axis, CandidateShapes, split_label};
 use crate::elimination::{ESSENTIAL, check_rank};
 use crate::engine::{self, Engine};
+use crate::equivalence;
 use crate::error::{Result, SensorsError};
 use crate::linalg::{dot, gather, log_det_gram, r_factor, singular_values, small_det, whiten_row};
 use crate::options::{Grouping, PlacementMethod, PlacementOptions};
@@ -47,6 +48,19 @@ pub struct AxisCounts {
     pub other: usize,
 }
 
+/// A set of candidates that carry the same information (see
+/// [`PlacementOptions::equivalence_tolerance`]): the placement saw only `kept`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Equivalent {
+    /// The candidate (DOF label, or node with [`Grouping::Node`]) that stood for the set.
+    pub kept: String,
+    /// The others, in candidate order: a sensor at any of them measures what one at `kept`
+    /// does (on a symmetric structure, its mirror images).
+    pub others: Vec<String>,
+    /// Whether `kept` is among the chosen sensors.
+    pub chosen: bool,
+}
+
 /// The result of [`place`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Placement {
@@ -63,7 +77,8 @@ pub struct Placement {
     /// Exchanges made by the swap refinement, in order.
     pub swaps: Vec<Swap>,
     /// Retained information `det(A_kept) / det(A_full)`, with `A = Phi_w^T Phi_w` over the
-    /// noise-weighted rows and `A_full` over every usable candidate (not excluded).
+    /// noise-weighted rows and `A_full` over every usable candidate (not excluded), each set
+    /// of equivalent candidates counted once.
     pub determinant_ratio: f64,
     /// Natural log of `determinant_ratio` (finite where the ratio underflows).
     pub log_determinant_ratio: f64,
@@ -76,6 +91,10 @@ pub struct Placement {
     pub max_auto_mac: f64,
     /// Chosen DOFs per axis (direction of measurement).
     pub counts_by_direction: AxisCounts,
+    /// Sets of candidates that repeat one another's information, each seen by the
+    /// placement as one candidate, in the order of their kept candidate.
+    #[serde(default)]
+    pub equivalents: Vec<Equivalent>,
     /// Notes that did not stop the placement (for example all-zero rows dropped).
     pub warnings: Vec<String>,
 }
@@ -83,7 +102,8 @@ pub struct Placement {
 /// Chooses `options.target` sensors among the candidates by effective independence.
 ///
 /// With `Phi_w` the noise-weighted shape matrix on the usable candidates (not excluded,
-/// not all-zero), the default backward method removes, one at a time, the DOF of smallest
+/// not all-zero, and one of each set of candidates that repeat one another's information:
+/// [`PlacementOptions::equivalence_tolerance`], [`Placement::equivalents`]), the default backward method removes, one at a time, the DOF of smallest
 /// `E_D,i = [Phi_w (Phi_w^T Phi_w)^-1 Phi_w^T]_ii` (with [`Grouping::Node`]: the node of
 /// smallest `1 - det(I - E_bb)`), each removal multiplying `det(Phi_w^T Phi_w)` by
 /// `1 - score`; DOFs in `keep` are never removed; ties go to the lowest candidate index.
@@ -203,6 +223,10 @@ struct Problem {
     dof_labels: Vec<Vec<String>>,
     /// Blocks that must stay.
     forced: Vec<bool>,
+    /// Candidates merged into another, as (kept block, other block names).
+    equivalents: Vec<(usize, Vec<String>)>,
+    /// Usable blocks merged away.
+    merged: usize,
     warnings: Vec<String>,
 }
 
@@ -324,7 +348,7 @@ impl Problem {
             .iter()
             .map(|b| b.iter().any(|&r| keep[cand[r]]))
             .collect();
-        let problem = Problem {
+        let mut problem = Problem {
             k,
             grouping: o.grouping,
             phi,
@@ -333,10 +357,69 @@ impl Problem {
             names,
             dof_labels,
             forced,
+            equivalents: Vec::new(),
+            merged: 0,
             warnings,
         };
+        problem.merge_equivalents(o.equivalence_tolerance);
         problem.check_target(o.target)?;
         Ok(problem)
+    }
+
+    /// Keeps one block of each set of blocks that repeat one another's information
+    /// ([`crate::equivalence::classes`]) and drops the others from the problem, remembering
+    /// them for the result.
+    fn merge_equivalents(&mut self, tolerance: f64) {
+        let rep_of = equivalence::classes(&self.phi, self.k, &self.blocks, &self.forced, tolerance);
+        if rep_of.iter().all(Option::is_none) {
+            return;
+        }
+        let k = self.k;
+        let mut others: Vec<Vec<String>> = vec![Vec::new(); self.blocks.len()];
+        for (b, rep) in rep_of.iter().enumerate() {
+            if let Some(a) = rep {
+                others[*a].push(self.names[b].clone());
+            }
+        }
+        let mut phi = Vec::new();
+        let mut cand = Vec::new();
+        let mut blocks = Vec::new();
+        let mut names = Vec::new();
+        let mut dof_labels = Vec::new();
+        let mut forced = Vec::new();
+        let mut equivalents = Vec::new();
+        for (b, rows) in self.blocks.iter().enumerate() {
+            if rep_of[b].is_some() {
+                self.merged += 1;
+                continue;
+            }
+            let mut new_rows = Vec::with_capacity(rows.len());
+            for &r in rows {
+                new_rows.push(cand.len());
+                cand.push(self.cand[r]);
+                phi.extend_from_slice(&self.phi[r * k..(r + 1) * k]);
+            }
+            if !others[b].is_empty() {
+                equivalents.push((blocks.len(), std::mem::take(&mut others[b])));
+            }
+            blocks.push(new_rows);
+            names.push(std::mem::take(&mut self.names[b]));
+            dof_labels.push(std::mem::take(&mut self.dof_labels[b]));
+            forced.push(self.forced[b]);
+        }
+        self.phi = phi;
+        self.cand = cand;
+        self.blocks = blocks;
+        self.names = names;
+        self.dof_labels = dof_labels;
+        self.forced = forced;
+        self.warnings.push(format!(
+            "{} candidate {} repeat the information of others (within an equivalence \
+             tolerance of {tolerance:e}) and count as one with them: see `equivalents`",
+            self.merged,
+            self.unit()
+        ));
+        self.equivalents = equivalents;
     }
 
     fn unit(&self) -> &'static str {
@@ -354,6 +437,7 @@ impl Problem {
                 target,
                 unit,
                 available,
+                equivalent: self.merged,
             });
         }
         let mut sizes: Vec<usize> = self.blocks.iter().map(Vec::len).collect();
@@ -512,6 +596,15 @@ impl Problem {
             max_off_diagonal,
             max_auto_mac: max_off_diagonal * max_off_diagonal,
             counts_by_direction: counts,
+            equivalents: self
+                .equivalents
+                .iter()
+                .map(|(b, others)| Equivalent {
+                    kept: self.names[*b].clone(),
+                    others: others.clone(),
+                    chosen: in_set[*b],
+                })
+                .collect(),
             warnings: self.warnings,
         })
     }

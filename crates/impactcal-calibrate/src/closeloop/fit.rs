@@ -50,6 +50,9 @@ pub(crate) struct Journaled<'a> {
     pub plan: Option<&'a Plan>,
     /// The loop's estimate of its runs, told to the observer as stages end.
     pub estimate: Option<&'a LoopRunEstimate>,
+    /// The channels each new run stores in its `result.csv` (`None`: all): the compared
+    /// ones once the nominal run has named them.
+    pub stored: Option<&'a [String]>,
 }
 
 impl<'a> Journaled<'a> {
@@ -66,6 +69,14 @@ impl<'a> Journaled<'a> {
     pub fn replan(&self, rest: impl FnOnce(&LoopRunEstimate) -> usize) {
         if let Some(e) = self.estimate {
             self.observer.plan(self.used.get() + rest(e));
+        }
+    }
+
+    /// The same runner storing every channel of its runs.
+    pub fn keeping_all(self) -> Self {
+        Journaled {
+            stored: None,
+            ..self
         }
     }
 
@@ -93,6 +104,7 @@ impl<'a> Journaled<'a> {
         };
         self.used.set(self.used.get() + points.len());
         Runs::open(&exec, self.dir, self.fingerprint, self.observer)?
+            .storing(self.stored.map(<[String]>::to_vec))
             .stage_from(stage, first, points, announce)
     }
 

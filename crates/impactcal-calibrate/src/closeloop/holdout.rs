@@ -46,12 +46,16 @@ pub(super) fn holdout_errors<M: Enrichable>(
             .stage(m, stage, std::slice::from_ref(point))?
             .histories(0, what)
     };
-    let nominal_h = run(
-        declared_at,
-        "holdout-nominal",
-        &nominal.point,
-        "the holdout's nominal run",
-    )?;
+    // The holdout's nominal run keeps every channel, as the test's does: the holdout's
+    // test is prepared against it.
+    let nominal_h = runner
+        .keeping_all()
+        .stage(
+            declared_at,
+            "holdout-nominal",
+            std::slice::from_ref(&nominal.point),
+        )?
+        .histories(0, "the holdout's nominal run")?;
     check_covered(h.histories, test.map, &nominal_h, "holdout")?;
     let (test_h, masks_h, preparation_h) =
         prepared_test(h.histories, test.map, test.cfc, &nominal_h, None)?;

@@ -190,6 +190,7 @@ pub fn run_loop_on<M: Enrichable>(
         condition: &[],
         plan: None,
         estimate: Some(&estimate),
+        stored: None,
     };
     runner.replan(|e| 1 + e.after_nominal());
     let nominal = setup::nominal(&runner, model, test)?;
@@ -200,8 +201,11 @@ pub fn run_loop_on<M: Enrichable>(
     };
     let plan = setup::plan(model, &nominal, options, threads)?;
     observer.step(&plan.line());
+    // Every later run is read on the compared channels only: unless asked to keep every
+    // channel, that is all a run stores.
     let runner = Journaled {
         plan: Some(&plan),
+        stored: (!options.keep_all_channels).then_some(nominal.labels.as_slice()),
         ..runner
     };
     let setting = frame::nuisance(runner, model, &nominal, test.cfc, options)?;

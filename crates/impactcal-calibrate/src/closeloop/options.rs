@@ -58,6 +58,12 @@ pub struct LoopOptions {
     /// Members of each model's predictive ensemble for M1 (default 199; no runs: see
     /// `closeloop::agreement`).
     pub m1_members: usize,
+    /// Keep every channel of every run in its `result.csv`. By default only the nominal
+    /// runs (of the test and of the holdout) keep every channel; every other run stores the
+    /// channels the loop compares (24 of the airframe's 1,215 in the demo). Not part of the
+    /// loop's fingerprint when off, so that folders written before it resume.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub keep_all_channels: bool,
     /// Memory the loop's process may use, in bytes; `None`: what the machine has available
     /// (`crate::memory`). A stage whose estimate does not fit stops the loop with a
     /// [`CalibrateError::Memory`](crate::CalibrateError::Memory) before it allocates. Not read from a loop file nor part of
@@ -88,6 +94,7 @@ impl Default for LoopOptions {
             candidates: None,
             m1_members: 199,
             fit_gains: true,
+            keep_all_channels: false,
             max_memory: None,
         }
     }

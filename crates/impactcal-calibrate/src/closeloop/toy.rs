@@ -169,6 +169,7 @@ pub fn journaled<'a>(dir: &'a Path, used: &'a Cell<usize>) -> Journaled<'a> {
         condition: &[],
         plan: None,
         estimate: None,
+        stored: None,
     }
 }
 

@@ -12,8 +12,10 @@
 //! the job array's name and id before and after `sbatch`) and each result after it is read;
 //! the study always works with the histories as read back from `result.csv` (our CSV
 //! writes the shortest text that reads back as the same number), so a resumed study uses
-//! the same bits as an uninterrupted one. A stage's histories are not held in memory: each
-//! stage reads from its runs' result files what it uses, one run at a time ([`Outcomes`]).
+//! the same bits as an uninterrupted one. A stage may store only the channels it uses
+//! (`Runs::storing`: the study's objective channels, the loop's compared ones). A stage's
+//! histories are not held in memory: each stage reads from its runs' result files what it
+//! uses, one run at a time ([`Outcomes`]).
 
 use std::path::{Path, PathBuf};
 
@@ -223,6 +225,8 @@ pub(crate) struct Runs<'a> {
     root: PathBuf,
     fingerprint: String,
     observer: &'a dyn Observer,
+    /// The channels each run's `result.csv` keeps (`None`: all).
+    stored: Option<Vec<String>>,
 }
 
 impl<'a> Runs<'a> {
@@ -259,7 +263,23 @@ impl<'a> Runs<'a> {
             root: dir.to_path_buf(),
             fingerprint: fingerprint.to_string(),
             observer,
+            stored: None,
         })
+    }
+
+    /// The same runs storing only the channels `labels` of each new run in its
+    /// `result.csv` (`None`: every channel; runs already finished are read as they were
+    /// stored). Each stage's readers select the channels they use, so a stage stored with
+    /// more channels reads the same.
+    #[must_use]
+    pub fn storing(&self, labels: Option<Vec<String>>) -> Runs<'a> {
+        Runs {
+            model_runs: self.model_runs,
+            root: self.root.clone(),
+            fingerprint: self.fingerprint.clone(),
+            observer: self.observer,
+            stored: labels,
+        }
     }
 
     /// The outcomes of `points` as stage `stage`: runs the journal holds as finished are
@@ -304,7 +324,8 @@ impl<'a> Runs<'a> {
             self.model_runs.condition(),
         )?
         .with_retries(self.model_runs.retries())
-        .with_identity(self.fingerprint.clone());
+        .with_identity(self.fingerprint.clone())
+        .with_stored_channels(self.stored.clone());
         let opened = |reused: usize| {
             if announce {
                 self.observer.stage(stage, points.len(), reused);

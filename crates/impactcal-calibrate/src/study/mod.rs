@@ -259,6 +259,9 @@ pub fn run(
     let points: Vec<Vec<f64>> = (0..design.points.nrows())
         .map(|i| design.points.row(i).iter().copied().collect())
         .collect();
+    // From here on a run is read on the objective channels only: unless asked to keep
+    // every channel, that is all a run stores.
+    let runs = runs.storing((!options.keep_all_channels).then(|| objective.clone()));
     let outcomes = runs.stage("ensemble", &points)?;
     let mut failed = Vec::new();
     let mut ok = Vec::new();

@@ -36,6 +36,13 @@ pub struct StudyOptions {
     pub keep_unpredictable: bool,
     /// Stop after M1 (the screening of a first parameter set).
     pub screen_only: bool,
+    /// Keep every channel of every run in its `result.csv`. By default the runs after the
+    /// jitter ensemble (the ensemble and the reconciliation) store only the objective
+    /// channels, the ones the study compares (a test of 24 channels against a model of 1,215
+    /// stores 24); the nominal and jitter runs keep every channel. Not part of the study's
+    /// fingerprint when off, so that folders written before it resume.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub keep_all_channels: bool,
     /// Memory the study's process may use, in bytes; `None`: what the machine has
     /// available (`crate::memory`). A stage whose estimate does not fit stops the study
     /// with a [`crate::CalibrateError::Memory`] before it allocates. Not read from a study
@@ -64,6 +71,7 @@ impl Default for StudyOptions {
             noise_fraction: 0.05,
             keep_unpredictable: false,
             screen_only: false,
+            keep_all_channels: false,
             max_memory: None,
             sigma: None,
         }

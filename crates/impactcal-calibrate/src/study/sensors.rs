@@ -28,6 +28,11 @@ pub struct SensorsResult {
     pub expansion_rel_error: Option<f64>,
     /// Condition number of the expansion's fit.
     pub expansion_condition: Option<f64>,
+    /// Chosen sensors whose information other candidates repeat (on a symmetric structure,
+    /// their mirror images), each with those candidates: the placement counted each such
+    /// set once ([`impactcal_sensors::PlacementOptions::equivalence_tolerance`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub equivalents: Vec<impactcal_sensors::Equivalent>,
     /// Why fewer shapes were kept than the options ask for: the ensemble's data has a lower
     /// numerical rank (absent when the requested number was kept).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -111,10 +116,31 @@ pub fn place_sensors(
     };
     drop(y);
     let shapes = ensemble.len();
-    let placement = place(
-        &CandidateShapes::new(candidates.to_vec(), ensemble.shapes())?,
-        &PlacementOptions::new(count),
-    )?;
+    let candidate_shapes = CandidateShapes::new(candidates.to_vec(), ensemble.shapes())?;
+    // Fewer distinct channels than sensors (channels that repeat one another, as at a low
+    // rank): the runs are done, so the sensors are placed by plain effective independence,
+    // with a note, rather than ending the study.
+    let (placement, note) = match place(&candidate_shapes, &PlacementOptions::new(count)) {
+        Err(impactcal_sensors::SensorsError::TargetAboveCandidates {
+            available,
+            equivalent,
+            ..
+        }) if equivalent > 0 => {
+            let plain = PlacementOptions::new(count).equivalence_tolerance(0.0)?;
+            let extra = format!(
+                "{count} sensors asked for, but only {available} channels carry distinct \
+                 information ({equivalent} repeat others): placed counting repeats"
+            );
+            (
+                place(&candidate_shapes, &plain)?,
+                Some(match note {
+                    Some(n) => format!("{n}; {extra}"),
+                    None => extra,
+                }),
+            )
+        }
+        other => (other?, note),
+    };
     let selected = placement.selected.clone();
     let rest: Vec<String> = candidates
         .iter()
@@ -142,6 +168,12 @@ pub fn place_sensors(
         condition_number: placement.condition_number,
         expansion_rel_error,
         expansion_condition,
+        equivalents: placement
+            .equivalents
+            .iter()
+            .filter(|e| e.chosen)
+            .cloned()
+            .collect(),
         note,
     })
 }
@@ -181,8 +213,16 @@ mod tests {
             note.contains("3 shapes asked for") && note.contains("numerical rank 1"),
             "{note}"
         );
-        // Asking what the data carries leaves no note.
+        // Asking what the data carries leaves no note on the shapes; the three proportional
+        // channels repeat one another, which the note says, and the three sensors are
+        // placed counting the repeats.
+        assert!(note.contains("2 repeat others"), "{note}");
         let r = place_sensors(&read, 4, &labels, 3, 1, &base, &rank_one(1.5)).unwrap();
-        assert_eq!((r.shapes, r.note), (1, None));
+        let note = r.note.unwrap();
+        assert_eq!(r.shapes, 1);
+        assert!(
+            !note.contains("shapes asked for") && note.contains("2 repeat others"),
+            "{note}"
+        );
     }
 }
