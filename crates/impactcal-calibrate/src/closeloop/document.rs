@@ -26,10 +26,51 @@ fn table(caption: &str, header: &[&str], rows: Vec<Vec<String>>) -> Block {
     })
 }
 
-/// The report document of `r`.
+/// The report document of `r`: the lead (verdict and errors in short), then one section per
+/// stage of the loop (`nuisance`, `noise_floor`, `detection`, `attribution`, `selection`,
+/// `unattributed` when error remains, `before_after`).
 pub fn report(r: &LoopResult) -> Report {
-    let (dt, start) = (r.time_step, r.start);
-    let mut lead = vec![match r.verdict {
+    let mut sections = vec![
+        nuisance(r),
+        noise_floor(r),
+        detection(r),
+        attribution(r),
+        selection(r),
+    ];
+    sections.extend(unattributed(r));
+    sections.push(before_after(r));
+    Report {
+        title: format!("Closed loop: {}", r.model),
+        lead: lead(r),
+        sections,
+    }
+}
+
+/// The verdict, the relative L2 errors of the three models and how the test was prepared.
+fn lead(r: &LoopResult) -> Vec<String> {
+    let mut lead = vec![verdict(r)];
+    let e = &r.errors.calibration;
+    lead.push(format!(
+        "Relative L2 on the calibration test: nominal {}, calibrated {}, enriched {}.",
+        f(e.nominal),
+        f(e.calibrated),
+        f(e.enriched)
+    ));
+    if let Some(h) = &r.errors.holdout {
+        lead.push(format!(
+            "On the holdout test (never fitted): nominal {}, calibrated {}, enriched {}.",
+            f(h.nominal),
+            f(h.calibrated),
+            f(h.enriched)
+        ));
+    }
+    lead.push(format!("{}.", r.test_preparation.describe()));
+    lead
+}
+
+/// The verdict in one sentence.
+fn verdict(r: &LoopResult) -> String {
+    match r.verdict {
         Verdict::NoModelFormError => format!(
             "No model-form error: the calibrated model explains the test to its noise floor \
              (chi2_red {} <= {}).",
@@ -68,25 +109,11 @@ pub fn report(r: &LoopResult) -> Report {
                 )
             }
         ),
-    }];
-    let e = &r.errors.calibration;
-    lead.push(format!(
-        "Relative L2 on the calibration test: nominal {}, calibrated {}, enriched {}.",
-        f(e.nominal),
-        f(e.calibrated),
-        f(e.enriched)
-    ));
-    if let Some(h) = &r.errors.holdout {
-        lead.push(format!(
-            "On the holdout test (never fitted): nominal {}, calibrated {}, enriched {}.",
-            f(h.nominal),
-            f(h.calibrated),
-            f(h.enriched)
-        ));
     }
-    lead.push(format!("{}.", r.test_preparation.describe()));
-    let mut sections = Vec::new();
+}
 
+/// The trigger offset, the gains and biases per channel and any units warning.
+fn nuisance(r: &LoopResult) -> Section {
     let n = &r.nuisance;
     let mut blocks = vec![Block::Paragraph(format!(
         "Trigger offset tau = {} s (a test triggered late has tau > 0). Gains and biases per \
@@ -117,12 +144,15 @@ pub fn report(r: &LoopResult) -> Report {
             u.meaning
         )));
     }
-    sections.push(Section {
+    Section {
         heading: "Nuisance terms".into(),
         blocks,
-    });
+    }
+}
 
-    sections.push(Section {
+/// The measurement noise per channel and the model's own simulation noise.
+fn noise_floor(r: &LoopResult) -> Section {
+    Section {
         heading: "Noise floor".into(),
         blocks: vec![table(
             "Measurement noise per channel and the model's own simulation noise",
@@ -149,13 +179,17 @@ pub fn report(r: &LoopResult) -> Report {
                 })
                 .collect(),
         )],
-    });
+    }
+}
 
+/// Detection before and after enrichment with the residual's sensor and time patterns.
+fn detection(r: &LoopResult) -> Section {
+    let (dt, start) = (r.time_step, r.start);
     let (d0, d1) = (&r.detection, &r.detection_final);
     let row = |name: &str, a: String, b: String| vec![name.to_string(), a, b];
     let labels: Vec<String> = d0.u1.keys().cloned().collect();
     let time: Vec<f64> = (0..d0.v1.len()).map(|k| start + k as f64 * dt).collect();
-    sections.push(Section {
+    Section {
         heading: "Detection".into(),
         blocks: vec![
             table(
@@ -214,8 +248,11 @@ pub fn report(r: &LoopResult) -> Report {
                 }),
             }),
         ],
-    });
+    }
+}
 
+/// The ranked candidates and the pairs these sensors cannot tell apart.
+fn attribution(r: &LoopResult) -> Section {
     let mut blocks = vec![table(
         "Candidates ranked on the calibrated model's residual",
         &[
@@ -251,12 +288,15 @@ pub fn report(r: &LoopResult) -> Report {
             f(*mu)
         )));
     }
-    sections.push(Section {
+    Section {
         heading: "Attribution".into(),
         blocks,
-    });
+    }
+}
 
-    sections.push(Section {
+/// The models of forward selection with their information criteria.
+fn selection(r: &LoopResult) -> Section {
+    Section {
         heading: "Forward selection".into(),
         blocks: vec![
             table(
@@ -283,40 +323,44 @@ pub fn report(r: &LoopResult) -> Report {
             ),
             Block::Paragraph(format!("Stopped: {}.", r.stopped)),
         ],
-    });
-
-    if let Some(d) = &r.unattributed {
-        sections.push(Section {
-            heading: "Unattributed model-form error".into(),
-            blocks: vec![
-                Block::Paragraph(format!(
-                    "A low-rank discrepancy carries {} of the residual. It describes what the \
-                     model lacks (where and when); it is not a physical effect.",
-                    f(d.energy_fraction)
-                )),
-                table(
-                    "Sensor signature of each component",
-                    &["component", "sigma", "sensors"],
-                    d.components
-                        .iter()
-                        .enumerate()
-                        .map(|(i, c)| {
-                            vec![
-                                (i + 1).to_string(),
-                                f(c.sigma),
-                                c.sensors
-                                    .iter()
-                                    .map(|(l, v)| format!("{l} {}", f(*v)))
-                                    .collect::<Vec<_>>()
-                                    .join(", "),
-                            ]
-                        })
-                        .collect(),
-                ),
-            ],
-        });
     }
+}
 
+/// The low-rank signature of the error no candidate explains, when there is one.
+fn unattributed(r: &LoopResult) -> Option<Section> {
+    r.unattributed.as_ref().map(|d| Section {
+        heading: "Unattributed model-form error".into(),
+        blocks: vec![
+            Block::Paragraph(format!(
+                "A low-rank discrepancy carries {} of the residual. It describes what the \
+                     model lacks (where and when); it is not a physical effect.",
+                f(d.energy_fraction)
+            )),
+            table(
+                "Sensor signature of each component",
+                &["component", "sigma", "sensors"],
+                d.components
+                    .iter()
+                    .enumerate()
+                    .map(|(i, c)| {
+                        vec![
+                            (i + 1).to_string(),
+                            f(c.sigma),
+                            c.sensors
+                                .iter()
+                                .map(|(l, v)| format!("{l} {}", f(*v)))
+                                .collect::<Vec<_>>()
+                                .join(", "),
+                        ]
+                    })
+                    .collect(),
+            ),
+        ],
+    })
+}
+
+/// The before/after metrics on the calibration test and the holdout.
+fn before_after(r: &LoopResult) -> Section {
     let mut blocks = vec![stages_table("Calibration test", &r.metrics_calibration)];
     if let Some(h) = &r.metrics_holdout {
         blocks.push(stages_table("Holdout test (never fitted)", h));
@@ -334,14 +378,9 @@ pub fn report(r: &LoopResult) -> Report {
         f(1.0 / (r.m1_members as f64 + 1.0)),
         r.runs
     )));
-    sections.push(Section {
+    Section {
         heading: "Before and after".into(),
         blocks,
-    });
-    Report {
-        title: format!("Closed loop: {}", r.model),
-        lead,
-        sections,
     }
 }
 
