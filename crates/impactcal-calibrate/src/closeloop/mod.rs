@@ -98,7 +98,9 @@ pub use noise_floor::NoiseFloor;
 pub use nuisance::Nuisance;
 pub use options::LoopOptions;
 pub use plan::{LoopShapes, estimated_peak};
-pub use result::{Added, ErrorSummary, Errors, LoopResult, ModelScore, Round, Stages, Verdict};
+pub use result::{
+    Added, ErrorSummary, Errors, Evidence, LoopResult, ModelScore, Round, Stages, Verdict,
+};
 
 use fit::Journaled;
 
@@ -264,6 +266,13 @@ pub fn run_loop_on<M: Enrichable>(
         m1_members: options.m1_members,
         time_step: nominal.test.dt(),
         start: nominal.test.start(),
+        unit: nominal.test.unit().to_string(),
+        channels: nominal.labels,
+        cfc: test.cfc.map(Cfc::class),
+        holdout_condition: holdout.map(|h| h.set.to_vec()).unwrap_or_default(),
+        parameters: enriched.space().parameters().to_vec(),
+        seed: options.seed,
+        digest: fp,
     })
 }
 
