@@ -271,6 +271,19 @@ pub fn run_loop_on<M: Enrichable>(
         cfc: test.cfc.map(Cfc::class),
         holdout_condition: holdout.map(|h| h.set.to_vec()).unwrap_or_default(),
         parameters: enriched.space().parameters().to_vec(),
+        catalogue: model
+            .candidates()
+            .into_iter()
+            .map(|c| {
+                (
+                    c.parameter.name,
+                    result::CandidateInfo {
+                        unit: c.parameter.unit,
+                        description: c.description,
+                    },
+                )
+            })
+            .collect(),
         seed: options.seed,
         digest: fp,
     })

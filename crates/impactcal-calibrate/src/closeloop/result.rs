@@ -168,6 +168,15 @@ pub struct Round {
     pub runs: usize,
 }
 
+/// A candidate of the model's catalogue, as the report names it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CandidateInfo {
+    /// Its unit (may be empty).
+    pub unit: String,
+    /// What it is, in a few words.
+    pub description: String,
+}
+
 /// Everything the closed loop found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LoopResult {
@@ -231,6 +240,9 @@ pub struct LoopResult {
     /// The enriched model's parameters (declared, then added): bounds, nominal, unit.
     #[serde(default)]
     pub parameters: Vec<impactcal_core::Parameter>,
+    /// The model's candidates: name -> unit and what it is, in a few words.
+    #[serde(default)]
+    pub catalogue: BTreeMap<String, CandidateInfo>,
     /// The seed of every random draw of the loop.
     #[serde(default)]
     pub seed: u64,

@@ -41,6 +41,7 @@ mod document;
 mod figure;
 mod html;
 mod markdown;
+mod provenance;
 mod validate;
 
 #[cfg(test)]
@@ -59,6 +60,7 @@ pub use document::{
 pub use figure::render_svg;
 pub use html::{escape_html, render_html};
 pub use markdown::{escape_markdown, render_markdown};
+pub use provenance::{Provenance, utc_date};
 pub use validate::{check_figure, check_report, check_table};
 
 use crate::Result;
