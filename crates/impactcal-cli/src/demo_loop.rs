@@ -11,10 +11,10 @@ use std::time::Instant;
 use impactcal::calibrate::closeloop::document::report_with;
 use impactcal::calibrate::closeloop::{Holdout, LoopOptions, LoopResult, run_loop_on};
 use impactcal::calibrate::report::{Block, Provenance, Section, Table};
-use impactcal::experiment::model::geometry_of;
 use impactcal::calibrate::study::TestData;
 use impactcal::core::synthetic::{Measurement, measured};
 use impactcal::core::{Cfc, Enrichable, Histories, Model};
+use impactcal::experiment::model::geometry_of;
 use impactcal::shell::airframe::{Airframe, AirframeModel, AirframeOptions, MeshDensity, Preset};
 use serde::Serialize;
 
@@ -308,7 +308,11 @@ fn spread(values: impl Iterator<Item = f64>) -> String {
 
 /// What was hidden beside what the loop found.
 fn reveal(r: &LoopResult, wrong: &str, gain: f64, noise: &NoiseReveal) -> Vec<Reveal> {
-    let unit = if r.unit.is_empty() { "(test units)" } else { &r.unit };
+    let unit = if r.unit.is_empty() {
+        "(test units)"
+    } else {
+        &r.unit
+    };
     let damping = r.added.iter().find(|a| a.name == "damping").map_or_else(
         || match r.candidates.iter().position(|c| c.name == "damping") {
             Some(k) => format!(

@@ -435,14 +435,7 @@ fn parameters(r: &LoopResult) -> Section {
         .iter()
         .map(|p| {
             let v = r.calibrated.get(&p.name).copied().unwrap_or(f64::NAN);
-            let near = 1e-3 * p.width();
-            let flag = if v - p.lower <= near {
-                "AT LOWER BOUND"
-            } else if p.upper - v <= near {
-                "AT UPPER BOUND"
-            } else {
-                ""
-            };
+            let flag = crate::report::bound_flag(p, v);
             vec![
                 p.name.clone(),
                 if p.unit.is_empty() {

@@ -39,6 +39,7 @@
 
 mod document;
 mod figure;
+mod flags;
 mod html;
 mod markdown;
 mod provenance;
@@ -58,6 +59,7 @@ pub use document::{
     Structure, Table,
 };
 pub use figure::render_svg;
+pub use flags::{AT_BOUND, bound_flag};
 pub use html::{escape_html, render_html};
 pub use markdown::{escape_markdown, render_markdown};
 pub use provenance::{Provenance, utc_date};
