@@ -12,9 +12,13 @@ Two independent looks at the page:
    position the layout step measured, must hold drawn (non-background) pixels too.
 
 The expected figures are the SVG files the report wrote beside report.html, so a figure that
-is missing from the page fails. `--negative-controls` breaks the page in five ways (a figure
-removed, a figure's drawing emptied, a figure shrunk to zero size, a figure hidden, the whole
-page hidden) and fails unless the check rejects every one of them.
+is missing from the page fails. `--negative-controls` breaks the page in six ways (a figure
+removed, a figure's drawing emptied, a figure shrunk to zero size, a figure hidden, a label
+written twice a few pixels apart, the whole page hidden) and fails unless the check rejects
+every one of them.
+
+Labels: within each figure, the boxes of the <text> elements as the browser laid them out
+must not overlap by more than OVERLAP_PX pixels in both directions.
 
 Python standard library only.
 """
@@ -38,6 +42,7 @@ MIN_MARKS = 5  # drawn non-text elements with a non-empty box
 MIN_TEXTS = 2  # axis descriptions at least
 MIN_INK = 0.01  # fraction of a figure's pixels that differ from white
 MIN_PAGE_STD = 5.0  # standard deviation of the page's grey levels (0..255)
+OVERLAP_PX = 2  # two text boxes overlap when they share more than this in x and in y
 
 PROBE = """
 <script>
@@ -59,8 +64,28 @@ PROBE = """
             if (e.tagName.toLowerCase() === 'text') { texts++; } else { marks++; }
           }
         });
+        // Boxes of the texts as laid out, and every pair that overlaps by more than
+        // OVERLAP_PX in both directions (a shared edge or a descender touching is not an
+        // overlap a reader notices).
+        var boxes = [];
+        svg.querySelectorAll('text').forEach(function (e) {
+          var b = e.getBoundingClientRect();
+          if (b.width > 0 && b.height > 0 && e.textContent.trim() !== '') {
+            boxes.push({t: e.textContent.trim(), l: b.left, r: b.right, u: b.top, d: b.bottom});
+          }
+        });
+        var overlaps = [];
+        for (var i = 0; i < boxes.length; i++) {
+          for (var j = i + 1; j < boxes.length; j++) {
+            var a = boxes[i], c = boxes[j];
+            var w = Math.min(a.r, c.r) - Math.max(a.l, c.l);
+            var h = Math.min(a.d, c.d) - Math.max(a.u, c.u);
+            if (w > %s && h > %s) { overlaps.push([a.t, c.t, Math.round(w), Math.round(h)]); }
+          }
+        }
         r = {present: true, svg: true, x: box.left + window.scrollX, y: box.top + window.scrollY,
-             width: box.width, height: box.height, marks: marks, texts: texts};
+             width: box.width, height: box.height, marks: marks, texts: texts,
+             overlaps: overlaps};
       }
     }
     out.figures[name] = r;
@@ -98,7 +123,7 @@ def run(args):
 def measure(chromium, page, names, work):
     """Layout of every expected figure, as the browser computed it."""
     text = page.read_text(encoding="utf-8")
-    probe = PROBE % json.dumps(names)
+    probe = PROBE % (json.dumps(names), OVERLAP_PX, OVERLAP_PX)
     if "</body>" in text:
         probed = text.replace("</body>", probe + "</body>", 1)
     else:
@@ -200,6 +225,11 @@ def check(chromium, page, names, work):
         elif f["marks"] < MIN_MARKS or f["texts"] < MIN_TEXTS:
             problems.append(f"{name}: {f['marks']} drawn marks and {f['texts']} texts "
                             f"(at least {MIN_MARKS} and {MIN_TEXTS} expected)")
+        elif f["overlaps"]:
+            shown = "; ".join(f"'{a}' and '{b}' ({w} x {h} px)"
+                              for a, b, w, h in f["overlaps"][:5])
+            problems.append(f"{name}: {len(f['overlaps'])} pairs of text labels overlap: "
+                            f"{shown}")
     height = max(200, min(30000, int(layout["page"]["height"])))
     shot = work / "page.png"
     run(chromium_args(chromium, work / "profile") + [
@@ -215,7 +245,8 @@ def check(chromium, page, names, work):
             continue
         std, ink = region_stats(image, f["x"], f["y"], f["x"] + f["width"], f["y"] + f["height"])
         summary[name] = (f"{f['width']:.0f} x {f['height']:.0f} px at y {f['y']:.0f}, "
-                         f"{f['marks']} marks, {f['texts']} texts, ink {ink:.3f}")
+                         f"{f['marks']} marks, {f['texts']} texts, "
+                         f"{len(f.get('overlaps', []))} overlapping labels, ink {ink:.3f}")
         if ink < MIN_INK:
             problems.append(f"{name}: its region of the screenshot is blank "
                             f"(ink {ink:.4f} < {MIN_INK})")
@@ -225,8 +256,8 @@ def check(chromium, page, names, work):
 def break_page(text, names, how):
     """The page broken one way (see --negative-controls)."""
     figures = list(re.finditer(r'<figure id="([^"]+)">.*?</figure>\n', text, re.S))
-    if len(figures) < 4:
-        raise SystemExit("negative controls need at least four figures")
+    if len(figures) < 5:
+        raise SystemExit("negative controls need at least five figures")
     pick = {m.group(1): m for m in figures}
 
     def svg_open(m):
@@ -246,6 +277,15 @@ def break_page(text, names, how):
     if how == "figure hidden":
         at = svg_open(pick[names[3]]) + len("<svg ")
         return text[:at] + 'style="visibility:hidden" ' + text[at:]
+    if how == "labels overlap":
+        # The figure's first label written a second time, shifted by a few pixels.
+        m = pick[names[4 % len(names)]]
+        found = re.compile(r"<text[^>]*>[^<]+</text>").search(text, svg_open(m), m.end())
+        if not found:
+            raise SystemExit("negative control: the figure holds no text label")
+        twin = re.sub(r'x="([-0-9.]+)"', lambda v: f'x="{float(v.group(1)) + 3}"',
+                      found.group(0), count=1)
+        return text[:found.end()] + twin + text[found.end():]
     if how == "page hidden":
         return text.replace("<body>", '<body style="display:none">', 1)
     raise ValueError(how)
@@ -257,7 +297,7 @@ def main():
     parser.add_argument("--report", required=True, type=Path,
                         help="folder holding report.html and one SVG file per figure")
     parser.add_argument("--negative-controls", action="store_true",
-                        help="also check that five broken copies of the page are rejected")
+                        help="also check that six broken copies of the page are rejected")
     args = parser.parse_args()
 
     page = args.report / "report.html"
@@ -283,7 +323,7 @@ def main():
         if args.negative_controls:
             missed = []
             for how in ["figure removed", "drawing emptied", "zero size", "figure hidden",
-                        "page hidden"]:
+                        "labels overlap", "page hidden"]:
                 broken = work / "broken" / how.replace(" ", "-")
                 broken.mkdir(parents=True)
                 bad = broken / "report.html"

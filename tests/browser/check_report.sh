@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
-# Renders a sample report with every kind of figure in headless Chromium and checks that the
-# page is not blank and shows every figure (tests/browser/check_report.py), then that the
-# check rejects deliberately broken copies of the page. Installs Chromium (Debian package
+# Renders a sample report with every kind of figure and a real closed-loop report (the
+# drop-tower loop of examples/loop_report.rs, about 15 s) in headless Chromium and checks
+# that each page is not blank, shows every figure and has no two text labels of a figure
+# overlapping (tests/browser/check_report.py), then that the check rejects deliberately
+# broken copies of the sample page. Installs Chromium (Debian package
 # `chromium`) with apt-get when it is missing and this user can.
 #
 #   bash tests/browser/check_report.sh [OUT_DIR]
 #
-# Exit status: 0 when every figure is shown and every broken page is rejected; 1 otherwise.
+# Exit status: 0 when every figure of both reports is shown without overlapping labels and
+# every broken page is rejected; 1 otherwise.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
@@ -50,3 +53,5 @@ fi
 cargo test --workspace --no-run --quiet
 "${CARGO_TARGET_DIR:-target}/debug/examples/report_gallery" "$OUT/report" >/dev/null
 python3 tests/browser/check_report.py --chromium "$CHROMIUM" --report "$OUT/report" --negative-controls
+"${CARGO_TARGET_DIR:-target}/debug/examples/loop_report" "$OUT/loop" >/dev/null
+python3 tests/browser/check_report.py --chromium "$CHROMIUM" --report "$OUT/loop"

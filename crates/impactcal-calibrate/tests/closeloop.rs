@@ -191,9 +191,28 @@ fn hidden_damping_is_found_added_and_the_error_falls_on_calibration_and_holdout(
     let doc = impactcal_calibrate::closeloop::document::report(&r);
     let files = impactcal_calibrate::report::write(&doc, dir.path()).unwrap();
     let html = std::fs::read_to_string(&files.html).unwrap();
+    std::fs::copy(&files.markdown, std::env::var("DUMP_MD").unwrap()).unwrap();
     assert!(html.contains("damping") && html.contains("Unattributed") == r.unattributed.is_some());
-    assert!(dir.path().join("fig-residual-sensors.svg").exists());
-    assert!(dir.path().join("fig-residual-time.svg").exists());
+    // What a crash analyst reads first: the setting, the test against the three models,
+    // their M1 envelopes and M2 matrices, the parameters.
+    for fig in [
+        "fig-residual-sensors",
+        "fig-residual-time",
+        "fig-channel-residual",
+        "fig-channel-change",
+        "fig-channel-holdout",
+        "fig-m1-nominal",
+        "fig-m1-calibrated",
+        "fig-m1-enriched",
+        "fig-m2-nominal",
+        "fig-m2-calibrated",
+        "fig-m2-enriched",
+    ] {
+        assert!(dir.path().join(format!("{fig}.svg")).exists(), "{fig}");
+    }
+    for heading in ["What was compared", "Test against model", "Parameters"] {
+        assert!(html.contains(heading), "{heading}");
+    }
 }
 
 #[test]

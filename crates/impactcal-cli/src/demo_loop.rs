@@ -8,14 +8,15 @@
 use std::path::Path;
 use std::time::Instant;
 
-use impactcal::calibrate::closeloop::document::report;
+use impactcal::calibrate::closeloop::document::report_with;
 use impactcal::calibrate::closeloop::{
     Holdout, LoopOptions, LoopResult, check_inputs, run_loop_on,
 };
-use impactcal::calibrate::report::{Block, Section, Table};
+use impactcal::calibrate::report::{Block, Provenance, Section, Table};
 use impactcal::calibrate::study::TestData;
 use impactcal::core::synthetic::{Measurement, measured};
 use impactcal::core::{Cfc, Enrichable, Histories, Model};
+use impactcal::experiment::model::geometry_of;
 use impactcal::shell::airframe::{Airframe, AirframeModel, AirframeOptions, MeshDensity, Preset};
 use serde::Serialize;
 
@@ -141,6 +142,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             args.channels
         )));
     }
+    let geometry = geometry_of(&airframe);
     let model = AirframeModel::preset(airframe, Preset::Table2)?;
     // Every option the loop checks, before the test's runs.
     let options = LoopOptions {
@@ -253,9 +255,21 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 
     let noise = noise_reveal(&result, &channels, &hidden_sd);
     let reveal = reveal(&result, &wrong, args.gain, &noise);
-    let mut doc = report(&result);
+    let provenance = Provenance::now(
+        std::env::args().collect::<Vec<_>>().join(" "),
+        result.digest.clone(),
+        result.seed,
+        started.elapsed().as_secs_f64(),
+    );
+    let mut doc = report_with(&result, Some(&geometry), Some(&provenance));
     doc.title = "Closed loop on the coarse airframe: a test with hidden damping".into();
-    doc.sections.push(reveal_section(&reveal));
+    // The reveal before the appendix and the provenance, which stay last.
+    let at = doc
+        .sections
+        .iter()
+        .position(|s| s.heading.starts_with("Appendix") || s.heading == "Provenance")
+        .unwrap_or(doc.sections.len());
+    doc.sections.insert(at, reveal_section(&reveal));
     let json = serde_json::to_string_pretty(&result)
         .map_err(|e| CliError::failure(format!("cannot encode the loop's result: {e}")))?;
     write_text(&(json + "\n"), Some(&args.out.join("loop.json")))?;
@@ -296,8 +310,23 @@ fn verdict(r: &LoopResult) -> &'static str {
     }
 }
 
+/// `least to largest (median m)` of `values`, to three significant digits.
+fn spread(values: impl Iterator<Item = f64>) -> String {
+    let mut v: Vec<f64> = values.collect();
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => "-".into(),
+        n => format!("{:.3} to {:.3} (median {:.3})", v[0], v[n - 1], v[n / 2]),
+    }
+}
+
 /// What was hidden beside what the loop found.
 fn reveal(r: &LoopResult, wrong: &str, gain: f64, noise: &NoiseReveal) -> Vec<Reveal> {
+    let unit = if r.unit.is_empty() {
+        "(test units)"
+    } else {
+        &r.unit
+    };
     let damping = r.added.iter().find(|a| a.name == "damping").map_or_else(
         || match r.candidates.iter().position(|c| c.name == "damping") {
             Some(k) => format!(
@@ -350,10 +379,15 @@ fn reveal(r: &LoopResult, wrong: &str, gain: f64, noise: &NoiseReveal) -> Vec<Re
         },
         Reveal {
             quantity: "measurement noise".into(),
-            hidden: format!("white, {SNR_DB} dB (1 % of each channel's RMS), after CFC {CFC}"),
+            hidden: format!(
+                "white, {SNR_DB} dB (1 % of each channel's RMS); after CFC {CFC}: sigma {} \
+                 {unit} over the channels",
+                spread(noise.channels.iter().map(|c| c.1))
+            ),
             found: format!(
-                "noise floor over the noise hidden: {:.2} to {:.2} (median {:.2}); sources {}; \
-                 final chi2_red {:.3}",
+                "sigma {} {unit} over the channels, {:.2} to {:.2} times the hidden (median \
+                 {:.2}); sources {}; final reduced chi-square {:.3}",
+                spread(noise.channels.iter().map(|c| c.2)),
                 noise.ratio[0],
                 noise.ratio[2],
                 noise.ratio[1],

@@ -101,12 +101,12 @@ pub(crate) fn m1_exceedance(
     m1::m1(&time, &runs, &norm_history_of(&test, t))
 }
 
-/// M2 of the model response `y` against the test (nuisance terms taken out): the number of
-/// paired impact shapes with `|M2| > 0.9`, and the number of shapes compared.
+/// M2 of the model response `y` against the test (nuisance terms taken out): the matrix,
+/// the pairing and its count of shapes with `|M2| > 0.9`.
 ///
 /// # Errors
 /// Shape errors (a response or test without signal on these channels).
-pub(crate) fn m2_count(frame: &Frame, y: &[f64], terms: &Terms) -> Result<(usize, usize)> {
+pub(crate) fn m2_result(frame: &Frame, y: &[f64], terms: &Terms) -> Result<m2::M2Result> {
     let t = frame.samples;
     let block = |v: &[f64]| -> Result<Histories> {
         Ok(Histories::from_channels(
@@ -118,8 +118,7 @@ pub(crate) fn m2_count(frame: &Frame, y: &[f64], terms: &Terms) -> Result<(usize
         )?)
     };
     let test = nuisance::corrected_test(frame, terms);
-    let r = m2::m2(&block(y)?, &block(&test)?, &frame.labels, M2_SHAPES)?;
-    Ok((r.matched_above_0_9, r.pairs.len()))
+    m2::m2(&block(y)?, &block(&test)?, &frame.labels, M2_SHAPES)
 }
 
 #[cfg(test)]
@@ -203,8 +202,8 @@ mod tests {
     fn m2_of_the_model_against_itself_pairs_every_shape() {
         let y = pulses();
         let f = frame(y.clone(), 0.01);
-        let (above, shapes) = m2_count(&f, &y, &unit_terms()).unwrap();
-        assert_eq!(shapes, 2);
-        assert_eq!(above, 2);
+        let r = m2_result(&f, &y, &unit_terms()).unwrap();
+        assert_eq!(r.pairs.len(), 2);
+        assert_eq!(r.matched_above_0_9, 2);
     }
 }

@@ -8,7 +8,7 @@ use super::fit::Fit;
 use super::frame::Setting;
 use super::nuisance::{self, Frame, Terms};
 use super::options::LoopOptions;
-use super::result::{Errors, Stages};
+use super::result::{Errors, Evidence, Stages};
 use crate::error::Result;
 use crate::metrics::{CurveMetrics, Iso18571};
 
@@ -125,7 +125,7 @@ impl Judge<'_> {
                 .seed
                 .wrapping_add(stream.wrapping_mul(0x9E37_79B9_7F4A_7C15)),
         )?;
-        let m2 = agreement::m2_count(frame, y, terms).ok();
+        let m2 = agreement::m2_result(frame, y, terms).ok();
         Ok(Errors {
             rel_l2: if den > 0.0 {
                 (num / den).sqrt()
@@ -138,8 +138,14 @@ impl Judge<'_> {
             m1_exceedance: m1.exceedance_fraction,
             m1_expected: m1.expected_exceedance,
             m1_probability: m1.probability,
-            m2_above_0_9: m2.map(|m| m.0),
-            m2_shapes: m2.map_or(0, |m| m.1),
+            m2_above_0_9: m2.as_ref().map(|m| m.matched_above_0_9),
+            m2_shapes: m2.as_ref().map_or(0, |m| m.pairs.len()),
+            evidence: Some(Box::new(Evidence {
+                test: corrected,
+                model: y.to_vec(),
+                m1,
+                m2,
+            })),
         })
     }
 }

@@ -99,7 +99,9 @@ pub use noise_floor::NoiseFloor;
 pub use nuisance::Nuisance;
 pub use options::LoopOptions;
 pub use plan::{LoopShapes, estimated_peak};
-pub use result::{Added, ErrorSummary, Errors, LoopResult, ModelScore, Round, Stages, Verdict};
+pub use result::{
+    Added, ErrorSummary, Errors, Evidence, LoopResult, ModelScore, Round, Stages, Verdict,
+};
 pub use setup::check_inputs;
 
 use fit::Journaled;
@@ -284,6 +286,26 @@ pub fn run_loop_on<M: Enrichable>(
         m1_members: options.m1_members,
         time_step: nominal.test.dt(),
         start: nominal.test.start(),
+        unit: nominal.test.unit().to_string(),
+        channels: nominal.labels,
+        cfc: test.cfc.map(Cfc::class),
+        holdout_condition: holdout.map(|h| h.set.to_vec()).unwrap_or_default(),
+        parameters: enriched.space().parameters().to_vec(),
+        catalogue: model
+            .candidates()
+            .into_iter()
+            .map(|c| {
+                (
+                    c.parameter.name,
+                    result::CandidateInfo {
+                        unit: c.parameter.unit,
+                        description: c.description,
+                    },
+                )
+            })
+            .collect(),
+        seed: options.seed,
+        digest: fp,
     })
 }
 

@@ -56,6 +56,18 @@ pub enum NoiseSource {
     ModelFreeBand,
 }
 
+impl NoiseSource {
+    /// The source in words, for reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            NoiseSource::User => "given",
+            NoiseSource::PreImpact => "pre-impact window",
+            NoiseSource::HighBand => "band above the filter (upper bound)",
+            NoiseSource::ModelFreeBand => "band above the model's content",
+        }
+    }
+}
+
 /// The noise floor of one channel.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ChannelNoise {

@@ -9,6 +9,8 @@ use super::detection::Detection;
 use super::discrepancy::Discrepancy;
 use super::noise_floor::NoiseFloor;
 use super::nuisance::Nuisance;
+use crate::study::m1::M1;
+use crate::study::m2::M2Result;
 
 /// The loop's conclusion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -107,6 +109,28 @@ pub struct Errors {
     pub m2_above_0_9: Option<usize>,
     /// Impact shapes compared a side by M2.
     pub m2_shapes: usize,
+    /// What the report draws of this comparison (histories, M1 envelope, M2 matrix).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub evidence: Option<Box<Evidence>>,
+}
+
+/// What the report draws of one model against one test, the numbers behind [`Errors`]:
+/// the compared histories, the M1 envelope and the M2 matrix.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Evidence {
+    /// The test with the nuisance terms taken out (`(test(t + tau) - b) / g`), in the test's
+    /// unit after filtering: `S x T` row-major, channels in the order of
+    /// [`LoopResult::channels`], `T` samples from [`LoopResult::start`] at
+    /// [`LoopResult::time_step`].
+    pub test: Vec<f64>,
+    /// The model's response on the same channels and samples.
+    pub model: Vec<f64>,
+    /// M1: the predictive envelope of `Q(t)` (the norm over the channels), the test's
+    /// `Q_e(t)` and where it leaves the envelope.
+    pub m1: M1,
+    /// M2: the matrix of the impact shapes of model (rows) and test (columns), their
+    /// contributions and the optimal pairing; `None` when the shapes cannot be formed.
+    pub m2: Option<M2Result>,
 }
 
 /// Errors of the three models against one test.
@@ -142,6 +166,15 @@ pub struct Round {
     pub attribution: Option<Attribution>,
     /// Runs of its (re)calibration.
     pub runs: usize,
+}
+
+/// A candidate of the model's catalogue, as the report names it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CandidateInfo {
+    /// Its unit (may be empty).
+    pub unit: String,
+    /// What it is, in a few words.
+    pub description: String,
 }
 
 /// Everything the closed loop found.
@@ -196,4 +229,29 @@ pub struct LoopResult {
     pub time_step: f64,
     /// Time of their first sample (s).
     pub start: f64,
+    /// The compared channels, in the order of every per-channel vector of the result.
+    #[serde(default)]
+    pub channels: Vec<String>,
+    /// The unit of the compared histories (the test's, e.g. `in/s`; empty when not given).
+    #[serde(default)]
+    pub unit: String,
+    /// The CFC class test and runs were filtered with, if any.
+    #[serde(default)]
+    pub cfc: Option<u32>,
+    /// The holdout's condition (held quantities and their values), empty without one.
+    #[serde(default)]
+    pub holdout_condition: Vec<(String, f64)>,
+    /// The enriched model's parameters (declared, then added): bounds, nominal, unit.
+    #[serde(default)]
+    pub parameters: Vec<impactcal_core::Parameter>,
+    /// The model's candidates: name -> unit and what it is, in a few words.
+    #[serde(default)]
+    pub catalogue: BTreeMap<String, CandidateInfo>,
+    /// The seed of every random draw of the loop.
+    #[serde(default)]
+    pub seed: u64,
+    /// The digest of the loop's configuration (model, parameter space, options, filter,
+    /// channel map, test and holdout data): the journal's fingerprint.
+    #[serde(default)]
+    pub digest: String,
 }

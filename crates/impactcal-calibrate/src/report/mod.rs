@@ -39,8 +39,10 @@
 
 mod document;
 mod figure;
+mod flags;
 mod html;
 mod markdown;
+mod provenance;
 mod validate;
 
 #[cfg(test)]
@@ -57,8 +59,10 @@ pub use document::{
     Structure, Table,
 };
 pub use figure::render_svg;
+pub use flags::{AT_BOUND, bound_flag};
 pub use html::{escape_html, render_html};
 pub use markdown::{escape_markdown, render_markdown};
+pub use provenance::{Provenance, utc_date};
 pub use validate::{check_figure, check_report, check_table};
 
 use crate::Result;

@@ -130,10 +130,18 @@ fn setup(r: &StudyResult) -> Section {
         .map(|(i, p)| {
             vec![
                 p.name.clone(),
+                if p.unit.is_empty() {
+                    "-".into()
+                } else {
+                    p.unit.clone()
+                },
                 g(p.lower),
                 g(p.upper),
                 g(p.nominal),
                 calibrated.map_or("-".into(), |c| g(c[i])),
+                calibrated
+                    .map_or("", |c| crate::report::bound_flag(p, c[i]))
+                    .into(),
             ]
         })
         .collect();
@@ -197,8 +205,17 @@ fn setup(r: &StudyResult) -> Section {
                 r.noise.fraction
             )),
             table(
-                "Parameters: bounds, nominal and calibrated values",
-                &["parameter", "lower", "upper", "nominal", "calibrated"],
+                "Parameters: bounds, nominal and calibrated values (a calibrated value \
+                 within 0.1 % of the range's width from a bound is flagged)",
+                &[
+                    "parameter",
+                    "unit",
+                    "lower",
+                    "upper",
+                    "nominal",
+                    "calibrated",
+                    "bound",
+                ],
                 rows,
             ),
             table(

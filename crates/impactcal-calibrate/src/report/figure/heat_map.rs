@@ -6,8 +6,8 @@ use plotters::prelude::*;
 
 use super::OUTLINE;
 use super::{
-    Area, BAR, BOTTOM_AREA, Drawn, LEFT_AREA, MARGIN, WIDTH, centred, colour_bar, dark, label_font,
-    sequential, tick_font,
+    Area, BAR, BOTTOM_AREA, Drawn, LEFT_AREA, MARGIN, WIDTH, centred, colour_bar, dark, diverging,
+    label_font, sequential, tick_font,
 };
 use crate::Result;
 use crate::report::document::HeatMap;
@@ -19,8 +19,9 @@ const BAR_PANEL: u32 = 100;
 const COLUMN_PANEL: u32 = 150;
 const KEY_STRIP: u32 = 44;
 
-/// Draws the heat map of `p`: cells coloured on a sequential scale over `p.range` (values
-/// outside it take the end colours), the marked cells outlined, values written in the
+/// Draws the heat map of `p`: cells coloured over `p.range` (values outside it take the end
+/// colours) on the sequential scale, or on the blue-white-red diverging scale with white at
+/// zero when the range holds values of both signs (`low < 0 < high`, see [`scale`]), the marked cells outlined, values written in the
 /// cells if asked, row weights as horizontal bars on the right, column weights as vertical
 /// bars on top, each bar labelled with its value, and a colour bar.
 pub(super) fn draw(p: &HeatMap, svg: &mut String, name: &str) -> Result<()> {
@@ -62,8 +63,25 @@ pub(super) fn draw(p: &HeatMap, svg: &mut String, name: &str) -> Result<()> {
         draw_key(&key_area, name)?;
     }
     let (lo, hi) = p.range;
-    colour_bar(&bar_area, (lo, hi), sequential, name)?;
+    colour_bar(
+        &bar_area,
+        (lo, hi),
+        |t| scale(p.range, lo + t * (hi - lo)),
+        name,
+    )?;
     root.present().drawn(name)
+}
+
+/// The colour of `v` on the scale of `range = (low, high)`: signed values (`low < 0 <
+/// high`) on the diverging scale, `v / max(-low, high)` from blue (-1) through white (0) to
+/// red (+1), so that the sign reads as hue and zero is white; otherwise the sequential scale
+/// from `low` to `high`.
+fn scale((lo, hi): (f64, f64), v: f64) -> RGBColor {
+    if lo < 0.0 && hi > 0.0 {
+        diverging(v / hi.max(-lo))
+    } else {
+        sequential((v - lo) / (hi - lo))
+    }
 }
 
 /// `n` segments, one per cell: plotters' integer ranges include their end, so `0..n - 1`.
@@ -91,7 +109,6 @@ fn flip(rows: usize, i: usize) -> usize {
 fn draw_cells(p: &HeatMap, area: &Area<'_>, name: &str) -> Result<()> {
     let rows = p.values.len();
     let cols = p.values.first().map_or(0, Vec::len);
-    let (lo, hi) = p.range;
     let mut chart = ChartBuilder::on(area)
         .margin(MARGIN)
         .x_label_area_size(BOTTOM_AREA)
@@ -126,7 +143,7 @@ fn draw_cells(p: &HeatMap, area: &Area<'_>, name: &str) -> Result<()> {
             (SegmentValue::Exact(j + 1), SegmentValue::Exact(r + 1)),
         ]
     };
-    let colour = |v: f64| sequential((v - lo) / (hi - lo));
+    let colour = |v: f64| scale(p.range, v);
     chart
         .draw_series(p.values.iter().enumerate().flat_map(|(i, row)| {
             row.iter()

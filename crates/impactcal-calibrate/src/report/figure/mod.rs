@@ -4,6 +4,7 @@
 
 mod envelope;
 mod heat_map;
+mod legend_place;
 mod lines;
 mod stacked;
 mod structure;
@@ -211,9 +212,19 @@ pub(crate) fn band(
 
 /// Draws the legend of `chart` in its upper right corner, over a translucent white box.
 pub(crate) fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, name: &str) -> Result<()> {
+    legend_in(chart, SeriesLabelPosition::UpperRight, name)
+}
+
+/// Draws the legend of `chart` in `corner` (see `legend_place`), over a translucent white
+/// box.
+pub(crate) fn legend_in<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
+    corner: SeriesLabelPosition,
+    name: &str,
+) -> Result<()> {
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        .position(corner)
         .background_style(WHITE.mix(0.85))
         .border_style(RGBColor(160, 160, 160))
         .label_font(label_font())
