@@ -4,7 +4,7 @@
 //! the test has.
 //!
 //! - [`kolsky`]: the split-Hopkinson (Kolsky) pressure bar: a bar test as data (the neutral
-//!   test form and the Los Alamos record converted into it).
+//!   test form, the Los Alamos record converted into it).
 //!
 //! The drop tower (`impactcal_core::drop_tower`) belongs here too and moves into this crate
 //! later; until then it stays in `impactcal-core`.

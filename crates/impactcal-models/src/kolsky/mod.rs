@@ -9,3 +9,13 @@
 //!
 //! Sign convention throughout: compression positive (strains, stresses, forces), particle
 //! velocities positive towards the transmitted bar.
+//!
+//! - [`form`]: the neutral test form (TOML in SI units beside a signals file in volts), its
+//!   bridges and the gauge strains ([`KolskyTest`]);
+//! - [`lanl`]: the Los Alamos record converted into it.
+
+pub mod form;
+pub mod lanl;
+
+pub use form::{BarSetup, GaugeBridge, KolskyTest, STRAIN_CHANNELS, Section, SpecimenSetup};
+pub use lanl::{GainRow, LanlConversion, LanlOptions, from_lanl};
