@@ -12,10 +12,18 @@
 //!
 //! - [`form`]: the neutral test form (TOML in SI units beside a signals file in volts), its
 //!   bridges and the gauge strains ([`KolskyTest`]);
-//! - [`lanl`]: the Los Alamos record converted into it.
+//! - [`lanl`]: the Los Alamos record converted into it;
+//! - [`waves`]: the incident gauge's record split into incident and reflected waves, records
+//!   resampled to what the bars carry;
+//! - [`classic`]: the classic one- and three-wave analysis (stress, strain, strain rate,
+//!   equilibrium).
 
+pub mod classic;
 pub mod form;
 pub mod lanl;
+pub mod waves;
 
+pub use classic::ClassicAnalysis;
 pub use form::{BarSetup, GaugeBridge, KolskyTest, STRAIN_CHANNELS, Section, SpecimenSetup};
 pub use lanl::{GainRow, LanlConversion, LanlOptions, from_lanl};
+pub use waves::{Resampling, Separated, separate};
