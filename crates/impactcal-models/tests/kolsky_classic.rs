@@ -4,92 +4,43 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use impactcal_core::Histories;
 use impactcal_core::testdata::LanlBarRecord;
 use impactcal_models::ModelsError;
-use impactcal_models::kolsky::{
-    BarSetup, ClassicAnalysis, GainRow, GaugeBridge, KolskyTest, LanlOptions, Section,
-    SpecimenSetup, from_lanl,
-};
+use impactcal_models::kolsky::{ClassicAnalysis, GainRow, KolskyTest, LanlOptions, from_lanl};
 
-const E: f64 = 110e9;
-const C: f64 = 5000.0;
-const X: f64 = 0.5; // gauge distance: 100 us of travel
+mod common;
+
+use common::{C, E, LS, X, bar, test_from, trapezoid};
+
 const A_PEAK: f64 = 2e-3;
 const SIGMA0: f64 = 300e6;
-const LS: f64 = 3e-3;
-
-fn bar(gain: f64, channel: &str) -> BarSetup {
-    BarSetup {
-        modulus: E,
-        density: E / (C * C),
-        poisson: 0.33,
-        section: Section::Round { diameter: 9.5e-3 },
-        wave_speed: None,
-        gauge_distance: X,
-        gauge_factor: 2.0,
-        gain,
-        excitation: 8.0,
-        bridge: GaugeBridge::Half,
-        polarity: 1.0,
-        channels: vec![channel.to_string()],
-    }
-}
-
-fn specimen() -> SpecimenSetup {
-    SpecimenSetup {
-        section: Section::Round { diameter: 6e-3 },
-        length: LS,
-        density: 8960.0,
-    }
-}
 
 /// The incident pulse at the gauge: a trapezoid from 80 us, rise 10, plateau 40, fall 10.
 fn incident(t: f64) -> f64 {
-    let u = (t - 80e-6) / 10e-6;
-    A_PEAK * (u.min(6.0 - u)).clamp(0.0, 1.0)
+    trapezoid(t, A_PEAK, 80e-6, 10e-6, 40e-6)
 }
 
 /// The transmitted strain at which the specimen flows.
-fn flow_strain(b: &BarSetup) -> f64 {
-    SIGMA0 * specimen().section.area() / (E * b.area())
-}
-
-/// Volts a half bridge with gain `g` (polarity +1) reads for compressive strain `e`.
-fn volts(e: f64, b: &BarSetup) -> f64 {
-    let a = b.gauge_factor * (-e);
-    -(a / (2.0 + a)) * b.gain * b.excitation
+fn flow_strain() -> f64 {
+    SIGMA0 * common::specimen().section.area() / (E * bar(9.5e-3, 1.0, "x").area())
 }
 
 /// The test of a rigid, perfectly plastic specimen sampled at `dt` over 480 us: the
-/// transmitted face strain is `min(eps_I, s)` and the reflected `min(eps_I, s) - eps_I`.
-fn synthetic(dt: f64, transmitted_gain_read: f64) -> KolskyTest {
-    let (bi, bt) = (bar(200.0, "inc"), bar(200.0, "tra"));
-    let s = flow_strain(&bt);
-    let n = (480e-6 / dt).round() as usize;
-    let (mut inc, mut tra) = (vec![0.0; n], vec![0.0; n]);
-    for k in 0..n {
-        let t = k as f64 * dt;
-        let late = incident(t - 2.0 * X / C);
-        inc[k] = volts(incident(t) + late.min(s) - late, &bi);
-        tra[k] = volts(late.min(s), &bt);
-    }
-    let signals = Histories::from_channels(
-        vec!["inc".into(), "tra".into()],
-        vec![inc, tra],
+/// transmitted face strain is `min(eps_I, s)` and the reflected `min(eps_I, s) - eps_I`;
+/// the transmitted bar is read with gain `read_gain` (the volts are made with 200).
+fn synthetic(dt: f64, read_gain: f64) -> KolskyTest {
+    let s = flow_strain();
+    let bars = (bar(9.5e-3, 200.0, "inc"), bar(9.5e-3, 200.0, "tra"));
+    let mut t = test_from(
         dt,
-        0.0,
-        "V",
-    )
-    .unwrap();
-    KolskyTest {
-        incident: bi,
-        transmitted: bar(transmitted_gain_read, "tra"),
-        specimen: specimen(),
-        striker_length: None,
-        signals,
-        source: "synthetic".into(),
-    }
+        480e-6,
+        bars,
+        incident,
+        |t| incident(t).min(s) - incident(t),
+        |t| incident(t).min(s),
+    );
+    t.transmitted.gain = read_gain;
+    t
 }
 
 #[test]
@@ -97,7 +48,7 @@ fn a_rigid_plastic_specimen_gives_its_flow_stress_rate_and_strain() {
     let t = synthetic(0.4e-6, 200.0);
     let a = ClassicAnalysis::of(&t).unwrap();
     assert!(a.resampling.is_none());
-    let s = flow_strain(&t.transmitted);
+    let s = flow_strain();
     let area_ratio = t.transmitted.area() / t.specimen.section.area();
     for k in 0..a.time.len() {
         let ei = incident(a.time[k] - X / C);

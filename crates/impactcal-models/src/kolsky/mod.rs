@@ -16,14 +16,17 @@
 //! - [`waves`]: the incident gauge's record split into incident and reflected waves, records
 //!   resampled to what the bars carry;
 //! - [`classic`]: the classic one- and three-wave analysis (stress, strain, strain rate,
-//!   equilibrium).
+//!   equilibrium);
+//! - [`model`]: the bar model, driven by the measured incident pulse ([`KolskyModel`]).
 
 pub mod classic;
 pub mod form;
 pub mod lanl;
+pub mod model;
 pub mod waves;
 
 pub use classic::ClassicAnalysis;
 pub use form::{BarSetup, GaugeBridge, KolskyTest, STRAIN_CHANNELS, Section, SpecimenSetup};
 pub use lanl::{GainRow, LanlConversion, LanlOptions, from_lanl};
+pub use model::{FaceRun, KolskyModel, OUTPUT_CHANNELS};
 pub use waves::{Resampling, Separated, separate};

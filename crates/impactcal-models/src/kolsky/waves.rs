@@ -7,7 +7,9 @@
 //! reflection. The pulse's onset and end are the first and last samples whose compressive
 //! strain exceeds [`ONSET_FRACTION`] of its peak; its window is the round trip `T` long,
 //! centred on the pulse (equal quiet margins before and after), so that the incident wave
-//! is the record inside the window and the reflected wave the record in the next window. A pulse
+//! is the record inside the window and the reflected wave the record in the next window; the
+//! transmitted wave is the transmitted gauge's record in the incident window moved by the
+//! travel from one gauge to the other, `x_i / c_i + x_t / c_t`. A pulse
 //! longer than `T` overlaps its reflection and cannot be separated: an error.
 //!
 //! **Resampling.** A bar carries one-dimensional waves only down to wavelengths of about its
@@ -125,7 +127,8 @@ pub struct Separated {
     /// The reflected wave at the incident gauge (the record in the round trip after the
     /// window, zero elsewhere).
     pub reflected: Vec<f64>,
-    /// The transmitted gauge's record.
+    /// The transmitted wave at its gauge: the record in the incident window moved by the
+    /// travel `x_i / c_i + x_t / c_t`, zero elsewhere.
     pub transmitted: Vec<f64>,
     /// The first sample of the incident window.
     pub window_start: usize,
@@ -222,12 +225,25 @@ pub fn separate(test: &KolskyTest) -> Result<Separated> {
             }
         })
         .collect();
+    // The transmitted wave's window: the incident window moved by both bars' travel.
+    let travel = test.incident.gauge_distance / test.incident.wave_speed()
+        + test.transmitted.gauge_distance / test.transmitted.wave_speed();
+    let t_start = window_start + (travel / dt).round() as usize;
+    let transmitted = (0..tra.len())
+        .map(|k| {
+            if (t_start..t_start + window_len).contains(&k) {
+                tra[k]
+            } else {
+                0.0
+            }
+        })
+        .collect();
     Ok(Separated {
         dt,
         start: strains.start(),
         incident,
         reflected,
-        transmitted: tra,
+        transmitted,
         window_start,
         window_len,
         resampling,
