@@ -17,15 +17,19 @@
 //!   resampled to what the bars carry;
 //! - [`classic`]: the classic one- and three-wave analysis (stress, strain, strain rate,
 //!   equilibrium);
+//! - [`dispersion`]: the Pochhammer-Chree first mode, solved, and waves moved along a bar
+//!   with it;
 //! - [`model`]: the bar model, driven by the measured incident pulse ([`KolskyModel`]).
 
 pub mod classic;
+pub mod dispersion;
 pub mod form;
 pub mod lanl;
 pub mod model;
 pub mod waves;
 
 pub use classic::ClassicAnalysis;
+pub use dispersion::DispersionCurve;
 pub use form::{BarSetup, GaugeBridge, KolskyTest, STRAIN_CHANNELS, Section, SpecimenSetup};
 pub use lanl::{GainRow, LanlConversion, LanlOptions, from_lanl};
 pub use model::{FaceRun, KolskyModel, OUTPUT_CHANNELS};
