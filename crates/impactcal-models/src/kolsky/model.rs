@@ -29,15 +29,33 @@
 //! `delay_reflected` and `delay_transmitted` (us, trigger offsets that shift the modelled
 //! signals later).
 //!
+//! **Held quantities** ([`Enrichable`]: each with its admissible range and the held value
+//! that switches it off; [`KolskyModel::candidates`](Enrichable::candidates)):
+//!
+//! | name | range | held | effect |
+//! |---|---|---|---|
+//! | `dispersion` | 0..1 | 0 | the Pochhammer-Chree phase ([`DispersionCurve`]) applied to the incident wave from its gauge to the specimen, and to the reflected and transmitted waves from the specimen to their gauges, scaled by this fraction |
+//! | `rate_sensitivity` | 0..0.1 | 0 | Johnson-Cook's `C` |
+//! | `friction` | 0..0.3 | 0 | Coulomb friction `mu` at both faces: the bars see the mean pressure `sigma (1 + mu d / (3 L))` of a flowing specimen of diameter `d` (Schmid and Boas 1935, "Kristallplastizitat"; the same first-order term as Siebel's) |
+//! | `inertia` | 0..1 | 0 | the specimen's inertia, as this fraction of its mass, by four elements through its length (the face stresses then differ: Davies and Hunter 1963, J. Mech. Phys. Solids 11, 155-179) |
+//! | `gain_incident` | 0.3..3 | 1 | the incident gauge reads this factor times the true strain (its input is divided by it, its reflected output multiplied) |
+//! | `gain_transmitted` | 0.3..3 | 1 | the same for the transmitted gauge |
+//! | `gap` | 0..0.2 | 0 | mm of clearance between the specimen and a bar: no force until the faces have closed it |
+//!
 //! **Outputs.** Channels `reflected` (the reflected wave at the incident gauge) and
 //! `transmitted` (at the transmitted gauge), strains compression positive, on the record's
 //! time base, zero outside the waves' windows; [`KolskyModel::measured`] gives the record's
 //! own waves on the same base, for comparison.
 
-use impactcal_core::{CoreError, Histories, Model, Parameter, ParameterSpace};
+use std::sync::{Arc, OnceLock};
+
+use impactcal_core::{
+    Candidate, CoreError, Enrichable, Histories, Model, Parameter, ParameterSpace,
+};
 
 use crate::error::{ModelsError, Result};
-use crate::kolsky::form::KolskyTest;
+use crate::kolsky::dispersion::DispersionCurve;
+use crate::kolsky::form::{BarSetup, KolskyTest};
 use crate::kolsky::waves::{Separated, at_time, separate};
 
 /// The model's output channels.
@@ -54,6 +72,76 @@ const DECLARED: [(&str, f64, f64, f64, &str); 6] = [
     ("delay_transmitted", -10.0, 10.0, 0.0, "us"),
 ];
 
+/// The held quantities: name, admissible range, held value, unit, group, description.
+const HELD: [(&str, f64, f64, f64, &str, &str, &str); 7] = [
+    (
+        "dispersion",
+        0.0,
+        1.0,
+        0.0,
+        "1",
+        "dispersion",
+        "Pochhammer-Chree dispersion of the bars (fraction of the first mode's phase)",
+    ),
+    (
+        "rate_sensitivity",
+        0.0,
+        0.1,
+        0.0,
+        "1",
+        "material",
+        "Johnson-Cook strain-rate sensitivity C (reference rate 1/s)",
+    ),
+    (
+        "friction",
+        0.0,
+        0.3,
+        0.0,
+        "1",
+        "friction",
+        "Coulomb friction at the specimen faces (Schmid-Boas mean pressure)",
+    ),
+    (
+        "inertia",
+        0.0,
+        1.0,
+        0.0,
+        "1",
+        "mass",
+        "specimen inertia (fraction of its mass, four elements through its length)",
+    ),
+    (
+        "gain_incident",
+        0.3,
+        3.0,
+        1.0,
+        "1",
+        "gauge",
+        "gain error of the incident bar's gauge (recorded over true strain)",
+    ),
+    (
+        "gain_transmitted",
+        0.3,
+        3.0,
+        1.0,
+        "1",
+        "gauge",
+        "gain error of the transmitted bar's gauge (recorded over true strain)",
+    ),
+    (
+        "gap",
+        0.0,
+        0.2,
+        0.0,
+        "mm",
+        "contact",
+        "clearance between the specimen and a bar before loading",
+    ),
+];
+
+/// The nuisance terms among the declared parameters.
+const NUISANCE: [&str; 3] = ["wave_speed", "delay_reflected", "delay_transmitted"];
+
 /// The values a run uses, from a point and the held quantities.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct RunValues {
@@ -64,7 +152,13 @@ pub(crate) struct RunValues {
     pub wave_speed: f64,
     pub delay_reflected: f64,
     pub delay_transmitted: f64,
+    pub dispersion: f64,
     pub rate_sensitivity: f64,
+    pub friction: f64,
+    pub inertia: f64,
+    pub gain_incident: f64,
+    pub gain_transmitted: f64,
+    pub gap: f64,
 }
 
 /// The face histories of one run, on the window's samples.
@@ -88,6 +182,11 @@ pub struct KolskyModel {
     test: KolskyTest,
     waves: Separated,
     space: ParameterSpace,
+    /// The held values, in the order of `HELD`.
+    held: [f64; 7],
+    /// The first-mode dispersion of the incident and the transmitted bar, solved on the
+    /// first run that needs it and shared by the model's clones.
+    curves: Arc<OnceLock<std::result::Result<[DispersionCurve; 2], String>>>,
 }
 
 impl KolskyModel {
@@ -111,6 +210,8 @@ impl KolskyModel {
             test: test.clone(),
             waves,
             space: ParameterSpace::new(params)?,
+            held: HELD.map(|h| h.3),
+            curves: Arc::new(OnceLock::new()),
         })
     }
 
@@ -156,6 +257,43 @@ impl KolskyModel {
         )?)
     }
 
+    /// The dispersion curves of both bars (solved once, see [`DispersionCurve::solve`]).
+    fn curves(&self) -> Result<&[DispersionCurve; 2]> {
+        let solved = self.curves.get_or_init(|| {
+            let w = &self.waves;
+            let curve = |b: &BarSetup| {
+                // Up to the Nyquist frequency at phase velocities down to half the bar's
+                // speed (the Rayleigh speed exceeds half the rod speed for any Poisson
+                // ratio).
+                let ka_max =
+                    std::f64::consts::PI / w.dt * b.section.radius() / (0.5 * b.wave_speed());
+                DispersionCurve::solve(b.poisson, ka_max.max(1.0), 0.02)
+            };
+            let (bi, bt) = (&self.test.incident, &self.test.transmitted);
+            let ci = curve(bi).map_err(|e| e.to_string())?;
+            let same = bi.poisson.to_bits() == bt.poisson.to_bits()
+                && (bi.section.radius() / bi.wave_speed()).to_bits()
+                    == (bt.section.radius() / bt.wave_speed()).to_bits();
+            let ct = if same {
+                ci.clone()
+            } else {
+                curve(bt).map_err(|e| e.to_string())?
+            };
+            Ok([ci, ct])
+        });
+        solved.as_ref().map_err(|message| ModelsError::Numerical {
+            what: "Pochhammer-Chree dispersion".into(),
+            message: message.clone(),
+        })
+    }
+
+    /// The value of held quantity `i` at point `p`: the point's when freed, else held.
+    fn value(&self, p: &[f64], i: usize) -> f64 {
+        self.space
+            .index_of(HELD[i].0)
+            .map_or(self.held[i], |j| p[j])
+    }
+
     fn values(&self, p: &[f64]) -> Result<RunValues> {
         if p.len() != self.space.dim() {
             return Err(ModelsError::invalid(
@@ -180,7 +318,13 @@ impl KolskyModel {
             wave_speed: need("wave_speed")?,
             delay_reflected: need("delay_reflected")? * 1e-6,
             delay_transmitted: need("delay_transmitted")? * 1e-6,
-            rate_sensitivity: 0.0,
+            dispersion: self.value(p, 0),
+            rate_sensitivity: self.value(p, 1),
+            friction: self.value(p, 2),
+            inertia: self.value(p, 3),
+            gain_incident: self.value(p, 4),
+            gain_transmitted: self.value(p, 5),
+            gap: self.value(p, 6) * 1e-3,
         };
         if !(v.a >= 0.0 && v.b >= 0.0 && v.n > 0.0 && v.modulus > 0.0 && v.wave_speed > 0.0) {
             return Err(ModelsError::invalid(
@@ -207,45 +351,91 @@ impl KolskyModel {
         let (bi, bt) = (&self.test.incident, &self.test.transmitted);
         let ci = v.wave_speed;
         let ct = bt.wave_speed() * v.wave_speed / bi.wave_speed();
-        let (zi, zt) = (bi.modulus * bi.area() / ci, bt.modulus * bt.area() / ct);
+        let bars = Bars {
+            zi: bi.modulus * bi.area() / ci,
+            zt: bt.modulus * bt.area() / ct,
+            ci,
+        };
         let (ki, kt) = (bi.modulus * bi.area(), bt.modulus * bt.area());
         let delay = bi.gauge_distance / ci;
         let t0 = w.start + w.window_start as f64 * w.dt + delay;
         let n = w.window_len;
         let time: Vec<f64> = (0..n).map(|k| t0 + k as f64 * w.dt).collect();
+        // The incident wave in its window, dispersed from the gauge to the face, as the true
+        // strain (the gauge reads `gain_incident` times it).
+        let segment: Vec<f64> = w.incident[w.window_start..w.window_start + n]
+            .iter()
+            .map(|e| e / v.gain_incident)
+            .collect();
+        let segment = if v.dispersion == 0.0 {
+            segment
+        } else {
+            self.curves()?[0].disperse(
+                &segment,
+                w.dt,
+                bi.gauge_distance,
+                bi.section.radius(),
+                ci,
+                v.dispersion,
+            )
+        };
+        let seg_start = w.start + w.window_start as f64 * w.dt;
         let eps_i: Vec<f64> = time
             .iter()
-            .map(|t| at_time(&w.incident, w.start, w.dt, t - delay))
+            .map(|t| at_time(&segment, seg_start, w.dt, t - delay))
             .collect();
         let sp = &self.test.specimen;
-        let (a0, l0) = (sp.section.area(), sp.length);
-        let mut s = Specimen {
-            sigma: 0.0,
-            plastic: 0.0,
-            length: l0,
+        let geometry = Geometry {
+            length: sp.length,
+            volume: sp.section.area() * sp.length,
+            diameter: 2.0 * sp.section.radius(),
+            mass: v.inertia * sp.density * sp.section.area() * sp.length,
         };
+        let mut state = if v.inertia > 0.0 {
+            Specimen::Elements(Elements::new(&geometry))
+        } else {
+            Specimen::Lumped(Lumped {
+                sigma: 0.0,
+                plastic: 0.0,
+                length: geometry.length,
+            })
+        };
+        let mut gap = v.gap;
         let (mut stress, mut strain, mut plastic) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let (mut er, mut et) = (vec![0.0; n], vec![0.0; n]);
-        let inv_z = 1.0 / zi + 1.0 / zt;
         for k in 0..n {
+            let mut forces = (0.0, 0.0);
             if k > 0 {
-                // Sub-steps of at most a tenth of the elastic time constant.
-                let area = a0 * l0 / s.length;
-                let tau = s.length / (v.modulus * area * inv_z);
-                let subs = ((w.dt / (0.1 * tau)).ceil() as usize).clamp(1, 10_000);
+                let h_max = state.max_step(v, &bars, &geometry);
+                let subs = ((w.dt / h_max).ceil() as usize).clamp(1, 100_000);
                 let h = w.dt / subs as f64;
                 for j in 0..subs {
                     let f = (j as f64 + 0.5) / subs as f64;
                     let e_in = eps_i[k - 1] * (1.0 - f) + eps_i[k] * f;
-                    s.step(v, h, 2.0 * ci * e_in, inv_z, a0 * l0)?;
+                    if gap > 0.0 {
+                        // The faces close the clearance at 2 c_i eps_I with no force.
+                        gap -= h * 2.0 * ci * e_in;
+                        continue;
+                    }
+                    gap = 0.0;
+                    forces = state.step(v, &bars, &geometry, h, e_in)?;
                 }
             }
-            let force = s.sigma * a0 * l0 / s.length;
-            et[k] = force / kt;
-            er[k] = force / ki - eps_i[k];
-            stress[k] = s.sigma;
-            strain[k] = (l0 / s.length).ln();
-            plastic[k] = s.plastic;
+            et[k] = forces.1 / kt;
+            er[k] = forces.0 / ki - eps_i[k];
+            let (sg, st, pl) = state.measures(&geometry);
+            stress[k] = sg;
+            strain[k] = st;
+            plastic[k] = pl;
+        }
+        if let Some(k) = stress.iter().position(|x| !x.is_finite()) {
+            return Err(ModelsError::Numerical {
+                what: "Kolsky specimen".into(),
+                message: format!(
+                    "the stress became non-finite at face time {:.3e} s",
+                    time[k]
+                ),
+            });
         }
         Ok(FaceRun {
             time,
@@ -256,7 +446,8 @@ impl KolskyModel {
         })
     }
 
-    /// The gauge signals of a face run at the model's wave speed and delays.
+    /// The gauge signals of a face run at the model's wave speed, delays, gains and
+    /// dispersion.
     pub(crate) fn gauges(&self, v: &RunValues, run: &FaceRun) -> Result<Histories> {
         let w = &self.waves;
         let (bi, bt) = (&self.test.incident, &self.test.transmitted);
@@ -266,6 +457,24 @@ impl KolskyModel {
         let dt_ = bt.gauge_distance / ct + v.delay_transmitted;
         let t0 = run.time[0];
         let samples = w.incident.len();
+        let moved =
+            |x: &[f64], bar: &BarSetup, which: usize, c: f64, gain: f64| -> Result<Vec<f64>> {
+                let y = if v.dispersion == 0.0 {
+                    x.to_vec()
+                } else {
+                    self.curves()?[which].disperse(
+                        x,
+                        w.dt,
+                        bar.gauge_distance,
+                        bar.section.radius(),
+                        c,
+                        v.dispersion,
+                    )
+                };
+                Ok(y.into_iter().map(|e| e * gain).collect())
+            };
+        let reflected = moved(&run.waves[1], bi, 0, ci, v.gain_incident)?;
+        let transmitted = moved(&run.waves[2], bt, 1, ct, v.gain_transmitted)?;
         let out = |x: &[f64], d: f64| -> Vec<f64> {
             (0..samples)
                 .map(|k| at_time(x, t0, w.dt, w.start + k as f64 * w.dt - d))
@@ -273,7 +482,7 @@ impl KolskyModel {
         };
         Ok(Histories::from_channels(
             OUTPUT_CHANNELS.iter().map(|s| s.to_string()).collect(),
-            vec![out(&run.waves[1], dr), out(&run.waves[2], dt_)],
+            vec![out(&reflected, dr), out(&transmitted, dt_)],
             w.dt,
             w.start,
             "1",
@@ -287,9 +496,144 @@ impl KolskyModel {
     }
 }
 
-/// The specimen's state.
+/// The bars as the specimen sees them.
+struct Bars {
+    /// Impedances `E A / c` (kg/s).
+    zi: f64,
+    zt: f64,
+    /// The incident bar's wave speed (m/s).
+    ci: f64,
+}
+
+/// The specimen's undeformed geometry.
+struct Geometry {
+    length: f64,
+    volume: f64,
+    diameter: f64,
+    /// The mass that inertia moves (kg): the held fraction of the specimen's.
+    mass: f64,
+}
+
+impl Geometry {
+    /// The Schmid-Boas factor `1 + mu d / (3 L)` at the current length (constant volume).
+    fn friction(&self, mu: f64, length: f64) -> f64 {
+        let d = self.diameter * (self.length / length).sqrt();
+        1.0 + mu * d / (3.0 * length)
+    }
+}
+
+/// The flow stress at plastic strain `p` and plastic rate `rate` (1/s).
+fn flow(v: &RunValues, p: f64, rate: f64) -> f64 {
+    let hard = v.a + v.b * p.max(0.0).powf(v.n);
+    hard * (1.0 + v.rate_sensitivity * rate.max(1.0).ln())
+}
+
+/// The derivative of the flow stress along a step's plastic increment `dp` (plastic strain
+/// `p`, step `h`).
+fn flow_slope(v: &RunValues, p: f64, dp: f64, h: f64) -> f64 {
+    let p = p.max(1e-300);
+    let rate = dp / h;
+    let factor = 1.0 + v.rate_sensitivity * rate.max(1.0).ln();
+    let hard = v.a + v.b * p.powf(v.n);
+    let dhard = v.b * v.n * p.powf(v.n - 1.0);
+    let dfactor = if rate > 1.0 {
+        v.rate_sensitivity / dp
+    } else {
+        0.0
+    };
+    dhard * factor + hard * dfactor
+}
+
+/// The plastic increment `dp` in `[0, hi]` where the falling `stress(dp)` (slope `-slope`)
+/// meets the flow stress from plastic strain `p` over a step `h`: Newton's method kept in
+/// the bracket (bisection when it would leave it).
+fn return_to_flow(
+    v: &RunValues,
+    p: f64,
+    h: f64,
+    hi: f64,
+    stress: impl Fn(f64) -> f64,
+    slope: f64,
+) -> Result<f64> {
+    let res = |dp: f64| stress(dp) - flow(v, p + dp, dp / h);
+    let (mut lo, mut hi) = (0.0, hi);
+    if !(hi > 0.0 && res(hi) < 0.0) {
+        return Err(ModelsError::Numerical {
+            what: "Kolsky specimen".into(),
+            message: format!("the flow stress cannot be met in a step (plastic strain {p:.4e})"),
+        });
+    }
+    let mut dp = 0.5 * hi;
+    for _ in 0..100 {
+        let r = res(dp);
+        if r > 0.0 {
+            lo = dp;
+        } else {
+            hi = dp;
+        }
+        let d = -slope - flow_slope(v, p + dp, dp, h);
+        let newton = dp - r / d;
+        let next = if newton > lo && newton < hi && d < 0.0 {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        let done = (next - dp).abs() <= 1e-14 * next.abs().max(1e-300) || hi - lo <= 1e-16 * hi;
+        dp = next;
+        if done {
+            break;
+        }
+    }
+    Ok(dp)
+}
+
+/// The specimen: quasi-static (one stress) or with inertia (elements through its length).
+enum Specimen {
+    Lumped(Lumped),
+    Elements(Elements),
+}
+
+impl Specimen {
+    /// The largest stable and accurate sub-step (s).
+    fn max_step(&self, v: &RunValues, bars: &Bars, g: &Geometry) -> f64 {
+        match self {
+            Specimen::Lumped(s) => {
+                let area = g.volume / s.length;
+                let k = area * g.friction(v.friction, s.length) * (1.0 / bars.zi + 1.0 / bars.zt);
+                // A tenth of the elastic time constant L / (E_s K).
+                0.1 * s.length / (v.modulus * k)
+            }
+            Specimen::Elements(e) => e.max_step(v, bars, g),
+        }
+    }
+
+    /// One sub-step under the incident face wave `e_in`; returns the face forces (N).
+    fn step(
+        &mut self,
+        v: &RunValues,
+        bars: &Bars,
+        g: &Geometry,
+        h: f64,
+        e_in: f64,
+    ) -> Result<(f64, f64)> {
+        match self {
+            Specimen::Lumped(s) => s.step(v, bars, g, h, e_in),
+            Specimen::Elements(e) => e.step(v, bars, g, h, e_in),
+        }
+    }
+
+    /// Stress (Pa), true strain and plastic strain of the specimen as a whole.
+    fn measures(&self, g: &Geometry) -> (f64, f64, f64) {
+        match self {
+            Specimen::Lumped(s) => (s.sigma, (g.length / s.length).ln(), s.plastic),
+            Specimen::Elements(e) => e.measures(g),
+        }
+    }
+}
+
+/// The quasi-static specimen.
 #[derive(Debug, Clone, Copy)]
-struct Specimen {
+struct Lumped {
     /// True stress (Pa).
     sigma: f64,
     /// Plastic strain.
@@ -298,89 +642,156 @@ struct Specimen {
     length: f64,
 }
 
-impl Specimen {
-    /// The flow stress at plastic strain `p` and plastic rate `rate`.
-    fn flow(v: &RunValues, p: f64, rate: f64) -> f64 {
-        let hard = v.a + v.b * p.max(0.0).powf(v.n);
-        hard * (1.0 + v.rate_sensitivity * rate.max(1.0).ln())
-    }
-
-    /// The derivative of the flow stress along a step's plastic increment `dp` (plastic
-    /// strain `p`, step `h`).
-    fn flow_slope(v: &RunValues, p: f64, dp: f64, h: f64) -> f64 {
-        let p = p.max(1e-300);
-        let rate = dp / h;
-        let factor = 1.0 + v.rate_sensitivity * rate.max(1.0).ln();
-        let hard = v.a + v.b * p.powf(v.n);
-        let dhard = v.b * v.n * p.powf(v.n - 1.0);
-        let dfactor = if rate > 1.0 {
-            v.rate_sensitivity / dp
-        } else {
-            0.0
-        };
-        dhard * factor + hard * dfactor
-    }
-
-    /// One step of length `h` under the drive `2 c_i eps_I` (m/s); `inv_z` is
-    /// `1 / Z_i + 1 / Z_t`, `volume` the specimen's.
-    fn step(&mut self, v: &RunValues, h: f64, drive: f64, inv_z: f64, volume: f64) -> Result<()> {
+impl Lumped {
+    fn step(
+        &mut self,
+        v: &RunValues,
+        bars: &Bars,
+        g: &Geometry,
+        h: f64,
+        e_in: f64,
+    ) -> Result<(f64, f64)> {
+        let drive = 2.0 * bars.ci * e_in;
         let l = self.length;
-        let area = volume / l;
-        let k = area * inv_z;
+        let phi = g.friction(v.friction, l);
+        let area = g.volume / l;
+        let k = area * phi * (1.0 / bars.zi + 1.0 / bars.zt);
         let e = v.modulus;
         // Elastic: dsigma/dt = (E / L) (drive - K sigma), solved exactly over the step.
         let sig_inf = drive / k;
         let decay = (-h * e * k / l).exp();
         let trial = sig_inf + (self.sigma - sig_inf) * decay;
-        let (sigma, dp) = if trial <= Specimen::flow(v, self.plastic, 0.0) {
+        let (sigma, dp) = if trial <= flow(v, self.plastic, 0.0) {
             (trial.max(0.0), 0.0)
         } else {
-            // Backward Euler: sigma(dp) = (sigma_n + E (h drive / L - dp)) / (1 + E h K / L)
-            // falls with dp; the flow stress rises: one root in (0, dp_max].
-            let g = 1.0 + e * h * k / l;
-            let sig = |dp: f64| (self.sigma + e * (h * drive / l - dp)) / g;
-            let res = |dp: f64| sig(dp) - Specimen::flow(v, self.plastic + dp, dp / h);
-            let (mut lo, mut hi) = (0.0, self.sigma / e + h * drive / l);
-            if !(hi > 0.0 && res(hi) < 0.0) {
-                return Err(ModelsError::Numerical {
-                    what: "Kolsky specimen".into(),
-                    message: format!(
-                        "the flow stress cannot be met in a step (stress {:.4e} Pa, plastic \
-                         strain {:.4e})",
-                        self.sigma, self.plastic
-                    ),
-                });
-            }
-            // Newton's method kept inside the bracket (bisection when it would leave it).
-            let mut dp = 0.5 * hi;
-            for _ in 0..100 {
-                let r = res(dp);
-                if r > 0.0 {
-                    lo = dp;
-                } else {
-                    hi = dp;
-                }
-                let slope = -e / g - Specimen::flow_slope(v, self.plastic + dp, dp, h);
-                let newton = dp - r / slope;
-                let next = if newton > lo && newton < hi && slope < 0.0 {
-                    newton
-                } else {
-                    0.5 * (lo + hi)
-                };
-                if (next - dp).abs() <= 1e-14 * next.abs().max(1e-300) || hi - lo <= 1e-16 * hi {
-                    dp = next;
-                    break;
-                }
-                dp = next;
-            }
-            (sig(dp), dp)
+            // Backward Euler: sigma(dp) = (sigma_n + E (h drive / L - dp)) / (1 + E h K / L).
+            let gk = 1.0 + e * h * k / l;
+            let sigma_n = self.sigma;
+            let stress = |dp: f64| (sigma_n + e * (h * drive / l - dp)) / gk;
+            let dp = return_to_flow(
+                v,
+                self.plastic,
+                h,
+                sigma_n / e + h * drive / l,
+                stress,
+                e / gk,
+            )?;
+            (stress(dp), dp)
         };
         // The strain increment the bars impose at the new force.
         let deps = h * (drive - k * sigma) / l;
         self.sigma = sigma;
         self.plastic += dp;
         self.length = l * (-deps).exp();
-        Ok(())
+        let force = sigma * area * phi;
+        Ok((force, force))
+    }
+}
+
+/// Elements through the specimen's length.
+const ELEMENTS: usize = 4;
+
+/// The specimen with inertia: `ELEMENTS` elastic-plastic elements, lumped nodal masses,
+/// the bars as impedances at its faces (`F_1 = 2 E_i A_i eps_I - Z_i v_0`, `F_2 = Z_t v_N`),
+/// explicit (symplectic Euler) in time.
+#[derive(Debug, Clone)]
+struct Elements {
+    /// Nodal displacements towards the transmitted bar (m) and velocities (m/s).
+    u: [f64; ELEMENTS + 1],
+    vel: [f64; ELEMENTS + 1],
+    /// Element stresses (Pa, compression positive) and plastic strains.
+    sigma: [f64; ELEMENTS],
+    plastic: [f64; ELEMENTS],
+    /// Element lengths at the last step (m).
+    length: [f64; ELEMENTS],
+}
+
+impl Elements {
+    fn new(g: &Geometry) -> Elements {
+        Elements {
+            u: [0.0; ELEMENTS + 1],
+            vel: [0.0; ELEMENTS + 1],
+            sigma: [0.0; ELEMENTS],
+            plastic: [0.0; ELEMENTS],
+            length: [g.length / ELEMENTS as f64; ELEMENTS],
+        }
+    }
+
+    fn masses(g: &Geometry) -> [f64; ELEMENTS + 1] {
+        let m = g.mass / ELEMENTS as f64;
+        let mut out = [m; ELEMENTS + 1];
+        out[0] = 0.5 * m;
+        out[ELEMENTS] = 0.5 * m;
+        out
+    }
+
+    fn max_step(&self, v: &RunValues, bars: &Bars, g: &Geometry) -> f64 {
+        let m = Elements::masses(g);
+        let l: f64 = self.length.iter().sum();
+        let area = g.volume / l;
+        let le = self.length.iter().fold(f64::INFINITY, |a, b| a.min(*b));
+        // The element's wave transit and the face masses' dashpot time, halved.
+        let k_el = v.modulus * area / le;
+        let wave = 2.0 * (m[1].min(m[0]) / k_el).sqrt();
+        let dash = 2.0 * m[0] / bars.zi.max(bars.zt);
+        0.4 * wave.min(dash)
+    }
+
+    fn step(
+        &mut self,
+        v: &RunValues,
+        bars: &Bars,
+        g: &Geometry,
+        h: f64,
+        e_in: f64,
+    ) -> Result<(f64, f64)> {
+        let m = Elements::masses(g);
+        let l: f64 = self.length.iter().sum();
+        let phi = g.friction(v.friction, l);
+        let f1 = (2.0 * bars.zi * bars.ci * e_in - bars.zi * self.vel[0]).max(0.0);
+        let f2 = (bars.zt * self.vel[ELEMENTS]).max(0.0);
+        let mut force = [0.0; ELEMENTS + 1];
+        force[0] += f1;
+        force[ELEMENTS] -= f2;
+        for e in 0..ELEMENTS {
+            let area = g.volume / (ELEMENTS as f64 * self.length[e]);
+            let fe = self.sigma[e] * area * phi;
+            force[e] -= fe;
+            force[e + 1] += fe;
+        }
+        for j in 0..=ELEMENTS {
+            self.vel[j] += h * force[j] / m[j];
+            self.u[j] += h * self.vel[j];
+        }
+        let l0 = g.length / ELEMENTS as f64;
+        for e in 0..ELEMENTS {
+            let new_len = l0 + self.u[e + 1] - self.u[e];
+            if new_len <= 0.0 {
+                return Err(ModelsError::Numerical {
+                    what: "Kolsky specimen".into(),
+                    message: format!("element {e} collapsed"),
+                });
+            }
+            let deps = (self.length[e] / new_len).ln();
+            self.length[e] = new_len;
+            let trial = self.sigma[e] + v.modulus * deps;
+            if trial <= flow(v, self.plastic[e], 0.0) {
+                self.sigma[e] = trial;
+            } else {
+                let stress = |dp: f64| trial - v.modulus * dp;
+                let dp =
+                    return_to_flow(v, self.plastic[e], h, trial / v.modulus, stress, v.modulus)?;
+                self.sigma[e] = stress(dp);
+                self.plastic[e] += dp;
+            }
+        }
+        Ok((f1, f2))
+    }
+
+    fn measures(&self, g: &Geometry) -> (f64, f64, f64) {
+        let l: f64 = self.length.iter().sum();
+        let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len() as f64;
+        (mean(&self.sigma), (g.length / l).ln(), mean(&self.plastic))
     }
 }
 
@@ -391,5 +802,103 @@ impl Model for KolskyModel {
 
     fn simulate(&self, params: &[f64]) -> impactcal_core::Result<Histories> {
         self.run(params).map_err(CoreError::from)
+    }
+}
+
+impl Enrichable for KolskyModel {
+    fn candidates(&self) -> Vec<Candidate> {
+        HELD.iter()
+            .enumerate()
+            .filter(|(_, h)| self.space.index_of(h.0).is_none())
+            .map(|(i, h)| {
+                let parameter = Parameter {
+                    name: h.0.into(),
+                    lower: h.1,
+                    upper: h.2,
+                    nominal: self.held[i],
+                    unit: h.4.into(),
+                };
+                Candidate::new(parameter, h.5, h.6)
+            })
+            .collect()
+    }
+
+    fn enrich(&self, added: &[Parameter]) -> impactcal_core::Result<Self> {
+        let candidates = self.candidates();
+        let mut params = self.space.parameters().to_vec();
+        for (k, p) in added.iter().enumerate() {
+            self.check_candidate(p)?;
+            if added[..k].iter().any(|q| q.name == p.name) {
+                return Err(CoreError::invalid_option("enrich", &p.name, "added twice"));
+            }
+            if let Some(c) = candidates.iter().find(|c| c.name() == p.name) {
+                c.check_bounds(p)?;
+            }
+            params.push(p.clone());
+        }
+        Ok(KolskyModel {
+            space: ParameterSpace::new(params)?,
+            ..self.clone()
+        })
+    }
+
+    fn at_condition(&self, set: &[(String, f64)]) -> impactcal_core::Result<Self> {
+        let mut out = self.clone();
+        for (name, value) in set {
+            let Some(i) = HELD.iter().position(|h| h.0 == name) else {
+                return Err(CoreError::invalid_option(
+                    "condition",
+                    name,
+                    format!(
+                        "not a held quantity of the Kolsky bar model ({})",
+                        HELD.map(|h| h.0).join(", ")
+                    ),
+                ));
+            };
+            if self.space.index_of(name).is_some() {
+                return Err(CoreError::invalid_option(
+                    "condition",
+                    name,
+                    "a parameter of the model; a point sets it",
+                ));
+            }
+            if !(value.is_finite() && (HELD[i].1..=HELD[i].2).contains(value)) {
+                return Err(CoreError::invalid_option(
+                    format!("condition {name}"),
+                    value,
+                    format!(
+                        "outside its admissible range [{}, {}]",
+                        HELD[i].1, HELD[i].2
+                    ),
+                ));
+            }
+            out.held[i] = *value;
+        }
+        Ok(out)
+    }
+
+    fn describe(&self, name: &str) -> Option<(String, String)> {
+        let nuisance = |what: &str| Some(("nuisance".to_string(), what.to_string()));
+        match name {
+            "A" | "B" | "n" => Some((
+                "material".into(),
+                format!("hardening law A + B eps_p^n: {name}"),
+            )),
+            "modulus" => Some(("material".into(), "effective specimen modulus".into())),
+            "wave_speed" => nuisance("the bars' wave speed"),
+            "delay_reflected" => nuisance("trigger offset of the reflected wave"),
+            "delay_transmitted" => nuisance("trigger offset of the transmitted wave"),
+            _ => HELD
+                .iter()
+                .find(|h| h.0 == name)
+                .map(|h| (h.5.to_string(), h.6.to_string())),
+        }
+    }
+}
+
+impl KolskyModel {
+    /// The names of the nuisance terms among the declared parameters.
+    pub fn nuisance() -> [&'static str; 3] {
+        NUISANCE
     }
 }
