@@ -683,7 +683,8 @@ impl Lumped {
         self.sigma = sigma;
         self.plastic += dp;
         self.length = l * (-deps).exp();
-        let force = sigma * area * phi;
+        // The force on the section and friction factor at the step's end.
+        let force = sigma * g.volume / self.length * g.friction(v.friction, self.length);
         Ok((force, force))
     }
 }
@@ -692,8 +693,8 @@ impl Lumped {
 const ELEMENTS: usize = 4;
 
 /// The specimen with inertia: `ELEMENTS` elastic-plastic elements, lumped nodal masses,
-/// the bars as impedances at its faces (`F_1 = 2 E_i A_i eps_I - Z_i v_0`, `F_2 = Z_t v_N`),
-/// explicit (symplectic Euler) in time.
+/// the bars as impedances at its faces (`F_1 = 2 E_i A_i eps_I - Z_i v_0`, `F_2 = Z_t v_N`,
+/// neither negative), explicit (symplectic Euler) in time but for the faces' dashpots.
 #[derive(Debug, Clone)]
 struct Elements {
     /// Nodal displacements towards the transmitted bar (m) and velocities (m/s).
@@ -730,11 +731,13 @@ impl Elements {
         let l: f64 = self.length.iter().sum();
         let area = g.volume / l;
         let le = self.length.iter().fold(f64::INFINITY, |a, b| a.min(*b));
-        // The element's wave transit and the face masses' dashpot time, halved.
+        // Within the elements' stability limit 2 sqrt(m / k), and resolving the faces'
+        // relaxation on the bars' dashpots, m / Z, down to a 25th of that limit (the
+        // dashpots are integrated implicitly, so a lighter face stays stable).
         let k_el = v.modulus * area / le;
         let wave = 2.0 * (m[1].min(m[0]) / k_el).sqrt();
         let dash = 2.0 * m[0] / bars.zi.max(bars.zt);
-        0.4 * wave.min(dash)
+        0.4 * wave.min(dash.max(wave / 25.0))
     }
 
     fn step(
@@ -748,19 +751,37 @@ impl Elements {
         let m = Elements::masses(g);
         let l: f64 = self.length.iter().sum();
         let phi = g.friction(v.friction, l);
-        let f1 = (2.0 * bars.zi * bars.ci * e_in - bars.zi * self.vel[0]).max(0.0);
-        let f2 = (bars.zt * self.vel[ELEMENTS]).max(0.0);
-        let mut force = [0.0; ELEMENTS + 1];
-        force[0] += f1;
-        force[ELEMENTS] -= f2;
+        let mut inner = [0.0; ELEMENTS + 1];
         for e in 0..ELEMENTS {
             let area = g.volume / (ELEMENTS as f64 * self.length[e]);
             let fe = self.sigma[e] * area * phi;
-            force[e] -= fe;
-            force[e + 1] += fe;
+            inner[e] -= fe;
+            inner[e + 1] += fe;
+        }
+        // The faces' dashpots (the bars) implicitly, so that light face masses stay stable;
+        // a bar that would pull on the specimen leaves it instead.
+        let last = ELEMENTS;
+        let drive = 2.0 * bars.zi * bars.ci * e_in;
+        let mut v0 = (m[0] * self.vel[0] + h * (drive + inner[0])) / (m[0] + h * bars.zi);
+        let mut f1 = drive - bars.zi * v0;
+        if f1 < 0.0 {
+            f1 = 0.0;
+            v0 = self.vel[0] + h * inner[0] / m[0];
+        }
+        let mut vn = (m[last] * self.vel[last] + h * inner[last]) / (m[last] + h * bars.zt);
+        let mut f2 = bars.zt * vn;
+        if f2 < 0.0 {
+            f2 = 0.0;
+            vn = self.vel[last] + h * inner[last] / m[last];
         }
         for j in 0..=ELEMENTS {
-            self.vel[j] += h * force[j] / m[j];
+            self.vel[j] = if j == 0 {
+                v0
+            } else if j == last {
+                vn
+            } else {
+                self.vel[j] + h * inner[j] / m[j]
+            };
             self.u[j] += h * self.vel[j];
         }
         let l0 = g.length / ELEMENTS as f64;
