@@ -3,6 +3,9 @@
 //!
 //! `cargo run --release -p impactcal-models --example kolsky_copper`
 //!
+//! With `-- timing N`: only N runs of the plain and the dispersed model at one point, with
+//! the wall time per run (run it under `/usr/bin/time -v` for the CPU time).
+//!
 //! The model's fits here are a plain Nelder-Mead search on the relative L2 error of both
 //! signals (a sanity check of the model against the record, not the closed loop's
 //! calibration): the plain model with its nuisance terms, then with dispersion held on.
@@ -113,6 +116,35 @@ fn main() {
         println!("note: {n}");
     }
     let test = conv.test;
+    let args: Vec<String> = std::env::args().collect();
+    if args.get(1).map(String::as_str) == Some("timing") {
+        let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2000);
+        let model = KolskyModel::new(&test).unwrap();
+        let mut names: Vec<String> = model
+            .space()
+            .names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        names.push("dispersion".into());
+        let dispersed = rebuild(&model, &names, &[]).unwrap();
+        let p = [60.0, 450.0, 0.45, 40.0, 4865.9, 0.0, 0.0, 1.0];
+        dispersed.simulate(&p).unwrap();
+        for (what, m, q) in [
+            ("plain", &model, &p[..7]),
+            ("dispersion", &dispersed, &p[..]),
+        ] {
+            let t0 = std::time::Instant::now();
+            for _ in 0..n {
+                std::hint::black_box(m.simulate(q).unwrap());
+            }
+            println!(
+                "{what}: {:.1} us per run (wall, {n} runs)",
+                t0.elapsed().as_secs_f64() / n as f64 * 1e6
+            );
+        }
+        return;
+    }
     let a = ClassicAnalysis::of(&test).unwrap();
     let cal = LanlOptions {
         transmitted_gain: GainRow::Calibrated,

@@ -64,7 +64,7 @@ pub const OUTPUT_CHANNELS: [&str; 2] = ["reflected", "transmitted"];
 /// The declared parameters, in order, with their default ranges and nominals: the material
 /// (`A`, `B`, `n`, `modulus`) and the nuisance terms (`wave_speed` is set around the test's).
 const DECLARED: [(&str, f64, f64, f64, &str); 6] = [
-    ("A", 10.0, 1000.0, 100.0, "MPa"),
+    ("A", 1.0, 2000.0, 100.0, "MPa"),
     ("B", 0.0, 2000.0, 300.0, "MPa"),
     ("n", 0.05, 1.0, 0.5, "1"),
     ("modulus", 5.0, 300.0, 50.0, "GPa"),
@@ -191,7 +191,9 @@ pub struct KolskyModel {
 
 impl KolskyModel {
     /// The model of `test`, with the default parameter ranges (the material's wide enough
-    /// for metals from annealed copper to steels; `wave_speed` within 5 % of the test's).
+    /// for metals from annealed pure metals to steels: `A` 1 to 2,000 MPa, `B` 0 to 2,000
+    /// MPa, `n` 0.05 to 1, `modulus` 5 to 300 GPa; `wave_speed` within 5 % of the test's;
+    /// delays within 10 us).
     ///
     /// # Errors
     /// As [`separate`] (a record whose incident pulse cannot be separated).
