@@ -155,8 +155,8 @@ fn main() {
     let (et, st) = a.true_curve();
     println!(
         "classic: resampled {:?}; equilibrium {:.3} (gain 200), {:.3} (gain 500); peak \
-         three-wave stress {:.1} MPa, final engineering strain {:.3} (true {:.3}, true stress \
-         at the end of loading {:.1} MPa); peak strain rate {:.0}/s",
+         three-wave stress {:.1} MPa, final engineering strain {:.3} (true {:.3}); true stress \
+         at mid-window {:.1} MPa; peak strain rate {:.0}/s",
         a.resampling,
         a.equilibrium,
         b.equilibrium,

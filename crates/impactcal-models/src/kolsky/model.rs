@@ -878,22 +878,15 @@ impl Enrichable for KolskyModel {
                     ),
                 ));
             };
-            if self.space.index_of(name).is_some() {
-                return Err(CoreError::invalid_option(
-                    "condition",
-                    name,
-                    "a parameter of the model; a point sets it",
-                ));
-            }
-            if !(value.is_finite() && (HELD[i].1..=HELD[i].2).contains(value)) {
-                return Err(CoreError::invalid_option(
-                    format!("condition {name}"),
-                    value,
-                    format!(
-                        "outside its admissible range [{}, {}]",
-                        HELD[i].1, HELD[i].2
-                    ),
-                ));
+            match self.candidates().iter().find(|c| c.name() == name) {
+                Some(c) => c.check_value(*value)?,
+                None => {
+                    return Err(CoreError::invalid_option(
+                        "condition",
+                        name,
+                        "a parameter of the model; a point sets it",
+                    ));
+                }
             }
             out.held[i] = *value;
         }
