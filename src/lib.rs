@@ -14,6 +14,7 @@
 //! | [`shell`] | `impactcal-shell` | explicit shell-impact solver, LS-DYNA keyword decks, the parametric airframe | core |
 //! | [`runner`] | `impactcal-runner` | where runs happen: in process, a local process pool, a Slurm cluster; external solvers through deck templates; work directories and a run journal | core (an in-process solver, such as the built-in one, is handed to it from above) |
 //! | [`calibrate`] | `impactcal-calibrate` | curve metrics (Sprague-Geers, Russell, ISO/TS 18571); the calibration study (M1, sensors, M2, surrogates, sensitivity, CORS reconciliation); the closed loop (residual, attribution, enrichment, recalibration, errors before and after); journals and reports | core, shapes, sensors, erbf, sobol, cors, runner |
+//! | [`models`] | `impactcal-models` | models that are not the shell solver, driven by measured inputs: the split-Hopkinson (Kolsky) bar (the drop tower moves here later) | core |
 //! | [`experiment`] | `impactcal-experiment` | experiment files: one schema for studies and closed loops, model assembly (airframe, deck, drop tower, external solver), `Experiment::study`, `close_loop` and `point` | core, shell, runner, calibrate |
 //!
 //! The calibration path runs through them in this order: histories of an ensemble
@@ -53,6 +54,7 @@ pub use impactcal_core as core;
 pub use impactcal_cors as cors;
 pub use impactcal_erbf as erbf;
 pub use impactcal_experiment as experiment;
+pub use impactcal_models as models;
 pub use impactcal_runner as runner;
 pub use impactcal_sensors as sensors;
 pub use impactcal_shapes as shapes;
@@ -66,6 +68,7 @@ use impactcal_core::CoreError;
 use impactcal_cors::CorsError;
 use impactcal_erbf::ErbfError;
 use impactcal_experiment::ExperimentError;
+use impactcal_models::ModelsError;
 use impactcal_runner::RunnerError;
 use impactcal_sensors::SensorsError;
 use impactcal_shapes::ShapesError;
@@ -109,6 +112,9 @@ pub enum Error {
     /// (boxed: its messages carry the file, line and key).
     #[error(transparent)]
     Experiment(Box<ExperimentError>),
+    /// From `impactcal-models`: bar tests (files, keys, records) and their models.
+    #[error(transparent)]
+    Models(#[from] ModelsError),
 }
 
 impl From<ExperimentError> for Error {
@@ -133,6 +139,7 @@ impl Error {
             Error::Calibrate(e) => e.kind(),
             Error::Runner(e) => e.kind(),
             Error::Experiment(e) => e.kind(),
+            Error::Models(e) => e.kind(),
         }
     }
 }

@@ -1,0 +1,17 @@
+//! Models that are not the shell solver: lumped and one-dimensional models of laboratory
+//! impact tests, each a [`Model`](impactcal_core::Model) (and, where it holds quantities it
+//! could free, an [`Enrichable`](impactcal_core::Enrichable)) driven by the measured inputs
+//! the test has.
+//!
+//! - [`kolsky`]: the split-Hopkinson (Kolsky) pressure bar: a bar test as data (the neutral
+//!   test form, the Los Alamos record converted into it).
+//!
+//! The drop tower (`impactcal_core::drop_tower`) belongs here too and moves into this crate
+//! later; until then it stays in `impactcal-core`.
+//!
+//! This crate depends on `impactcal-core` only.
+
+pub mod error;
+pub mod kolsky;
+
+pub use error::{ModelsError, Result};
