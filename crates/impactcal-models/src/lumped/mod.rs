@@ -2,8 +2,12 @@
 //! base that moves with a measured acceleration; the outputs are the absolute accelerations
 //! of named masses, each named after the test channel that measured it.
 //!
-//! - [`system`]: the system as a file ([`LumpedSystem`]) and its typed errors.
+//! - [`system`]: the system as a file ([`LumpedSystem`]) and its typed errors;
+//! - [`integrate`]: the integrator, exact for the linear part and symplectic for the
+//!   contacts ([`Dynamics`]).
 
+pub mod integrate;
 pub mod system;
 
+pub use integrate::{Dynamics, GapLink, SpringLink, Trajectory};
 pub use system::{BASE, Dashpot, Gap, GapSides, LumpedSystem, Node, Output, Spring};
