@@ -1,7 +1,7 @@
 //! The lumped integrator against closed forms (a base-excited single-degree oscillator
 //! under a step and a half-sine) and the energy of a rattling pair of masses.
 
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 use std::f64::consts::PI;
 

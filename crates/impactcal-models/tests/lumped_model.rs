@@ -4,7 +4,7 @@
 //! the resonances of an added mode, a closed rattle as a parallel spring, an exact delay,
 //! a clip at the rail.
 
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 use std::f64::consts::PI;
 

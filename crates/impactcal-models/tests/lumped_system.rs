@@ -1,7 +1,7 @@
 //! The lumped system file: reading it, and the typed error of each malformed case a user
 //! would produce, naming the file, the key and what is wrong.
 
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::float_cmp)]
 
 use impactcal_models::ModelsError;
 use impactcal_models::lumped::{GapSides, LumpedSystem, Node};

@@ -381,7 +381,8 @@ fn matmul(a: &[f64], b: &[f64], n: usize) -> Vec<f64> {
 }
 
 /// `e^A` of an `n x n` row-major matrix: scaled by `2^-s` to a 1-norm of at most 1/2, the
-/// Taylor series summed until a term no longer changes the sum, then squared `s` times.
+/// Taylor series summed until a term falls below the round-off of the sum's largest entry,
+/// then squared `s` times.
 pub(crate) fn expm(a: &[f64], n: usize) -> Vec<f64> {
     let norm = (0..n)
         .map(|j| (0..n).map(|i| a[i * n + j].abs()).sum::<f64>())
@@ -402,13 +403,15 @@ pub(crate) fn expm(a: &[f64], n: usize) -> Vec<f64> {
         term = matmul(&term, &x, n);
         let inv = 1.0 / q as f64;
         term.iter_mut().for_each(|t| *t *= inv);
-        let mut changed = false;
+        let mut largest_sum: f64 = 0.0;
+        let mut largest_term: f64 = 0.0;
         for (acc, t) in sum.iter_mut().zip(&term) {
-            let before = *acc;
             *acc += t;
-            changed |= *acc != before;
+            largest_sum = largest_sum.max(acc.abs());
+            largest_term = largest_term.max(t.abs());
         }
-        if !changed {
+        // Below a quarter of the round-off of the largest entry: no entry moves further.
+        if largest_term <= 0.25 * f64::EPSILON * largest_sum {
             break;
         }
     }
