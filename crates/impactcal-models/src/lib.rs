@@ -5,6 +5,8 @@
 //!
 //! - [`kolsky`]: the split-Hopkinson (Kolsky) pressure bar: a bar test as data (the neutral
 //!   test form, the Los Alamos record converted into it).
+//! - [`lumped`]: driven lumped systems (masses, springs, dashpots, gap contacts) defined in
+//!   a file and driven by a measured base acceleration.
 //!
 //! The drop tower (`impactcal_core::drop_tower`) belongs here too and moves into this crate
 //! later; until then it stays in `impactcal-core`.
@@ -13,5 +15,6 @@
 
 pub mod error;
 pub mod kolsky;
+pub mod lumped;
 
 pub use error::{ModelsError, Result};
