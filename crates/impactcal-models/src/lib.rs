@@ -14,6 +14,7 @@
 //! This crate depends on `impactcal-core` only.
 
 pub mod error;
+mod keys;
 pub mod kolsky;
 pub mod lumped;
 

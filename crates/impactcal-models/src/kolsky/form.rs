@@ -52,6 +52,7 @@ use impactcal_core::Histories;
 use impactcal_core::testdata::Bridge;
 
 use crate::error::{ModelsError, Result};
+use crate::keys::Keys;
 
 /// How the gauges of a bar are wired (see the module docs for the equations).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -243,7 +244,7 @@ impl KolskyTest {
                 file: file.to_string(),
                 message: e.to_string().trim().to_string(),
             })?;
-        let r = Reader { file };
+        let r = Keys { file };
         r.known(
             &root,
             "",
@@ -401,89 +402,7 @@ fn section_keys(s: &Section, square_key: &str) -> String {
     }
 }
 
-/// Typed access to the keys of one file, with errors that name the file and the key.
-struct Reader<'a> {
-    file: &'a str,
-}
-
-impl Reader<'_> {
-    fn key(&self, key: &str, message: impl Into<String>) -> ModelsError {
-        ModelsError::Key {
-            file: self.file.to_string(),
-            key: key.to_string(),
-            message: message.into(),
-        }
-    }
-
-    fn path(table: &str, key: &str) -> String {
-        if table.is_empty() {
-            key.to_string()
-        } else {
-            format!("{table}.{key}")
-        }
-    }
-
-    fn known(&self, t: &toml::Table, table: &str, allowed: &[&str]) -> Result<()> {
-        match t.keys().find(|k| !allowed.contains(&k.as_str())) {
-            Some(k) => Err(self.key(
-                &Self::path(table, k),
-                format!("unknown key (known here: {})", allowed.join(", ")),
-            )),
-            None => Ok(()),
-        }
-    }
-
-    fn get<'t>(&self, t: &'t toml::Table, table: &str, key: &str) -> Result<&'t toml::Value> {
-        t.get(key)
-            .ok_or_else(|| self.key(&Self::path(table, key), "missing"))
-    }
-
-    fn table<'t>(&self, t: &'t toml::Table, table: &str, key: &str) -> Result<&'t toml::Table> {
-        self.get(t, table, key)?
-            .as_table()
-            .ok_or_else(|| self.key(&Self::path(table, key), "must be a table (`[...]`)"))
-    }
-
-    fn number(&self, t: &toml::Table, table: &str, key: &str) -> Result<f64> {
-        let v = self.get(t, table, key)?;
-        let x = v
-            .as_float()
-            .or_else(|| v.as_integer().map(|i| i as f64))
-            .ok_or_else(|| {
-                self.key(
-                    &Self::path(table, key),
-                    format!("must be a number, found {}", v.type_str()),
-                )
-            })?;
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(self.key(&Self::path(table, key), format!("{x} is not finite")))
-        }
-    }
-
-    fn positive(&self, t: &toml::Table, table: &str, key: &str) -> Result<f64> {
-        let x = self.number(t, table, key)?;
-        if x > 0.0 {
-            Ok(x)
-        } else {
-            Err(self.key(
-                &Self::path(table, key),
-                format!("{x} must be positive (SI units)"),
-            ))
-        }
-    }
-
-    fn string(&self, t: &toml::Table, table: &str, key: &str) -> Result<String> {
-        let v = self.get(t, table, key)?;
-        v.as_str().map(str::to_string).ok_or_else(|| {
-            self.key(
-                &Self::path(table, key),
-                format!("must be a string, found {}", v.type_str()),
-            )
-        })
-    }
-
+impl Keys<'_> {
     /// A round section by `round_key`, or a rectangle by `rect` (one key for a square
     /// side, two for width and depth); exactly one of the forms.
     fn section(

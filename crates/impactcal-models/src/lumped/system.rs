@@ -41,6 +41,7 @@
 use std::path::Path;
 
 use crate::error::{ModelsError, Result};
+use crate::keys::Keys;
 
 /// The name of the base node in a system file.
 pub const BASE: &str = "base";
@@ -381,101 +382,7 @@ impl LumpedSystem {
     }
 }
 
-/// Typed access to the keys of one file, with errors that name the file and the key.
-struct Keys<'a> {
-    file: &'a str,
-}
-
 impl Keys<'_> {
-    fn key(&self, key: &str, message: impl Into<String>) -> ModelsError {
-        ModelsError::Key {
-            file: self.file.to_string(),
-            key: key.to_string(),
-            message: message.into(),
-        }
-    }
-
-    fn path(table: &str, key: &str) -> String {
-        if table.is_empty() {
-            key.to_string()
-        } else if key
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-        {
-            format!("{table}.{key}")
-        } else {
-            format!("{table}.{key:?}")
-        }
-    }
-
-    fn known(&self, t: &toml::Table, table: &str, allowed: &[&str]) -> Result<()> {
-        match t.keys().find(|k| !allowed.contains(&k.as_str())) {
-            Some(k) => Err(self.key(
-                &Self::path(table, k),
-                format!("unknown key (known here: {})", allowed.join(", ")),
-            )),
-            None => Ok(()),
-        }
-    }
-
-    fn get<'t>(&self, t: &'t toml::Table, table: &str, key: &str) -> Result<&'t toml::Value> {
-        t.get(key)
-            .ok_or_else(|| self.key(&Self::path(table, key), "missing"))
-    }
-
-    fn table<'t>(&self, t: &'t toml::Table, table: &str, key: &str) -> Result<&'t toml::Table> {
-        self.get(t, table, key)?
-            .as_table()
-            .ok_or_else(|| self.key(&Self::path(table, key), "must be a table (`[...]`)"))
-    }
-
-    fn as_number(&self, v: &toml::Value, path: &str) -> Result<f64> {
-        let x = v
-            .as_float()
-            .or_else(|| v.as_integer().map(|i| i as f64))
-            .ok_or_else(|| self.key(path, format!("must be a number, found {}", v.type_str())))?;
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(self.key(path, format!("{x} is not finite")))
-        }
-    }
-
-    fn number(&self, t: &toml::Table, table: &str, key: &str) -> Result<f64> {
-        self.as_number(self.get(t, table, key)?, &Self::path(table, key))
-    }
-
-    fn positive(&self, t: &toml::Table, table: &str, key: &str) -> Result<f64> {
-        let x = self.number(t, table, key)?;
-        if x > 0.0 {
-            Ok(x)
-        } else {
-            Err(self.key(
-                &Self::path(table, key),
-                format!("{x} must be positive (SI units)"),
-            ))
-        }
-    }
-
-    fn non_negative(&self, t: &toml::Table, table: &str, key: &str) -> Result<f64> {
-        let x = self.number(t, table, key)?;
-        if x >= 0.0 {
-            Ok(x)
-        } else {
-            Err(self.key(&Self::path(table, key), format!("{x} must not be negative")))
-        }
-    }
-
-    fn string(&self, t: &toml::Table, table: &str, key: &str) -> Result<String> {
-        let v = self.get(t, table, key)?;
-        v.as_str().map(str::to_string).ok_or_else(|| {
-            self.key(
-                &Self::path(table, key),
-                format!("must be a string, found {}", v.type_str()),
-            )
-        })
-    }
-
     fn not_base(&self, name: &str, table: &str) -> Result<()> {
         if name == BASE {
             Err(self.key(
