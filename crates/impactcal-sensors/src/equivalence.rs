@@ -14,11 +14,13 @@
 //! Parallel is judged on the whitened rows `w_i = phi_i R^-1` (`Phi = Q R` over all usable
 //! rows), whose directions do not change when `Phi` becomes `Phi T` (`T` invertible): the
 //! test is the same for `U_k`, `U_k S_k` or any other basis of the shapes. A block (a node's
-//! rows) repeats another of as many rows when the spans of their whitened rows coincide.
-//! Near-parallel counts as parallel within `tolerance`: with `B` an orthonormal basis of one
-//! block's whitened rows and `P_a` the orthogonal projector on the other's span, each row
-//! `b` of `B` must satisfy `1 - ||b P_a|| <= tolerance` (for single rows: `1 - |cos theta|
-//! <= tolerance`, about `theta^2 / 2`).
+//! rows) repeats another of as many rows when it adds the same information up to scale: the
+//! Fisher contributions `G = W^T W` of their whitened rows `W` are proportional. A mirror
+//! node (x and z equal, y negated) has the same `G`; two nodes whose rows merely span the
+//! same space (every triaxial node does when there are three shapes) do not. Near-proportional
+//! counts within `tolerance`: with `c = tr(G_a G_b) / (||G_a||_F ||G_b||_F)` the cosine of
+//! the two matrices, `1 - sqrt(c) <= tolerance` (for single rows `c = cos^2 theta`, so this
+//! is `1 - |cos theta| <= tolerance`, about `theta^2 / 2`).
 
 use crate::linalg::{dot, r_factor, whiten_row};
 
@@ -26,16 +28,18 @@ use crate::linalg::{dot, r_factor, whiten_row};
 /// of the block that represents it.
 ///
 /// Blocks are visited forced ones first, then the others by index: a block joins the class
-/// of the first representative already seen whose span matches its own (same row count,
-/// within `tolerance`), else it becomes a representative. Forced blocks never join a class
-/// and stay the representative of theirs; any other class is then represented by its
-/// member of largest whitened norm (the most signal over noise), the first in candidate
-/// order among members within a relative `1e-9` of it. `tolerance <= 0` merges nothing.
+/// of the first representative already seen whose information matches its own (same row
+/// count, `1 - sqrt(c) <= tolerance`, see the module docs), else it becomes a representative.
+/// Forced blocks never join a class and stay the representative of theirs; any other class
+/// is then represented by its member of largest whitened norm (the most signal over noise),
+/// the first in candidate order among members within a relative `1e-9` of it. A block of
+/// zero rows carries no information and joins none. `tolerance <= 0` merges nothing.
 ///
-/// The search sorts the blocks by a scalar key of their projector, `tr(P_b D)` with a fixed
-/// diagonal `D`; equal spans have equal keys and spans within `tolerance` have keys within
-/// `2 ||D||_F sqrt(n tolerance)` (`n` rows), so only neighbours in that window are compared (`O(s log
-/// s)` for `s` candidates rather than `O(s^2)`).
+/// The search sorts the blocks by a scalar key of their normalised Fisher contribution,
+/// `tr(G D) / ||G||_F` with a fixed diagonal `D`; equal contributions have equal keys and
+/// contributions within `tolerance` have keys within `||D||_F sqrt(2 - 2 (1 - tolerance)^2)`,
+/// so only neighbours in that window are compared (`O(s log s)` for `s` candidates rather
+/// than `O(s^2)`).
 pub(crate) fn classes(
     phi: &[f64],
     k: usize,
@@ -50,40 +54,35 @@ pub(crate) fn classes(
     }
     let rows = phi.len() / k.max(1);
     let r = r_factor(phi, k, &(0..rows).collect::<Vec<_>>());
-    // Orthonormal basis of each block's whitened rows (Gram-Schmidt; at most 3 rows), its
-    // squared whitened norm and its key.
+    // Each block's whitened rows, the Frobenius norm of its `G = W^T W`, its squared
+    // whitened norm `tr G` and its key.
     let d: Vec<f64> = (0..k).map(|m| 1.0 + (m as f64 + 1.0).sqrt()).collect();
     let d_norm = dot(&d, &d).sqrt();
-    let mut bases: Vec<Vec<Vec<f64>>> = Vec::with_capacity(n);
+    let mut whitened: Vec<Vec<Vec<f64>>> = Vec::with_capacity(n);
+    let mut g_norm = Vec::with_capacity(n);
     let mut energy = Vec::with_capacity(n);
     let mut key = Vec::with_capacity(n);
     for b in blocks {
-        let mut basis: Vec<Vec<f64>> = Vec::new();
-        let mut e = 0.0;
-        for &row in b {
-            let mut w = vec![0.0; k];
-            whiten_row(&phi[row * k..(row + 1) * k], r.as_ref(), &mut w);
-            e += dot(&w, &w);
-            let scale = dot(&w, &w).sqrt();
-            for q in &basis {
-                let c = dot(&w, q);
-                w.iter_mut().zip(q).for_each(|(x, y)| *x -= c * y);
-            }
-            let norm = dot(&w, &w).sqrt();
-            // A row (nearly) inside the span of the rows before it adds no direction.
-            if norm > 1e-8 * scale && norm > 0.0 {
-                w.iter_mut().for_each(|x| *x /= norm);
-                basis.push(w);
-            }
-        }
-        key.push(
-            basis
-                .iter()
-                .map(|q| q.iter().zip(&d).map(|(x, dm)| x * x * dm).sum::<f64>())
-                .sum::<f64>(),
-        );
-        energy.push(e);
-        bases.push(basis);
+        let w: Vec<Vec<f64>> = b
+            .iter()
+            .map(|&row| {
+                let mut w = vec![0.0; k];
+                whiten_row(&phi[row * k..(row + 1) * k], r.as_ref(), &mut w);
+                w
+            })
+            .collect();
+        let norm = gram_inner(&w, &w).sqrt();
+        energy.push(w.iter().map(|x| dot(x, x)).sum::<f64>());
+        key.push(if norm > 0.0 {
+            w.iter()
+                .map(|x| x.iter().zip(&d).map(|(v, dm)| v * v * dm).sum::<f64>())
+                .sum::<f64>()
+                / norm
+        } else {
+            0.0
+        });
+        g_norm.push(norm);
+        whitened.push(w);
     }
     let mut by_key: Vec<usize> = (0..n).collect();
     by_key.sort_by(|&a, &b| key[a].total_cmp(&key[b]).then(a.cmp(&b)));
@@ -96,27 +95,30 @@ pub(crate) fn classes(
         .filter(|&b| forced[b])
         .chain((0..n).filter(|&b| !forced[b]))
         .collect();
+    let floor = 1.0 - tolerance.min(1.0);
+    let window = d_norm * (2.0 - 2.0 * floor * floor).max(0.0).sqrt();
     // Position in the visiting order of each block already made a representative.
     let mut rank = vec![usize::MAX; n];
     for (visit, &b) in order.iter().enumerate() {
-        let dim = bases[b].len();
-        // Within tolerance, ||P_a - P_b||_F^2 = 2 dim - 2 tr(P_a P_b) <= 4 dim tolerance.
-        let window = d_norm * 2.0 * (dim as f64 * tolerance).sqrt() + 1e-12 * key[b].abs();
         let mut best: Option<usize> = None;
-        if !forced[b] && dim > 0 {
+        if !forced[b] && g_norm[b] > 0.0 {
             let p = place[b];
+            let reach = window + 1e-12 * key[b].abs();
             let below = by_key[..p]
                 .iter()
                 .rev()
-                .take_while(|&&a| key[b] - key[a] <= window);
+                .take_while(|&&a| key[b] - key[a] <= reach);
             let above = by_key[p + 1..]
                 .iter()
-                .take_while(|&&a| key[a] - key[b] <= window);
+                .take_while(|&&a| key[a] - key[b] <= reach);
             for &a in below.chain(above) {
                 let candidate = rank[a] != usize::MAX
                     && blocks[a].len() == blocks[b].len()
-                    && bases[a].len() == dim
-                    && same_span(&bases[a], &bases[b], tolerance);
+                    && g_norm[a] > 0.0
+                    && {
+                        let c = gram_inner(&whitened[a], &whitened[b]) / (g_norm[a] * g_norm[b]);
+                        c.max(0.0).sqrt() >= floor
+                    };
                 if candidate && best.is_none_or(|c| rank[a] < rank[c]) {
                     best = Some(a);
                 }
@@ -156,13 +158,11 @@ pub(crate) fn classes(
     rep_of
 }
 
-/// Whether every vector of the orthonormal `b` lies in the span of the orthonormal `a`
-/// within `tolerance` (`1 - ||q P_a|| <= tolerance`); `a` and `b` have the same length.
-fn same_span(a: &[Vec<f64>], b: &[Vec<f64>], tolerance: f64) -> bool {
-    b.iter().all(|q| {
-        let inside: f64 = a.iter().map(|p| dot(q, p).powi(2)).sum();
-        1.0 - inside.sqrt() <= tolerance
-    })
+/// `tr(G_a G_b)` for `G = W^T W` of the rows `a` and `b`: `sum_ij (a_i . b_j)^2`.
+fn gram_inner(a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
+    a.iter()
+        .map(|x| b.iter().map(|y| dot(x, y).powi(2)).sum::<f64>())
+        .sum()
 }
 
 #[cfg(test)]
@@ -213,10 +213,10 @@ mod tests {
         assert_eq!(classes(&phi, 2, &blocks, &[false; 5], 0.0), [None; 5]);
     }
 
-    /// Two nodes whose rows span the same plane (a mirror pair: x equal, y negated) are
-    /// one class; a node whose rows span another plane is not.
+    /// Two nodes with the same rows up to the sign of one (a mirror pair: x equal, y
+    /// negated) are one class; a node with other rows is not.
     #[test]
-    fn nodes_with_the_same_span_are_equivalent() {
+    fn mirror_nodes_are_equivalent() {
         let phi: Vec<f64> = [
             [1.0, 0.2, 0.0],
             [0.1, 1.0, 0.3],
@@ -232,5 +232,30 @@ mod tests {
         let blocks = vec![vec![0, 1], vec![2, 3], vec![4, 5]];
         let rep = classes(&phi, 3, &blocks, &[false; 3], 1e-9);
         assert_eq!(rep, [None, Some(0), None]);
+    }
+
+    /// With as many shapes as a node has rows, every node's rows span the whole space, yet
+    /// two nodes with different rows add different information: they stay apart, and only
+    /// the mirror image (y negated) joins its node.
+    #[test]
+    fn triaxial_nodes_spanning_the_space_are_not_all_equivalent() {
+        let phi: Vec<f64> = [
+            [1.0, 0.2, 0.0],
+            [0.1, 1.0, 0.3],
+            [0.0, 0.4, 1.0],
+            [2.0, 0.1, 0.5],
+            [0.3, 0.7, 0.0],
+            [0.2, 0.0, 0.9],
+            [1.0, 0.2, 0.0],
+            [-0.1, -1.0, -0.3],
+            [0.0, 0.4, 1.0],
+        ]
+        .iter()
+        .flatten()
+        .copied()
+        .collect();
+        let blocks = vec![vec![0, 1, 2], vec![3, 4, 5], vec![6, 7, 8]];
+        let rep = classes(&phi, 3, &blocks, &[false; 3], 5e-7);
+        assert_eq!(rep, [None, None, Some(0)]);
     }
 }
