@@ -191,7 +191,6 @@ fn hidden_damping_is_found_added_and_the_error_falls_on_calibration_and_holdout(
     let doc = impactcal_calibrate::closeloop::document::report(&r);
     let files = impactcal_calibrate::report::write(&doc, dir.path()).unwrap();
     let html = std::fs::read_to_string(&files.html).unwrap();
-    std::fs::copy(&files.markdown, std::env::var("DUMP_MD").unwrap()).unwrap();
     assert!(html.contains("damping") && html.contains("Unattributed") == r.unattributed.is_some());
     // What a crash analyst reads first: the setting, the test against the three models,
     // their M1 envelopes and M2 matrices, the parameters.

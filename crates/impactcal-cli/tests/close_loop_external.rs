@@ -84,12 +84,14 @@ fn configured(dir: &Path, name: &str, extra: &str, executor: &str) -> PathBuf {
     p
 }
 
-/// `loop.json` of `out` as JSON, and its `model` line taken out.
+/// `loop.json` of `out` as JSON, with its `model` line taken out (and returned) and its
+/// configuration `digest` removed (the two files differ by their model).
 fn loop_json(out: &Path) -> (serde_json::Value, String) {
     let text = std::fs::read_to_string(out.join("loop.json")).unwrap();
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let model = v["model"].as_str().unwrap().to_string();
     v.as_object_mut().unwrap().remove("model");
+    v.as_object_mut().unwrap().remove("digest");
     (v, model)
 }
 

@@ -553,9 +553,22 @@ mod tests {
                 .map(|k| k.to_string())
                 .collect()
         };
+        // `keep_all_channels` is written only when set (so that older folders resume).
         for (section, json) in [
-            ("study", serde_json::to_value(StudyOptions::default())),
-            ("loop", serde_json::to_value(LoopOptions::default())),
+            (
+                "study",
+                serde_json::to_value(StudyOptions {
+                    keep_all_channels: true,
+                    ..StudyOptions::default()
+                }),
+            ),
+            (
+                "loop",
+                serde_json::to_value(LoopOptions {
+                    keep_all_channels: true,
+                    ..LoopOptions::default()
+                }),
+            ),
         ] {
             let json = json.unwrap_or_default();
             let mut fields: Vec<String> = json

@@ -52,7 +52,8 @@ pub(crate) struct Posterior<'a> {
 /// predictive draws about the model response `y` (`S x T`); see the module docs: the
 /// observed exceedance, the expected one `2 / (N + 1)` (the draws carry the noise), the
 /// probability and the verdict as the study judges them ([`m1::m1`]). Deterministic for a
-/// given `seed`.
+/// given `seed`. A masked sample (weight 0: clipped, a spike) carries no evidence: the draws
+/// and the test take the model's value there, so it neither widens the band nor leaves it.
 ///
 /// # Errors
 /// [`crate::CalibrateError::Study`] when `members` is zero.
@@ -73,7 +74,7 @@ pub(crate) fn m1_exceedance(
         .map(|(i, w)| {
             let g = terms.gains[i / t];
             let g = if g != 0.0 { g.abs() } else { 1.0 };
-            1.0 / (w * g)
+            if *w > 0.0 { 1.0 / (w * g) } else { 0.0 }
         })
         .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -97,7 +98,12 @@ pub(crate) fn m1_exceedance(
         })
         .collect();
     let time: Vec<f64> = (0..t).map(|k| k as f64 * frame.dt).collect();
-    let test = nuisance::corrected_test(frame, terms);
+    let mut test = nuisance::corrected_test(frame, terms);
+    for ((v, w), m) in test.iter_mut().zip(&frame.weights).zip(y) {
+        if *w <= 0.0 {
+            *v = *m;
+        }
+    }
     m1::m1(&time, &runs, &norm_history_of(&test, t))
 }
 
