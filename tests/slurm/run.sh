@@ -159,7 +159,8 @@ echo "study killed with $(grep -c '"event":"result"' "$J") of 12 ensemble result
 [ ! -e "$S/slurm/study.json" ] || fail "the study finished before the kill"
 "$IMPACTCAL" study --config "$S/slurm.toml" --out "$S/slurm" 2> "$S/resume.err" \
   || { cat "$S/resume.err"; fail "the resumed study"; }
-grep 'ensemble: 12 runs' "$S/resume.err"
+grep -E 'ensemble over the parameter space: 0/12 runs \([0-9]+ from the journal\)' "$S/resume.err" \
+  || { cat "$S/resume.err"; fail "the resumed ensemble's line (12 runs, some from the journal)"; }
 grep -c '"event":"slurm_job"' "$J" | grep -qx 1 || fail "the ensemble was resubmitted instead of re-attached"
 cmp "$S/reference/study.json" "$S/slurm/study.json" || fail "the resumed study differs from the reference"
 
