@@ -86,7 +86,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
 use crate::model::Model;
-use crate::space::Parameter;
+use crate::space::{Parameter, ParameterSpace};
 
 /// A quantity a model holds fixed and could free: an effect it does not declare.
 ///
@@ -222,6 +222,30 @@ pub trait Enrichable: Model + Sized {
             ))
         }
     }
+}
+
+/// The space of `model` with `added` appended in order (a helper for implementations of
+/// [`Enrichable::enrich`]): each added parameter must be one of the model's candidates
+/// ([`Enrichable::check_candidate`]), with bounds inside the candidate's admissible range
+/// ([`Candidate::check_bounds`]), and none may be added twice.
+///
+/// # Errors
+/// [`CoreError::InvalidOption`] naming the parameter for any of the three; the space's
+/// errors (a duplicate name, bounds not holding the nominal).
+pub fn enriched_space<M: Enrichable>(model: &M, added: &[Parameter]) -> Result<ParameterSpace> {
+    let candidates = model.candidates();
+    let mut params = model.space().parameters().to_vec();
+    for (k, p) in added.iter().enumerate() {
+        model.check_candidate(p)?;
+        if added[..k].iter().any(|q| q.name == p.name) {
+            return Err(CoreError::invalid_option("enrich", &p.name, "added twice"));
+        }
+        if let Some(c) = candidates.iter().find(|c| c.name() == p.name) {
+            c.check_bounds(p)?;
+        }
+        params.push(p.clone());
+    }
+    ParameterSpace::new(params)
 }
 
 /// The model a run names: `model` with the parameters `names` (its own, in order, then

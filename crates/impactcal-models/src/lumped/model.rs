@@ -508,20 +508,8 @@ impl Enrichable for LumpedModel {
     }
 
     fn enrich(&self, added: &[Parameter]) -> impactcal_core::Result<Self> {
-        let candidates = self.candidates();
-        let mut params = self.space.parameters().to_vec();
-        for (k, p) in added.iter().enumerate() {
-            self.check_candidate(p)?;
-            if added[..k].iter().any(|q| q.name == p.name) {
-                return Err(CoreError::invalid_option("enrich", &p.name, "added twice"));
-            }
-            if let Some(c) = candidates.iter().find(|c| c.name() == p.name) {
-                c.check_bounds(p)?;
-            }
-            params.push(p.clone());
-        }
         Ok(LumpedModel {
-            space: ParameterSpace::new(params)?,
+            space: impactcal_core::enrich::enriched_space(self, added)?,
             ..self.clone()
         })
     }
