@@ -1,7 +1,7 @@
 //! Models that can grow: the quantities a model holds fixed today and could free, so that a
 //! calibration that leaves a residual can look for the effect the model lacks.
 //!
-//! A [`Model`] declares a [`ParameterSpace`](crate::ParameterSpace); everything else it needs (a damping
+//! A [`Model`] declares a [`ParameterSpace`]; everything else it needs (a damping
 //! coefficient, a friction coefficient, a concentrated mass, the impact velocity) it holds at
 //! one value. An [`Enrichable`] model lists those held quantities as [`Candidate`]s, builds
 //! itself with some of them freed ([`Enrichable::enrich`]), and builds itself at another test
