@@ -27,6 +27,7 @@
 pub mod builtin;
 pub mod declared;
 pub mod error;
+mod kolsky;
 pub mod model;
 pub mod schema;
 
@@ -100,6 +101,9 @@ pub struct Measured {
     pub holdout: Option<(Histories, Vec<(String, f64)>)>,
     /// What the readers noticed (resampling, ISO-MME notes, deck warnings).
     pub notes: Vec<String>,
+    /// The measurement noise the test itself states, where `[test] sigma` is not given: a
+    /// Kolsky bar's gauge noise before its pulse.
+    pub sigma: Option<f64>,
 }
 
 impl Experiment {
@@ -212,7 +216,25 @@ impl Experiment {
         let base = self.base();
         let in_test = |e: ExperimentError| e.in_section(&self.name, "test");
         let mut notes = Vec::new();
-        let test = read_test(&resolve(base, &t.data), &mut notes).map_err(in_test)?;
+        let mut sigma = None;
+        let test = match (&self.spec, &t.data) {
+            (ModelSpec::KolskyBar { test }, _) => {
+                let (h, s, n) = kolsky::measured(&resolve(base, test))
+                    .map_err(|e| e.in_section(&self.name, "model"))?;
+                if t.sigma.is_none() {
+                    sigma = s;
+                    notes.extend(n);
+                }
+                h
+            }
+            (_, Some(data)) => read_test(&resolve(base, data), &mut notes).map_err(in_test)?,
+            (_, None) => {
+                return Err(ExperimentError::File {
+                    file: self.name.clone(),
+                    message: "[test] data: missing (the measured test, wide CSV or ISO-MME)".into(),
+                });
+            }
+        };
         let map = t
             .map
             .as_ref()
@@ -238,6 +260,7 @@ impl Experiment {
             cfc,
             holdout,
             notes,
+            sigma,
         })
     }
 
@@ -514,12 +537,14 @@ impl Experiment {
             histories,
             set: set.as_slice(),
         });
+        let mut options = self.loop_options();
+        options.sigma = options.sigma.or(measured.sigma);
         let result = run_loop_on(
             model,
             &built.description,
             test,
             holdout,
-            &self.loop_options(),
+            &options,
             out,
             observer,
             worker.as_ref(),

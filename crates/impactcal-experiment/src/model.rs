@@ -9,6 +9,7 @@
 //!   `[parameters]` may give other names; the space a bounds file or `[parameters]` (each
 //!   quantity +-20 % about the deck's value);
 //! - the drop tower (`kind = "drop-tower"`) at the condition `set`;
+//! - the Kolsky bar (`kind = "kolsky-bar"`) on its bar test (`test`; [`crate::kolsky`]);
 //! - an external solver (`[solver]`): the space a bounds file naming the template's
 //!   parameters, the candidates and held quantities those of `[candidates]` and `[held]`
 //!   ([`DeclaredModel`], its runs the runner's);
@@ -31,6 +32,7 @@ use impactcal_core::enrich::Candidate;
 use impactcal_core::{
     CoreError, Enrichable, Histories, Model, Parameter, ParameterSpace, Result as CoreResult,
 };
+use impactcal_models::kolsky::KolskyModel;
 use impactcal_runner::config::SolverSection;
 use impactcal_runner::{Executor, Runner, Template, fingerprint};
 use impactcal_shell::DeckModel;
@@ -128,6 +130,11 @@ pub enum ModelSpec {
         /// The condition (`v0`, ...).
         set: Vec<(String, f64)>,
     },
+    /// The Kolsky bar on a bar test in the neutral form.
+    KolskyBar {
+        /// The bar test's file.
+        test: PathBuf,
+    },
     /// An external solver through a deck template.
     External {
         /// The `[solver]` table.
@@ -149,6 +156,8 @@ pub enum ExperimentModel {
     Deck(Box<Subspace<DeckModel>>),
     /// The drop tower.
     DropTower(DropTower),
+    /// The Kolsky bar.
+    KolskyBar(Box<KolskyModel>),
     /// A deck template or parameterised deck with declared candidates and held quantities.
     Declared(Box<DeclaredModel>),
 }
@@ -161,6 +170,7 @@ macro_rules! each {
             ExperimentModel::Airframe($m) => $body,
             ExperimentModel::Deck($m) => $body,
             ExperimentModel::DropTower($m) => $body,
+            ExperimentModel::KolskyBar($m) => $body,
             ExperimentModel::Declared($m) => $body,
         }
     };
@@ -169,6 +179,7 @@ macro_rules! each {
             ExperimentModel::Airframe($m) => ExperimentModel::Airframe(Box::new($body)),
             ExperimentModel::Deck($m) => ExperimentModel::Deck(Box::new($body)),
             ExperimentModel::DropTower($m) => ExperimentModel::DropTower($body),
+            ExperimentModel::KolskyBar($m) => ExperimentModel::KolskyBar(Box::new($body)),
             ExperimentModel::Declared($m) => ExperimentModel::Declared(Box::new($body)),
         }
     };
@@ -230,7 +241,8 @@ impl ModelSpec {
     /// [`ExperimentError::File`] for `[model]` and `[solver]` that do not name exactly one
     /// model, an unknown `kind`, or keys that do not apply to the model named (`end_time`
     /// and `set` on a deck, `[space]` or `[parameters]` on the drop tower, `[parameters]`
-    /// on the airframe or an external solver).
+    /// on the airframe or an external solver; for the Kolsky bar, those of
+    /// [`crate::kolsky`]), a missing `[test] data` (every model but the Kolsky bar).
     pub fn of(file: &ExperimentFile, name: &str) -> Result<ModelSpec> {
         let fault = |message: &str| ExperimentError::File {
             file: name.to_string(),
@@ -254,6 +266,20 @@ impl ModelSpec {
                 )))
             }
         };
+        if m.kind.as_deref() == Some("kolsky-bar") && m.airframe.is_none() && m.deck.is_none() {
+            return crate::kolsky::spec(&m, file, name);
+        }
+        if m.test.is_some() {
+            return Err(fault(
+                "[model] test names the bar test of kind = \"kolsky-bar\"; other models \
+                 take their test from [test] data",
+            ));
+        }
+        if file.test.data.is_none() {
+            return Err(fault(
+                "[test] data: missing (the measured test, wide CSV or ISO-MME)",
+            ));
+        }
         match (&m.kind, &m.airframe, &m.deck, &file.solver) {
             (Some(k), None, None, None) if k == "drop-tower" => {
                 if !no_space || !params.is_empty() || m.end_time.is_some() {
@@ -268,8 +294,8 @@ impl ModelSpec {
                 })
             }
             (Some(k), None, None, None) => Err(fault(&format!(
-                "[model] kind = \"{k}\": unknown (the built-in model is \"drop-tower\"; the \
-                 airframe and decks are `airframe = \"coarse\"`, `deck = \"model.k\"`)"
+                "[model] kind = \"{k}\": unknown (the built-in models are \"drop-tower\" and \
+                 \"kolsky-bar\"; the airframe and decks are `airframe = \"coarse\"`, `deck = \"model.k\"`)"
             ))),
             (None, Some(mesh), None, None) => {
                 if !params.is_empty() {
@@ -364,6 +390,7 @@ impl ModelSpec {
                     notes: Vec::new(),
                 })
             }
+            ModelSpec::KolskyBar { test } => crate::kolsky::build(&resolve(base, test)),
             ModelSpec::External {
                 solver,
                 space,

@@ -2,6 +2,7 @@
 //!
 //! ```toml
 //! [model]                  # one of: airframe = "coarse" | deck = "model.k" | kind = "drop-tower"
+//!                          # | kind = "kolsky-bar" with test = "copper.toml" (the bar test)
 //! airframe = "coarse"
 //! end_time = 0.025         # airframe only (s)
 //! set = { "ground.friction" = 0.3 }   # held values (airframe; the drop tower's condition)
@@ -74,7 +75,8 @@ pub struct ExperimentFile {
     /// `[space]`: the declared parameters.
     #[serde(default)]
     pub space: SpaceSection,
-    /// `[test]`: the measured test.
+    /// `[test]`: the measured test (a Kolsky bar's is its own bar test, `[model] test`).
+    #[serde(default)]
     pub test: TestSection,
     /// `[holdout]`: a test at another condition the loop never fits.
     pub holdout: Option<HoldoutSection>,
@@ -129,6 +131,8 @@ pub struct ModelSection {
     /// Held values: airframe quantities, or the drop tower's condition.
     #[serde(default)]
     pub set: BTreeMap<String, f64>,
+    /// The bar test of `kind = "kolsky-bar"` in the neutral form (relative to the file).
+    pub test: Option<PathBuf>,
 }
 
 /// `[space]`.
@@ -142,11 +146,12 @@ pub struct SpaceSection {
 }
 
 /// `[test]`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TestSection {
-    /// Wide CSV or an ISO-MME data set (relative to the file).
-    pub data: PathBuf,
+    /// Wide CSV or an ISO-MME data set (relative to the file); required for every model
+    /// but the Kolsky bar, whose measured signals are those of its bar test.
+    pub data: Option<PathBuf>,
     /// Channel map `test_label,model_label[,gain]`.
     pub map: Option<PathBuf>,
     /// CFC class applied to the test and every run.
@@ -171,7 +176,7 @@ pub struct HoldoutSection {
 pub const SECTIONS: &[(&str, Option<&[&str]>)] = &[
     (
         "model",
-        Some(&["kind", "airframe", "deck", "end_time", "set"]),
+        Some(&["kind", "airframe", "deck", "end_time", "set", "test"]),
     ),
     ("parameters", None),
     ("candidates", None),
@@ -287,7 +292,7 @@ const GONE: &[(&str, &str)] = &[
 ///
 /// # Errors
 /// [`ExperimentError::File`] for TOML that does not parse or a value of the wrong type (with
-/// its line and column) or a missing `[test]`; [`ExperimentError::Key`] for an unknown key
+/// its line and column); [`ExperimentError::Key`] for an unknown key
 /// (with the closest names), a key of an earlier schema (with its new place), a section
 /// that is gone, or a `[loop]` value out of range (with what it must be).
 pub fn parse(text: &str, file: &str) -> Result<ExperimentFile> {

@@ -136,6 +136,23 @@ pub struct Separated {
     pub window_len: usize,
     /// How the record was resampled, if it was.
     pub resampling: Option<Resampling>,
+    /// The gauges' noise: the standard deviation of each channel's strain (incident,
+    /// transmitted) about its mean over the quiet start of the record, where neither gauge
+    /// has a wave yet, after the resampling: the samples before the incident pulse's onset
+    /// less one rise time (onset to peak) for its foot; `None` when fewer than
+    /// [`MIN_QUIET`] samples are quiet.
+    pub noise: Option<[f64; 2]>,
+    /// The number of quiet samples [`Separated::noise`] is measured on.
+    pub quiet: usize,
+}
+
+/// The fewest quiet samples before the incident window that give a noise level.
+pub const MIN_QUIET: usize = 32;
+
+/// The standard deviation of `x` about its mean.
+fn spread(x: &[f64]) -> f64 {
+    let m = x.iter().sum::<f64>() / x.len() as f64;
+    (x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (x.len() - 1) as f64).sqrt()
 }
 
 /// Splits a test's gauge strains into the three waves (see the module docs), after
@@ -238,7 +255,11 @@ pub fn separate(test: &KolskyTest) -> Result<Separated> {
             }
         })
         .collect();
+    let quiet = on.saturating_sub(peak_at.saturating_sub(on));
+    let noise = (quiet >= MIN_QUIET).then(|| [spread(&inc[..quiet]), spread(&tra[..quiet])]);
     Ok(Separated {
+        noise,
+        quiet,
         dt,
         start: strains.start(),
         incident,
