@@ -3,6 +3,9 @@
 //!
 //! `cargo run --release -p impactcal-models --example kolsky_copper`
 //!
+//! With `-- neutral DIR`: only the record converted and written in the neutral form
+//! (`DIR/copper.toml` and `DIR/copper-signals.csv`, what examples/kolsky/ holds).
+//!
 //! With `-- timing N`: only N runs of the plain and the dispersed model at one point, with
 //! the wall time per run (run it under `/usr/bin/time -v` for the CPU time).
 //!
@@ -117,6 +120,12 @@ fn main() {
     }
     let test = conv.test;
     let args: Vec<String> = std::env::args().collect();
+    if args.get(1).map(String::as_str) == Some("neutral") {
+        let dir = args.get(2).expect("neutral DIR");
+        let written = test.write(dir, "copper").unwrap();
+        println!("wrote {}", written.display());
+        return;
+    }
     if args.get(1).map(String::as_str) == Some("timing") {
         let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2000);
         let model = KolskyModel::new(&test).unwrap();
