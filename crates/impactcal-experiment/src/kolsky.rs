@@ -4,11 +4,12 @@
 //! The model is [`KolskyModel`] on the test; the measured test is the same record's
 //! reflected and transmitted waves on the model's time base
 //! ([`KolskyModel::measured`]), so a file of this kind gives no `[test] data`. `[test]`
-//! may still give `map` (to compare one wave only), `cfc` and `sigma`.
+//! may still give `map` (the waves it names are the measured test: `reflected` alone
+//! calibrates on the reflected wave), `cfc` and `sigma`.
 
 use std::path::Path;
 
-use impactcal_core::{Histories, Model};
+use impactcal_core::{ChannelMap, Histories, Model};
 use impactcal_models::kolsky::{KolskyModel, KolskyTest};
 use impactcal_runner::fingerprint;
 
@@ -64,12 +65,13 @@ pub(crate) fn spec(m: &ModelSection, file: &ExperimentFile, name: &str) -> Resul
     }
     if !stray.is_empty() {
         return Err(fault(&format!(
-            "{} do(es) not apply to kind = \"kolsky-bar\": the bar model declares A, B, n, \
+            "{} {} not apply to kind = \"kolsky-bar\": the bar model declares A, B, n, \
              modulus and its nuisance terms and lists its own candidates; the measured \
              signals are the bar test's (`[model] test`), and `[test]` takes only `map`, \
              `cfc` and `sigma` (a map naming `reflected` alone calibrates on the reflected \
              wave)",
-            stray.join(", ")
+            stray.join(", "),
+            if stray.len() == 1 { "does" } else { "do" }
         )));
     }
     Ok(ModelSpec::KolskyBar { test: test.clone() })
@@ -139,4 +141,35 @@ pub(crate) fn measured(path: &Path) -> Result<(Histories, Option<f64>, Vec<Strin
         )],
     };
     Ok((model.measured()?, sigma, notes))
+}
+
+/// The bar test's waves that `map` names (a map naming `reflected` alone calibrates on the
+/// reflected wave, leaving the transmitted one to predict), in the map's order.
+///
+/// # Errors
+/// [`ExperimentError::File`] naming the map's line whose test label is not a wave of the
+/// bar test (`reflected`, `transmitted`).
+pub(crate) fn mapped(test: Histories, map: &ChannelMap) -> Result<Histories> {
+    let mut labels = Vec::new();
+    let mut channels = Vec::new();
+    for e in &map.entries {
+        let Some(i) = test.index_of(&e.test_label) else {
+            return Err(ExperimentError::File {
+                file: map.file.clone(),
+                message: format!(
+                    "line {}: `{}` is not a wave of the bar test (reflected, transmitted)",
+                    e.line, e.test_label
+                ),
+            });
+        };
+        labels.push(e.test_label.clone());
+        channels.push(test.channel(i).to_vec());
+    }
+    Ok(Histories::from_channels(
+        labels,
+        channels,
+        test.dt(),
+        test.start(),
+        test.unit(),
+    )?)
 }

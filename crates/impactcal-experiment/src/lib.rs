@@ -246,6 +246,12 @@ impl Experiment {
             .map(Cfc::from_class)
             .transpose()
             .map_err(|e| in_test(e.into()))?;
+        let test = match (&self.spec, &map) {
+            (ModelSpec::KolskyBar { .. }, Some(map)) => {
+                kolsky::mapped(test, map).map_err(in_test)?
+            }
+            _ => test,
+        };
         let holdout = match &self.file.holdout {
             Some(h) => Some((
                 read_test(&resolve(base, &h.data), &mut notes)
