@@ -308,3 +308,35 @@ fn a_record_without_a_needed_row_names_it() {
         Err(ModelsError::Invalid { .. })
     ));
 }
+
+/// Core's reading of a Los Alamos record (`LanlBarRecord::bridge`) and this crate's
+/// (`from_lanl` with its default options) are one reading: the same bridge, and the same
+/// strain sample by sample on both bars, bit for bit. The record's compression reads
+/// positive in volts, so core's tension-positive conversion takes the gain negated (a bridge
+/// wired the other way, as its docs say) and gives the strain with the opposite sign.
+#[test]
+fn core_and_the_models_crate_read_a_los_alamos_record_alike() {
+    use impactcal_core::testdata::lanl_bar::Bar;
+    let record = LanlBarRecord::read(copper_raw()).unwrap();
+    let options = LanlOptions::default();
+    let t = from_lanl(&record, &options).unwrap().test;
+    assert_eq!(
+        options.bridge.core(t.incident.poisson),
+        LanlBarRecord::BRIDGE
+    );
+    let strains = t.strains().unwrap();
+    for (c, bar, setup) in [
+        (0, Bar::Incident, &t.incident),
+        (1, Bar::Transmitted, &t.transmitted),
+    ] {
+        let core = record.bridge(bar, -setup.gain).unwrap();
+        for k in 0..record.histories.samples() {
+            let v = record.histories.value(c, k);
+            assert_eq!(
+                strains.value(c, k).to_bits(),
+                (-core.apply(v)).to_bits(),
+                "{bar:?} sample {k}"
+            );
+        }
+    }
+}

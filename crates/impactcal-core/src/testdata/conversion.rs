@@ -14,11 +14,12 @@
 //! | quarter | one, axial | `4 V_r / (GF (1 - 2 V_r))` |
 //! | half, Poisson | one axial, one transverse (adjacent arms) | `4 V_r / (GF ((1 + nu) - 2 V_r (1 - nu)))` |
 //! | half, bending | two, `+epsilon` and `-epsilon` (adjacent arms) | `2 V_r / GF` |
+//! | half, axial | two axial on opposite faces (opposite arms; bending cancels) | `2 V_r / (GF (1 - V_r))` |
 //! | full, bending | four, two `+epsilon`, two `-epsilon` | `V_r / GF` |
 //! | full, bending with Poisson | `+epsilon`, `-epsilon` and `+-nu epsilon` | `2 V_r / (GF (1 + nu))` |
 //! | full, Poisson (axial) | two axial, two transverse | `2 V_r / (GF ((1 + nu) - V_r (1 - nu)))` |
 //!
-//! The quarter, half-Poisson and full-Poisson forms are exact (the bridge's own
+//! The quarter, half-Poisson, half-axial and full-Poisson forms are exact (the bridge's own
 //! non-linearity included); the others are linear in `V_r` exactly.
 //!
 //! **Accelerometers.** A sensitivity `S` in mV/g and an amplifier gain `G`:
@@ -44,6 +45,9 @@ pub enum Bridge {
     },
     /// Two gauges of equal and opposite strain (bending), in adjacent arms.
     HalfBending,
+    /// Two axial gauges on opposite faces of a bar, in opposite arms: their mean strain,
+    /// bending cancelled (the usual Kolsky bar set-up).
+    HalfAxial,
     /// Four gauges, two of `+epsilon`, two of `-epsilon` (bending).
     FullBending,
     /// Four gauges in bending, `+epsilon`, `-epsilon`, `+nu epsilon`, `-nu epsilon`.
@@ -68,6 +72,7 @@ impl Bridge {
                 4.0 * vr / (gf * ((1.0 + nu) - 2.0 * vr * (1.0 - nu)))
             }
             Bridge::HalfBending => 2.0 * vr / gf,
+            Bridge::HalfAxial => 2.0 * vr / (gf * (1.0 - vr)),
             Bridge::FullBending => vr / gf,
             Bridge::FullBendingPoisson { poisson: nu } => 2.0 * vr / (gf * (1.0 + nu)),
             Bridge::FullPoisson { poisson: nu } => 2.0 * vr / (gf * ((1.0 + nu) - vr * (1.0 - nu))),
@@ -83,6 +88,7 @@ impl Bridge {
             Bridge::Quarter => (1.0 + a, 1.0, 1.0, 1.0),
             Bridge::HalfPoisson { poisson: nu } => (1.0 + a, 1.0 - nu * a, 1.0, 1.0),
             Bridge::HalfBending => (1.0 + a, 1.0 - a, 1.0, 1.0),
+            Bridge::HalfAxial => (1.0 + a, 1.0, 1.0 + a, 1.0),
             Bridge::FullBending => (1.0 + a, 1.0 - a, 1.0 + a, 1.0 - a),
             Bridge::FullBendingPoisson { poisson: nu } => {
                 (1.0 + a, 1.0 - a, 1.0 + nu * a, 1.0 - nu * a)
@@ -247,9 +253,10 @@ impl Conversion {
             pairs.push((k, v));
         }
         let allowed: &[&str] = match kind {
-            "quarter-bridge" | "half-bridge-bending" | "full-bridge-bending" => {
-                &["gf", "gain", "excitation"]
-            }
+            "quarter-bridge"
+            | "half-bridge-bending"
+            | "half-bridge-axial"
+            | "full-bridge-bending" => &["gf", "gain", "excitation"],
             "half-bridge-poisson" | "full-bridge-poisson" | "full-bridge-bending-poisson" => {
                 &["gf", "gain", "excitation", "nu"]
             }
@@ -258,7 +265,7 @@ impl Conversion {
             _ => {
                 return Err(format!(
                     "unknown conversion `{kind}` (quarter-bridge, half-bridge-poisson, \
-                     half-bridge-bending, full-bridge-bending, full-bridge-bending-poisson, \
+                     half-bridge-bending, half-bridge-axial, full-bridge-bending, full-bridge-bending-poisson, \
                      full-bridge-poisson, accelerometer, unit)"
                 ));
             }
@@ -294,6 +301,7 @@ impl Conversion {
             "quarter-bridge" => Some(Bridge::Quarter),
             "half-bridge-poisson" => Some(Bridge::HalfPoisson { poisson: nu()? }),
             "half-bridge-bending" => Some(Bridge::HalfBending),
+            "half-bridge-axial" => Some(Bridge::HalfAxial),
             "full-bridge-bending" => Some(Bridge::FullBending),
             "full-bridge-bending-poisson" => Some(Bridge::FullBendingPoisson { poisson: nu()? }),
             "full-bridge-poisson" => Some(Bridge::FullPoisson { poisson: nu()? }),
@@ -345,6 +353,7 @@ mod tests {
             Bridge::Quarter,
             Bridge::HalfPoisson { poisson: 0.3 },
             Bridge::HalfBending,
+            Bridge::HalfAxial,
             Bridge::FullBending,
             Bridge::FullBendingPoisson { poisson: 0.33 },
             Bridge::FullPoisson { poisson: 0.29 },
@@ -357,11 +366,12 @@ mod tests {
                 assert!((back - eps).abs() < 1e-9 * eps.abs(), "{b:?} {eps}: {back}");
             }
         }
-        // The textbook small-strain sensitivities: quarter GF/4, half bending GF/2, full
-        // bending GF, full Poisson GF (1 + nu) / 2 (per unit strain).
+        // The textbook small-strain sensitivities: quarter GF/4, half bending and half axial
+        // GF/2, full bending GF, full Poisson GF (1 + nu) / 2 (per unit strain).
         let s = |b: Bridge| b.ratio(1e-7, 2.0) / 1e-7;
         assert!((s(Bridge::Quarter) - 0.5).abs() < 1e-6);
         assert!((s(Bridge::HalfBending) - 1.0).abs() < 1e-9);
+        assert!((s(Bridge::HalfAxial) - 1.0).abs() < 1e-6);
         assert!((s(Bridge::FullBending) - 2.0).abs() < 1e-9);
         assert!((s(Bridge::FullPoisson { poisson: 0.3 }) - 1.3).abs() < 1e-6);
     }

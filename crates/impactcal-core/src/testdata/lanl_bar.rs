@@ -208,13 +208,29 @@ impl LanlBarRecord {
             .collect()
     }
 
-    /// The quarter-bridge conversion of `bar`'s gauge signal to strain, with the gain
-    /// `gain` (the header may give two: see [`LanlBarRecord::gains`]), the header's gauge
-    /// factor and excitation voltage.
+    /// The conversion of `bar`'s gauge signal to strain, with the gain `gain` (the header
+    /// may give two: see [`LanlBarRecord::gains`]), the header's gauge factor and excitation
+    /// voltage, through [`LanlBarRecord::BRIDGE`]: the one reading of this record, which
+    /// `impactcal-models`' `kolsky::from_lanl` uses by default too.
     ///
     /// # Errors
     /// [`CoreError::File`] naming the missing or non-numeric header row.
     pub fn bridge(&self, bar: Bar, gain: f64) -> Result<Conversion> {
+        self.bridge_as(bar, gain, Self::BRIDGE)
+    }
+
+    /// How the record's gauges are read: the header does not say how they are wired; the
+    /// half bridge of two opposite axial gauges ([`Bridge::HalfAxial`]) is the usual bar
+    /// set-up, and with it the copper record's plateau is 2.06e-3 of strain (a striker of
+    /// about 20 m/s) and its front and back forces agree (0.999), where a quarter bridge
+    /// would double both strains.
+    pub const BRIDGE: Bridge = Bridge::HalfAxial;
+
+    /// [`LanlBarRecord::bridge`] through another `bridge`.
+    ///
+    /// # Errors
+    /// As [`LanlBarRecord::bridge`].
+    pub fn bridge_as(&self, bar: Bar, gain: f64, bridge: Bridge) -> Result<Conversion> {
         let p = bar.prefix();
         let need = |key: String| -> Result<f64> {
             self.number(&key).ok_or_else(|| CoreError::File {
@@ -223,7 +239,7 @@ impl LanlBarRecord {
             })
         };
         Ok(Conversion::Bridge {
-            bridge: Bridge::Quarter,
+            bridge,
             gauge_factor: need(format!("{p} Bar Calibrated Gage Factor"))?,
             gain,
             excitation: need(format!("{p} Bar Excitation Voltage(V)"))?,
@@ -262,7 +278,10 @@ mod tests {
         );
         let c = r.bridge(Bar::Incident, 200.0).unwrap();
         let vr: f64 = 3.0 / 1600.0;
-        assert!((c.apply(3.0) - 4.0 * vr / (2.061 * (1.0 - 2.0 * vr))).abs() < 1e-15);
+        // The half bridge of two opposite axial gauges: `2 V_r / (GF (1 - V_r))`.
+        assert!((c.apply(3.0) - 2.0 * vr / (2.061 * (1.0 - vr))).abs() < 1e-15);
+        let q = r.bridge_as(Bar::Incident, 200.0, Bridge::Quarter).unwrap();
+        assert!((q.apply(3.0) - 4.0 * vr / (2.061 * (1.0 - 2.0 * vr))).abs() < 1e-15);
         let e = r.bridge(Bar::Transmitted, 500.0).unwrap_err().to_string();
         assert!(e.contains("Transmitted Bar Calibrated Gage Factor"), "{e}");
     }

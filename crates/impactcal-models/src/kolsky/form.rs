@@ -78,10 +78,17 @@ impl GaugeBridge {
     /// The tensile strain a bridge ratio `vr` gives (the module docs' equations), for gauge
     /// factor `gf` and the bar's Poisson ratio `nu` (used by `full` only).
     pub fn strain(self, vr: f64, gf: f64, nu: f64) -> f64 {
+        self.core(nu).strain(vr, gf)
+    }
+
+    /// The bridge of `impactcal-core`'s conversions this wiring is, on a bar of Poisson
+    /// ratio `nu`: `quarter` [`Bridge::Quarter`], `half` [`Bridge::HalfAxial`], `full`
+    /// [`Bridge::FullPoisson`].
+    pub fn core(self, nu: f64) -> Bridge {
         match self {
-            GaugeBridge::Quarter => Bridge::Quarter.strain(vr, gf),
-            GaugeBridge::Half => 2.0 * vr / (gf * (1.0 - vr)),
-            GaugeBridge::Full => Bridge::FullPoisson { poisson: nu }.strain(vr, gf),
+            GaugeBridge::Quarter => Bridge::Quarter,
+            GaugeBridge::Half => Bridge::HalfAxial,
+            GaugeBridge::Full => Bridge::FullPoisson { poisson: nu },
         }
     }
 }

@@ -38,7 +38,8 @@ pub enum GainRow {
 #[derive(Debug, Clone, PartialEq)]
 pub struct LanlOptions {
     /// How the gauges are wired (the header does not say; the default is
-    /// [`GaugeBridge::Half`], two opposite axial gauges, the usual bar set-up).
+    /// [`GaugeBridge::Half`], two opposite axial gauges, the usual bar set-up: the reading
+    /// of `LanlBarRecord::BRIDGE` in `impactcal-core`, so that both read a record alike).
     pub bridge: GaugeBridge,
     /// `+1` when compression reads positive in volts (as in the copper record, whose
     /// incident pulse is positive), `-1` otherwise.
