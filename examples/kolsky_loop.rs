@@ -4,10 +4,12 @@
 //! `cargo run --release --example kolsky_loop [-- OUT]` (default `target/kolsky-loop/`)
 //!
 //! Runs `loop.toml` (both waves), `holdout.toml` (the reflected wave alone, the transmitted
-//! one predicted) and `loop-gain500.toml` (the planted gain fault), each into its folder
+//! one predicted), `loop-gain500.toml` (the planted gain fault) and `pmma13-loop.toml` (a
+//! PMMA test on another bar, unseen), each into its folder
 //! under OUT with its report, and prints per wave the relative L2 error at the nominal,
 //! calibrated and enriched points (with the loop's trigger offset and biases), the fitted
-//! timing, what was added and why the loop stopped. The holdout's transmitted wave is
+//! timing, what was added and why the loop stopped; for a residual left unattributed, where
+//! in time and in which frequency bands its first components sit. The holdout's transmitted wave is
 //! predicted at the reflected-only calibration with the loop's trigger offset; its own
 //! trigger offset (`delay_transmitted`, a nuisance term the reflected wave says nothing
 //! about) is the only thing fitted to it, on a 0.05 us grid over its range.
@@ -69,6 +71,62 @@ fn point_of(
         .map(|n| values.get(*n).copied().unwrap_or(0.0))
         .collect();
     Ok((m, p))
+}
+
+/// Where a residual's time pattern `v` (first sample at `start`, interval `dt`) holds its
+/// energy (the interval from 10 % to 90 % of it) and how its energy splits over frequency
+/// bands (a plain DFT of the pattern, up to 2 MHz).
+fn where_and_band(v: &[f64], start: f64, dt: f64) -> String {
+    let total: f64 = v.iter().map(|x| x * x).sum();
+    let mut cum = 0.0;
+    let (mut lo, mut hi) = (None, None);
+    for (k, x) in v.iter().enumerate() {
+        cum += x * x;
+        if lo.is_none() && cum > 0.1 * total {
+            lo = Some(k);
+        }
+        if hi.is_none() && cum > 0.9 * total {
+            hi = Some(k);
+        }
+    }
+    let at = |k: Option<usize>| (start + k.unwrap_or(0) as f64 * dt) * 1e6;
+    let edges = [0.0, 20e3, 50e3, 100e3, 200e3, 500e3, 1e6, 2e6];
+    let mut power = vec![0.0; edges.len() - 1];
+    let n = v.len();
+    for m in 1..n / 2 {
+        let f = m as f64 / (n as f64 * dt);
+        if f >= 2e6 {
+            break;
+        }
+        let (mut re, mut im) = (0.0, 0.0);
+        for (k, x) in v.iter().enumerate() {
+            let w = -2.0 * std::f64::consts::PI * (m * k % n) as f64 / n as f64;
+            re += x * w.cos();
+            im += x * w.sin();
+        }
+        if let Some(b) = edges.windows(2).position(|e| e[0] <= f && f < e[1]) {
+            power[b] += re * re + im * im;
+        }
+    }
+    let all: f64 = power.iter().sum();
+    let bands: Vec<String> = power
+        .iter()
+        .enumerate()
+        .map(|(b, p)| {
+            format!(
+                "{:.0}-{:.0} kHz {:.0} %",
+                edges[b] / 1e3,
+                edges[b + 1] / 1e3,
+                100.0 * p / all
+            )
+        })
+        .collect();
+    format!(
+        "80 % of its energy from {:.1} to {:.1} us; by band: {}",
+        at(lo),
+        at(hi),
+        bands.join(", ")
+    )
 }
 
 /// The names the loop added, in order.
@@ -163,6 +221,17 @@ fn report(name: &str, file: &Path, out: &Path) -> R<(LoopResult, Experiment)> {
         );
     }
     println!("stopped: {}", r.stopped);
+    if let Some(u) = &r.unattributed {
+        for (i, c) in u.components.iter().take(2).enumerate() {
+            println!(
+                "unattributed component {}: sigma {:.1}, waves {:?}; {}",
+                i + 1,
+                c.sigma,
+                c.sensors,
+                where_and_band(&c.time, r.start, r.time_step)
+            );
+        }
+    }
     Ok((r, e))
 }
 
@@ -208,5 +277,6 @@ fn main() -> R<()> {
         100.0 * as_fitted
     );
     let _ = report("gain500", &dir.join("loop-gain500.toml"), &out)?;
+    let _ = report("pmma13", &dir.join("pmma13-loop.toml"), &out)?;
     Ok(())
 }
