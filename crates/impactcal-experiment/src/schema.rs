@@ -701,7 +701,10 @@ mod tests {
     fn wrong_types_name_line_and_column() {
         let e = err(&format!("{TEST}[study]\nhalton_runs = \"many\"\n"));
         assert!(e.starts_with("x.toml: line 4, column"), "{e}");
-        let e = err("[study]\nseed = 1\n");
-        assert!(e.contains("missing field `test`"), "{e}");
+        // A file without [test] parses (a Kolsky bar's test is its bar test); every other
+        // model is refused when its spec is made.
+        let f = parse("[study]\nseed = 1\n", "x.toml").unwrap();
+        let e = crate::model::ModelSpec::of(&f, "x.toml").unwrap_err().to_string();
+        assert!(e.contains("[test] data: missing"), "{e}");
     }
 }
