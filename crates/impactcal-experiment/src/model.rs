@@ -9,7 +9,7 @@
 //!   `[parameters]` may give other names; the space a bounds file or `[parameters]` (each
 //!   quantity +-20 % about the deck's value);
 //! - the drop tower (`kind = "drop-tower"`) at the condition `set`;
-//! - the Kolsky bar (`kind = "kolsky-bar"`) on its bar test (`test`; [`crate::kolsky`]);
+//! - the Kolsky bar (`kind = "kolsky-bar"`) on its bar test (`test`; module `kolsky`);
 //! - an external solver (`[solver]`): the space a bounds file naming the template's
 //!   parameters, the candidates and held quantities those of `[candidates]` and `[held]`
 //!   ([`DeclaredModel`], its runs the runner's);
@@ -242,7 +242,7 @@ impl ModelSpec {
     /// model, an unknown `kind`, or keys that do not apply to the model named (`end_time`
     /// and `set` on a deck, `[space]` or `[parameters]` on the drop tower, `[parameters]`
     /// on the airframe or an external solver; for the Kolsky bar, those of
-    /// [`crate::kolsky`]), a missing `[test] data` (every model but the Kolsky bar).
+    /// the `kolsky` module's `spec`), a missing `[test] data` (every model but the Kolsky bar).
     pub fn of(file: &ExperimentFile, name: &str) -> Result<ModelSpec> {
         let fault = |message: &str| ExperimentError::File {
             file: name.to_string(),

@@ -704,7 +704,9 @@ mod tests {
         // A file without [test] parses (a Kolsky bar's test is its bar test); every other
         // model is refused when its spec is made.
         let f = parse("[study]\nseed = 1\n", "x.toml").unwrap();
-        let e = crate::model::ModelSpec::of(&f, "x.toml").unwrap_err().to_string();
+        let e = crate::model::ModelSpec::of(&f, "x.toml")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("[test] data: missing"), "{e}");
     }
 }
