@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use impactcal_calibrate::CalibrateError;
 use impactcal_core::{CoreError, ErrorKind};
+use impactcal_models::ModelsError;
 use impactcal_runner::RunnerError;
 use impactcal_shell::ShellError;
 
@@ -65,6 +66,9 @@ pub enum ExperimentError {
     /// From `impactcal-calibrate` (the study and the loop).
     #[error(transparent)]
     Calibrate(#[from] CalibrateError),
+    /// From `impactcal-models` (model files and their records).
+    #[error(transparent)]
+    Models(#[from] ModelsError),
 }
 
 impl ExperimentError {
@@ -79,6 +83,7 @@ impl ExperimentError {
             ExperimentError::Shell(e) => e.kind(),
             ExperimentError::Runner(e) => e.kind(),
             ExperimentError::Calibrate(e) => e.kind(),
+            ExperimentError::Models(e) => e.kind(),
         }
     }
 

@@ -27,6 +27,7 @@
 pub mod builtin;
 pub mod declared;
 pub mod error;
+pub mod lumped;
 pub mod model;
 pub mod schema;
 
@@ -98,8 +99,12 @@ pub struct Measured {
     pub cfc: Option<Cfc>,
     /// The holdout test and its condition.
     pub holdout: Option<(Histories, Vec<(String, f64)>)>,
-    /// What the readers noticed (resampling, ISO-MME notes, deck warnings).
+    /// What the readers noticed (resampling, ISO-MME notes, deck warnings), and the
+    /// scatter between repeated tests.
     pub notes: Vec<String>,
+    /// The scatter between repeated calibration tests, per channel (a lumped model's;
+    /// empty otherwise).
+    pub scatter: Vec<impactcal_models::lumped::ChannelScatter>,
 }
 
 impl Experiment {
@@ -212,16 +217,28 @@ impl Experiment {
         let base = self.base();
         let in_test = |e: ExperimentError| e.in_section(&self.name, "test");
         let mut notes = Vec::new();
+        let cfc = t
+            .cfc
+            .map(Cfc::from_class)
+            .transpose()
+            .map_err(|e| in_test(e.into()))?;
+        if let ModelSpec::Lumped(spec) = &self.spec {
+            let m = lumped::measured(spec, base, &mut notes).map_err(in_test)?;
+            notes.extend(lumped::scatter_notes(&m.scatter));
+            return Ok(Measured {
+                test: m.test,
+                map: None,
+                cfc,
+                holdout: m.holdout,
+                notes,
+                scatter: m.scatter,
+            });
+        }
         let test = read_test(&resolve(base, &t.data), &mut notes).map_err(in_test)?;
         let map = t
             .map
             .as_ref()
             .map(|m| ChannelMap::read(resolve(base, m)))
-            .transpose()
-            .map_err(|e| in_test(e.into()))?;
-        let cfc = t
-            .cfc
-            .map(Cfc::from_class)
             .transpose()
             .map_err(|e| in_test(e.into()))?;
         let holdout = match &self.file.holdout {
@@ -238,6 +255,7 @@ impl Experiment {
             cfc,
             holdout,
             notes,
+            scatter: Vec::new(),
         })
     }
 

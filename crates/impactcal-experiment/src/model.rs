@@ -9,6 +9,8 @@
 //!   `[parameters]` may give other names; the space a bounds file or `[parameters]` (each
 //!   quantity +-20 % about the deck's value);
 //! - the drop tower (`kind = "drop-tower"`) at the condition `set`;
+//! - a driven lumped system (`kind = "lumped"`, [`crate::lumped`]) driven by each test's
+//!   own input;
 //! - an external solver (`[solver]`): the space a bounds file naming the template's
 //!   parameters, the candidates and held quantities those of `[candidates]` and `[held]`
 //!   ([`DeclaredModel`], its runs the runner's);
@@ -128,6 +130,8 @@ pub enum ModelSpec {
         /// The condition (`v0`, ...).
         set: Vec<(String, f64)>,
     },
+    /// A driven lumped system and the tests that drive it.
+    Lumped(crate::lumped::LumpedSpec),
     /// An external solver through a deck template.
     External {
         /// The `[solver]` table.
@@ -149,6 +153,8 @@ pub enum ExperimentModel {
     Deck(Box<Subspace<DeckModel>>),
     /// The drop tower.
     DropTower(DropTower),
+    /// A driven lumped system on its calibration or holdout tests.
+    Lumped(Box<impactcal_models::lumped::LumpedRepeats>),
     /// A deck template or parameterised deck with declared candidates and held quantities.
     Declared(Box<DeclaredModel>),
 }
@@ -161,6 +167,7 @@ macro_rules! each {
             ExperimentModel::Airframe($m) => $body,
             ExperimentModel::Deck($m) => $body,
             ExperimentModel::DropTower($m) => $body,
+            ExperimentModel::Lumped($m) => $body,
             ExperimentModel::Declared($m) => $body,
         }
     };
@@ -169,6 +176,7 @@ macro_rules! each {
             ExperimentModel::Airframe($m) => ExperimentModel::Airframe(Box::new($body)),
             ExperimentModel::Deck($m) => ExperimentModel::Deck(Box::new($body)),
             ExperimentModel::DropTower($m) => ExperimentModel::DropTower($body),
+            ExperimentModel::Lumped($m) => ExperimentModel::Lumped(Box::new($body)),
             ExperimentModel::Declared($m) => ExperimentModel::Declared(Box::new($body)),
         }
     };
@@ -254,7 +262,13 @@ impl ModelSpec {
                 )))
             }
         };
+        if m.kind.as_deref() != Some(crate::lumped::KIND) {
+            crate::lumped::refuse_elsewhere(file, name)?;
+        }
         match (&m.kind, &m.airframe, &m.deck, &file.solver) {
+            (Some(k), None, None, None) if k == crate::lumped::KIND => {
+                crate::lumped::LumpedSpec::of(file, name).map(ModelSpec::Lumped)
+            }
             (Some(k), None, None, None) if k == "drop-tower" => {
                 if !no_space || !params.is_empty() || m.end_time.is_some() {
                     return Err(fault(
@@ -268,8 +282,9 @@ impl ModelSpec {
                 })
             }
             (Some(k), None, None, None) => Err(fault(&format!(
-                "[model] kind = \"{k}\": unknown (the built-in model is \"drop-tower\"; the \
-                 airframe and decks are `airframe = \"coarse\"`, `deck = \"model.k\"`)"
+                "[model] kind = \"{k}\": unknown (the built-in models are \"drop-tower\" and \
+                 \"lumped\"; the airframe and decks are `airframe = \"coarse\"`, `deck = \
+                 \"model.k\"`)"
             ))),
             (None, Some(mesh), None, None) => {
                 if !params.is_empty() {
@@ -364,6 +379,7 @@ impl ModelSpec {
                     notes: Vec::new(),
                 })
             }
+            ModelSpec::Lumped(spec) => spec.build(base),
             ModelSpec::External {
                 solver,
                 space,

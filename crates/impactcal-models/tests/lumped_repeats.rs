@@ -52,8 +52,8 @@ fn each_test_runs_its_own_input_side_by_side() {
     let b = record(3000, 26.0, 0.8e-4);
     let c = record(3000, 23.0, 0.9e-4);
     let d = record(3000, 30.0, 0.7e-4);
-    let reps = LumpedRepeats::new(&system(), &[("a", &a), ("b", &b)], &[("c", &c), ("d", &d)])
-        .unwrap();
+    let reps =
+        LumpedRepeats::new(&system(), &[("a", &a), ("b", &b)], &[("c", &c), ("d", &d)]).unwrap();
     assert_eq!(reps.tests(), [vec!["a", "b"], vec!["c", "d"]]);
     let p = reps.space().nominal();
     let h = reps.simulate(&p).unwrap();
@@ -72,17 +72,32 @@ fn each_test_runs_its_own_input_side_by_side() {
     }
     // Back to the calibration set; another value is refused.
     let back = held.at_condition(&[(REPEAT_SET.into(), 0.0)]).unwrap();
-    assert_eq!(back.simulate(&p).unwrap().channel(0), reps.simulate(&p).unwrap().channel(0));
-    let e = reps.at_condition(&[(REPEAT_SET.into(), 2.0)]).unwrap_err().to_string();
-    assert!(e.contains("0 runs the calibration tests, 1 the holdout tests"), "{e}");
+    assert_eq!(
+        back.simulate(&p).unwrap().channel(0),
+        reps.simulate(&p).unwrap().channel(0)
+    );
+    let e = reps
+        .at_condition(&[(REPEAT_SET.into(), 2.0)])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("0 runs the calibration tests, 1 the holdout tests"),
+        "{e}"
+    );
     // One test keeps its channel's own label.
     let one = LumpedRepeats::new(&system(), &[("a", &a)], &[("c", &c)]).unwrap();
     assert_eq!(one.simulate(&p).unwrap().labels(), ["accel_1"]);
     let one_held = one.at_condition(&[(REPEAT_SET.into(), 1.0)]).unwrap();
-    let own = LumpedModel::new(system(), &c).unwrap().simulate(&p).unwrap();
+    let own = LumpedModel::new(system(), &c)
+        .unwrap()
+        .simulate(&p)
+        .unwrap();
     assert_eq!(one_held.simulate(&p).unwrap().channel(0), own.channel(0));
     let none = LumpedRepeats::new(&system(), &[("a", &a)], &[]).unwrap();
-    let e = none.at_condition(&[(REPEAT_SET.into(), 1.0)]).unwrap_err().to_string();
+    let e = none
+        .at_condition(&[(REPEAT_SET.into(), 1.0)])
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("none was given"), "{e}");
 }
 
@@ -115,7 +130,9 @@ fn malformed_sets_are_refused_naming_the_test() {
     let a = record(2000, 20.0, 1e-4);
     let b = record(2000, 25.0, 1e-4);
     let short = record(1500, 20.0, 1e-4);
-    let e = LumpedRepeats::new(&system(), &[], &[]).unwrap_err().to_string();
+    let e = LumpedRepeats::new(&system(), &[], &[])
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("no calibration test"), "{e}");
     let e = LumpedRepeats::new(&system(), &[("a", &a), ("b", &b)], &[("c", &a)])
         .unwrap_err()
@@ -152,8 +169,8 @@ fn scatter_of_synthetic_repeats_recovers_the_known_noise() {
             (2.0 * PI * 3000.0 * t).sin() * (-t / 2e-3).exp()
         })
         .collect();
-    let truth = Histories::from_channels(vec!["accel_1".into()], vec![y.clone()], DT, 0.0, "g")
-        .unwrap();
+    let truth =
+        Histories::from_channels(vec!["accel_1".into()], vec![y.clone()], DT, 0.0, "g").unwrap();
     let rms = (y.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
     for (ar1, tol) in [(0.0, 0.04), (0.6, 0.08)] {
         let snr = 20.0;
@@ -175,9 +192,17 @@ fn scatter_of_synthetic_repeats_recovers_the_known_noise() {
         let named: Vec<(&str, &Histories)> = repeats.iter().map(|h| ("t", h)).collect();
         let s = scatter(&named, &["accel_1".into()]).unwrap();
         assert_eq!(s[0].repeats, 5);
-        assert!((s[0].rms / sigma - 1.0).abs() < tol, "ar1 {ar1}: {} vs {sigma}", s[0].rms);
+        assert!(
+            (s[0].rms / sigma - 1.0).abs() < tol,
+            "ar1 {ar1}: {} vs {sigma}",
+            s[0].rms
+        );
         let size = (rms * rms + sigma * sigma).sqrt();
-        assert!((s[0].relative - sigma / size).abs() < tol * sigma / size, "{:?}", s[0].relative);
+        assert!(
+            (s[0].relative - sigma / size).abs() < tol * sigma / size,
+            "{:?}",
+            s[0].relative
+        );
         for h in &repeats {
             for (t, v) in h.channel(0).iter().enumerate() {
                 assert!(s[0].lower[t] <= *v && *v <= s[0].upper[t]);
@@ -188,7 +213,9 @@ fn scatter_of_synthetic_repeats_recovers_the_known_noise() {
     let s = scatter(&[("a", &truth), ("b", &truth)], &["accel_1".into()]).unwrap();
     assert_eq!(s[0].rms, 0.0);
     // Fewer than two tests, a missing channel: refused.
-    let e = scatter(&[("a", &truth)], &["accel_1".into()]).unwrap_err().to_string();
+    let e = scatter(&[("a", &truth)], &["accel_1".into()])
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("at least two tests"), "{e}");
     let e = scatter(&[("a", &truth), ("b", &truth)], &["accel_9".into()])
         .unwrap_err()

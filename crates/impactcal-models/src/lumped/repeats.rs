@@ -17,7 +17,9 @@
 //! **Which set runs** is a condition: [`REPEAT_SET`] `= 0` the calibration tests (the
 //! default), `= 1` the holdout tests; the loop's holdout runs at `repeat_set = 1`.
 
-use impactcal_core::{Candidate, CoreError, Enrichable, Histories, Model, Parameter, ParameterSpace};
+use impactcal_core::{
+    Candidate, CoreError, Enrichable, Histories, Model, Parameter, ParameterSpace,
+};
 
 use crate::error::{ModelsError, Result};
 use crate::lumped::model::LumpedModel;
