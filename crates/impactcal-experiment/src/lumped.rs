@@ -31,6 +31,7 @@
 use std::path::{Path, PathBuf};
 
 use impactcal_core::Histories;
+use impactcal_core::quality::{QualityOptions, check};
 use impactcal_models::lumped::{
     ChannelScatter, LumpedRepeats, LumpedSystem, REPEAT_SET, repeat_label, scatter,
 };
@@ -185,7 +186,10 @@ impl LumpedSpec {
                 .iter()
                 .map(|p| {
                     let p = resolve(base, p);
-                    Ok((p.display().to_string(), read_test(&p, notes)?))
+                    let name = p.display().to_string();
+                    let record = read_test(&p, notes)?;
+                    let record = driving(&record, &system.base_channel, &name, notes)?;
+                    Ok((name, record))
                 })
                 .collect()
         };
@@ -304,6 +308,46 @@ pub fn scatter_notes(scatter: &[ChannelScatter]) -> Vec<String> {
             )
         })
         .collect()
+}
+
+/// `record` with its base channel `base` checked as `impactcal check` checks a channel and
+/// repaired ([`impactcal_core::quality::RecordQuality::repaired`]): its offset (the mean
+/// of its quiet part before the drop) removed, its clipped samples and spikes bridged
+/// linearly between their neighbours, since the model integrates the input and a spike or
+/// an offset in it would drive the system as if it were motion. What is repaired goes to
+/// `notes`. A record without the base channel is returned as it is (the model names it).
+///
+/// # Errors
+/// The quality check's errors on the channel.
+fn driving(record: &Histories, base: &str, name: &str, notes: &mut Vec<String>) -> Result<Histories> {
+    let Some(c) = record.index_of(base) else {
+        return Ok(record.clone());
+    };
+    let input = record.select(&[base])?;
+    let quality = check(&input, &QualityOptions::default())?;
+    let repaired = quality.repaired(&input)?;
+    let masked = quality.masked_count();
+    if masked > 0 {
+        notes.push(format!(
+            "{name}: input `{base}`: {masked} clipped or spiked samples bridged before it              drives the model"
+        ));
+    }
+    let channels = (0..record.channels())
+        .map(|k| {
+            if k == c {
+                repaired.channel(0).to_vec()
+            } else {
+                record.channel(k).to_vec()
+            }
+        })
+        .collect();
+    Ok(Histories::from_channels(
+        record.labels().to_vec(),
+        channels,
+        record.dt(),
+        record.start(),
+        record.unit(),
+    )?)
 }
 
 /// `(name, histories)` pairs as borrowed pairs.
