@@ -25,7 +25,11 @@ fn main() {
         .and_then(|i| args.get(i + 1))
         .map_or(10, |s| s.parse().expect("--seeds N"));
     for planted in [false, true] {
-        let what = if planted { "planted rattle" } else { "negative control" };
+        let what = if planted {
+            "planted rattle"
+        } else {
+            "negative control"
+        };
         let mut good = 0;
         for seed in 0..seeds {
             let dir = std::env::temp_dir().join(format!(
@@ -57,7 +61,11 @@ fn main() {
         }
         println!(
             "{what}: {good} of {seeds} {}",
-            if planted { "found and added the rattle" } else { "added nothing" }
+            if planted {
+                "found and added the rattle"
+            } else {
+                "added nothing"
+            }
         );
     }
 }

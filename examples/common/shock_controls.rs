@@ -75,12 +75,26 @@ pub fn truth(model: &LumpedModel, planted: bool) -> Histories {
 pub fn measured(truth: &Histories, seed: u64) -> Histories {
     let board = drop1().select(&[BOARD]).expect("board channel");
     let q = check(&board, &QualityOptions::default()).expect("quality");
-    let noise = q.channels[0].noise_model.clone().expect("a quiet part before the drop");
+    let noise = q.channels[0]
+        .noise_model
+        .clone()
+        .expect("a quiet part before the drop");
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let e = noise.generate(truth.samples(), &mut rng);
-    let y: Vec<f64> = truth.channel(0).iter().zip(&e).map(|(a, b)| a + b).collect();
-    Histories::from_channels(vec![BOARD.into()], vec![y], truth.dt(), truth.start(), truth.unit())
-        .expect("measured")
+    let y: Vec<f64> = truth
+        .channel(0)
+        .iter()
+        .zip(&e)
+        .map(|(a, b)| a + b)
+        .collect();
+    Histories::from_channels(
+        vec![BOARD.into()],
+        vec![y],
+        truth.dt(),
+        truth.start(),
+        truth.unit(),
+    )
+    .expect("measured")
 }
 
 /// The loop on the synthetic drop of `seed` (planted rattle or not), in `dir`.

@@ -319,7 +319,12 @@ pub fn scatter_notes(scatter: &[ChannelScatter]) -> Vec<String> {
 ///
 /// # Errors
 /// The quality check's errors on the channel.
-fn driving(record: &Histories, base: &str, name: &str, notes: &mut Vec<String>) -> Result<Histories> {
+fn driving(
+    record: &Histories,
+    base: &str,
+    name: &str,
+    notes: &mut Vec<String>,
+) -> Result<Histories> {
     let Some(c) = record.index_of(base) else {
         return Ok(record.clone());
     };
