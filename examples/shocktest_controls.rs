@@ -4,7 +4,7 @@
 //! `examples/common/shock_controls.rs`).
 //!
 //! ```text
-//! cargo run --release --example shocktest_controls [-- --seeds 10]
+//! cargo run --release --example shocktest_controls [-- --seeds 10] [--only negative|planted]
 //! ```
 //!
 //! Prints, per seed, what the loop added and its verdict on the negative control (target:
@@ -24,7 +24,16 @@ fn main() {
         .position(|a| a == "--seeds")
         .and_then(|i| args.get(i + 1))
         .map_or(10, |s| s.parse().expect("--seeds N"));
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1))
+        .cloned();
     for planted in [false, true] {
+        let name = if planted { "planted" } else { "negative" };
+        if only.as_deref().is_some_and(|o| o != name) {
+            continue;
+        }
         let what = if planted {
             "planted rattle"
         } else {
@@ -51,9 +60,11 @@ fn main() {
                 .map(|a| format!("{} = {:.4e}", a.name, a.value))
                 .collect();
             println!(
-                "{what}, seed {seed}: verdict {:?}, added [{}], error {:.3} -> {:.3}, {:.1} s",
+                "{what}, seed {seed}: verdict {:?}, added [{}], best candidates {:?}, error \
+                 {:.3} -> {:.3}, {:.1} s",
                 r.verdict,
                 added.join(", "),
+                shock_controls::reasons(&r),
                 r.errors.calibration.calibrated,
                 r.errors.calibration.enriched,
                 start.elapsed().as_secs_f64()

@@ -113,7 +113,20 @@ pub fn run(planted: bool, seed: u64, dir: &Path) -> LoopResult {
     run_loop(&model, "shock control", data, None, &options, dir, &Silent).expect("loop")
 }
 
+/// Why the first attribution's three best candidates were or were not added: name,
+/// status, explained fraction.
+#[allow(dead_code)]
+pub fn reasons(r: &LoopResult) -> Vec<(String, String, f64)> {
+    r.candidates
+        .iter()
+        .filter(|s| s.kind == "candidate")
+        .take(3)
+        .map(|s| (s.name.clone(), s.status.clone(), s.explained_fraction))
+        .collect()
+}
+
 /// Whether a loop added a rattle of board 1 (its stiffness or its gap).
+#[allow(dead_code)]
 pub fn found_rattle(r: &LoopResult) -> bool {
     r.added.iter().any(|a| a.name.starts_with("rattle_mount1"))
 }
