@@ -23,6 +23,10 @@ fn the_negative_control_adds_nothing() {
         assert_eq!(r.verdict, Verdict::NoModelFormError, "seed {seed}");
         // The calibrated model reproduces the truth to the noise's level (its relative
         // L2 on the synthetic drop is the noise's share, under 1 %).
-        assert!(r.errors.calibration.calibrated < 0.01, "seed {seed}: {:?}", r.errors);
+        assert!(
+            r.errors.calibration.calibrated < 0.01,
+            "seed {seed}: {:?}",
+            r.errors
+        );
     }
 }
