@@ -45,6 +45,9 @@ use crate::schema::ExperimentFile;
 /// The `[model] kind` of a lumped system.
 pub const KIND: &str = "lumped";
 
+/// Tests as read: `(path, record)` each, the base channel repaired.
+type Tests = Vec<(String, Histories)>;
+
 /// What a file says of a lumped model: its system file and its tests, as written
 /// (relative to the file).
 #[derive(Debug, Clone, PartialEq)]
@@ -175,13 +178,9 @@ impl LumpedSpec {
     }
 
     /// Reads the system file and every test, each relative to `base`.
-    fn read(
-        &self,
-        base: &Path,
-        notes: &mut Vec<String>,
-    ) -> Result<(LumpedSystem, [Vec<(String, Histories)>; 2])> {
+    fn read(&self, base: &Path, notes: &mut Vec<String>) -> Result<(LumpedSystem, [Tests; 2])> {
         let system = LumpedSystem::read(resolve(base, &self.file))?;
-        let mut read = |paths: &[PathBuf]| -> Result<Vec<(String, Histories)>> {
+        let mut read = |paths: &[PathBuf]| -> Result<Tests> {
             paths
                 .iter()
                 .map(|p| {

@@ -119,7 +119,7 @@ fn held_quantities_share_the_largest_drives_scale() {
     assert!((p.upper - 2.0 * reach).abs() <= 1e-12 * reach, "{p:?}");
     assert!((p.nominal - 0.5 * reach).abs() <= 1e-12 * reach, "{p:?}");
     // Freed on both sets: the holdout run takes the freed rattle too.
-    let enriched = reps.enrich(&[gap.parameter.clone()]).unwrap();
+    let enriched = reps.enrich(std::slice::from_ref(&gap.parameter)).unwrap();
     let held = enriched.at_condition(&[(REPEAT_SET.into(), 1.0)]).unwrap();
     assert_eq!(held.space().dim(), 3);
     assert!(held.simulate(&held.space().nominal()).is_ok());

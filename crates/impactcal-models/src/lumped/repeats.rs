@@ -210,20 +210,23 @@ impl Enrichable for LumpedRepeats {
                 rest.push((name.clone(), *value));
                 continue;
             }
-            active = match *value {
-                v if v == 0.0 => 0,
-                v if v == 1.0 && !self.sets[1].is_empty() => 1,
-                v if v == 1.0 => {
+            let rounded = value.round();
+            let set = ((value - rounded).abs() <= 1e-9 && (0.0..=1.0).contains(&rounded))
+                .then_some(rounded as usize);
+            active = match set {
+                Some(0) => 0,
+                Some(_) if !self.sets[1].is_empty() => 1,
+                Some(_) => {
                     return Err(CoreError::invalid_option(
                         "condition",
                         REPEAT_SET,
                         "1 runs the holdout tests, and none was given",
                     ));
                 }
-                v => {
+                None => {
                     return Err(CoreError::invalid_option(
                         "condition",
-                        format!("{REPEAT_SET} = {v}"),
+                        format!("{REPEAT_SET} = {value}"),
                         "0 runs the calibration tests, 1 the holdout tests",
                     ));
                 }
