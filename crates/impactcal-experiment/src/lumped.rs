@@ -32,9 +32,7 @@ use std::path::{Path, PathBuf};
 
 use impactcal_core::Histories;
 use impactcal_core::quality::{QualityOptions, check};
-use impactcal_models::lumped::{
-    ChannelScatter, LumpedRepeats, LumpedSystem, REPEAT_SET, repeat_label, scatter,
-};
+use impactcal_models::lumped::{ChannelScatter, LumpedRepeats, LumpedSystem, REPEAT_SET, scatter};
 use impactcal_runner::fingerprint;
 
 use crate::error::{ExperimentError, Result, io};
@@ -228,7 +226,7 @@ impl LumpedSpec {
 }
 
 /// The measured side of `spec` (paths relative to `base`): each set's output channels of
-/// the system, labelled as the model labels them ([`repeat_label`]), and the scatter
+/// the system, labelled as the model labels them ([`impactcal_models::lumped::repeat_label`]), and the scatter
 /// between the calibration tests; what the readers notice goes to `notes`.
 ///
 /// # Errors
@@ -238,40 +236,9 @@ pub fn measured(spec: &LumpedSpec, base: &Path, notes: &mut Vec<String>) -> Resu
     let (system, [cal, hold]) = spec.read(base, notes)?;
     let outputs: Vec<String> = system.outputs.iter().map(|o| o.channel.clone()).collect();
     let side_by_side = |set: &[(String, Histories)]| -> Result<Histories> {
-        let n = set.len();
-        let mut labels = Vec::with_capacity(n * outputs.len());
-        let mut channels = Vec::with_capacity(n * outputs.len());
-        for (k, (name, h)) in set.iter().enumerate() {
-            let first = &set[0].1;
-            if h.samples() != first.samples() || (h.dt() - first.dt()).abs() > 1e-9 * first.dt() {
-                return Err(fault(
-                    name,
-                    format!(
-                        "{} samples every {} s, but {} has {} every {} s: repeated tests share \
-                         one window",
-                        h.samples(),
-                        h.dt(),
-                        set[0].0,
-                        first.samples(),
-                        first.dt()
-                    ),
-                ));
-            }
-            for c in &outputs {
-                let y = h
-                    .channel_by_label(c)
-                    .map_err(|e| fault(name, format!("output channel `{c}`: {e}")))?;
-                labels.push(repeat_label(c, k, n));
-                channels.push(y.to_vec());
-            }
-        }
-        let first = &set[0].1;
-        Ok(Histories::from_channels(
-            labels,
-            channels,
-            first.dt(),
-            first.start(),
-            first.unit(),
+        Ok(impactcal_models::lumped::side_by_side(
+            &as_refs(set),
+            &outputs,
         )?)
     };
     let test = side_by_side(&cal)?;

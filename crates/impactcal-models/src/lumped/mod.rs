@@ -48,5 +48,5 @@ pub mod system;
 
 pub use integrate::{Dynamics, GapLink, SpringLink, Trajectory};
 pub use model::LumpedModel;
-pub use repeats::{ChannelScatter, LumpedRepeats, REPEAT_SET, repeat_label, scatter};
+pub use repeats::{ChannelScatter, LumpedRepeats, REPEAT_SET, repeat_label, scatter, side_by_side};
 pub use system::{BASE, Dashpot, Gap, GapSides, LumpedSystem, Node, Output, Spring};

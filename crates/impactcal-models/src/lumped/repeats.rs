@@ -64,12 +64,12 @@ impl LumpedRepeats {
         calibration: &[(&str, &Histories)],
         holdout: &[(&str, &Histories)],
     ) -> Result<LumpedRepeats> {
-        let Some((first_name, first)) = calibration.first() else {
+        if calibration.is_empty() {
             return Err(ModelsError::record(
                 "repeated tests",
                 "no calibration test: name at least one",
             ));
-        };
+        }
         if !holdout.is_empty() && holdout.len() != calibration.len() {
             return Err(ModelsError::record(
                 "repeated tests",
@@ -83,25 +83,7 @@ impl LumpedRepeats {
             ));
         }
         let all = || calibration.iter().chain(holdout);
-        for (name, record) in all() {
-            let same_dt = (record.dt() - first.dt()).abs() <= 1e-9 * first.dt();
-            let same_start = (record.start() - first.start()).abs() <= 1e-6 * first.dt();
-            if !same_dt || record.samples() != first.samples() || !same_start {
-                return Err(ModelsError::record(
-                    format!("test `{name}`"),
-                    format!(
-                        "{} samples from {} s every {} s, but `{first_name}` has {} from {} s \
-                         every {} s: repeated tests share one window (cut each record to it)",
-                        record.samples(),
-                        record.start(),
-                        record.dt(),
-                        first.samples(),
-                        first.start(),
-                        first.dt()
-                    ),
-                ));
-            }
-        }
+        same_window(&all().copied().collect::<Vec<_>>())?;
         let mut peak = 0.0_f64;
         for (name, record) in all() {
             let m = LumpedModel::new(system.clone(), record).map_err(|e| in_test(name, e))?;
@@ -152,6 +134,67 @@ impl LumpedRepeats {
         }
         Ok(out)
     }
+}
+
+/// Refuses tests whose step, sample count or start differs from the first's, naming the
+/// test.
+fn same_window(tests: &[(&str, &Histories)]) -> Result<()> {
+    let Some((first_name, first)) = tests.first() else {
+        return Ok(());
+    };
+    for (name, record) in tests {
+        let same_dt = (record.dt() - first.dt()).abs() <= 1e-9 * first.dt();
+        let same_start = (record.start() - first.start()).abs() <= 1e-6 * first.dt();
+        if !same_dt || record.samples() != first.samples() || !same_start {
+            return Err(ModelsError::record(
+                format!("test `{name}`"),
+                format!(
+                    "{} samples from {} s every {} s, but `{first_name}` has {} from {} s \
+                     every {} s: repeated tests share one window (cut each record to it)",
+                    record.samples(),
+                    record.start(),
+                    record.dt(),
+                    first.samples(),
+                    first.start(),
+                    first.dt()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The channels `channels` (test labels) of each of `tests` side by side, labelled as a
+/// [`LumpedRepeats`] labels its run ([`repeat_label`]): the measured side of a set of
+/// repeated tests.
+///
+/// # Errors
+/// [`ModelsError::Record`] for no test, tests of different windows, or a test without one
+/// of the channels (naming the test and the channel).
+pub fn side_by_side(tests: &[(&str, &Histories)], channels: &[String]) -> Result<Histories> {
+    let Some((_, first)) = tests.first() else {
+        return Err(ModelsError::record("repeated tests", "no test"));
+    };
+    same_window(tests)?;
+    let n = tests.len();
+    let mut labels = Vec::with_capacity(n * channels.len());
+    let mut data = Vec::with_capacity(n * channels.len());
+    for (k, (name, h)) in tests.iter().enumerate() {
+        for c in channels {
+            let y = h.channel_by_label(c).map_err(|e| {
+                ModelsError::record(format!("test `{name}`"), format!("channel `{c}`: {e}"))
+            })?;
+            labels.push(repeat_label(c, k, n));
+            data.push(y.to_vec());
+        }
+    }
+    Ok(Histories::from_channels(
+        labels,
+        data,
+        first.dt(),
+        first.start(),
+        first.unit(),
+    )?)
 }
 
 /// `e` of the test `name`.
@@ -276,7 +319,7 @@ pub struct ChannelScatter {
 /// the test); a channel a test lacks (the core error, naming it); a non-finite sample
 /// (naming the test, the channel and the sample).
 pub fn scatter(tests: &[(&str, &Histories)], channels: &[String]) -> Result<Vec<ChannelScatter>> {
-    let [(first_name, first), ..] = tests else {
+    let [(_, first), ..] = tests else {
         return Err(ModelsError::record(
             "scatter between repeats",
             "needs at least two tests",
@@ -288,21 +331,7 @@ pub fn scatter(tests: &[(&str, &Histories)], channels: &[String]) -> Result<Vec<
             "needs at least two tests",
         ));
     }
-    for (name, h) in tests {
-        if h.samples() != first.samples() || (h.dt() - first.dt()).abs() > 1e-9 * first.dt() {
-            return Err(ModelsError::record(
-                format!("test `{name}`"),
-                format!(
-                    "{} samples every {} s, but `{first_name}` has {} every {} s: repeats are \
-                     compared on one window",
-                    h.samples(),
-                    h.dt(),
-                    first.samples(),
-                    first.dt()
-                ),
-            ));
-        }
-    }
+    same_window(tests)?;
     let n = tests.len();
     let len = first.samples();
     channels
