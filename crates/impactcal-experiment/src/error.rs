@@ -66,8 +66,8 @@ pub enum ExperimentError {
     /// From `impactcal-calibrate` (the study and the loop).
     #[error(transparent)]
     Calibrate(#[from] CalibrateError),
-    /// From `impactcal-models` (a Kolsky bar test that does not read, a bar model that
-    /// cannot be built).
+    /// From `impactcal-models` (model files and their records: a Kolsky bar test, a lumped
+    /// system, ...).
     #[error(transparent)]
     Models(#[from] ModelsError),
 }

@@ -42,6 +42,12 @@ pub(crate) fn spec(m: &ModelSection, file: &ExperimentFile, name: &str) -> Resul
     if m.end_time.is_some() {
         stray.push("[model] end_time");
     }
+    if m.file.is_some() {
+        stray.push("[model] file");
+    }
+    if !file.test.repeats.is_empty() {
+        stray.push("[test] repeats");
+    }
     if file.space.preset.is_some() || file.space.bounds.is_some() {
         stray.push("[space]");
     }

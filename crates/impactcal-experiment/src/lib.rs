@@ -28,6 +28,7 @@ pub mod builtin;
 pub mod declared;
 pub mod error;
 mod kolsky;
+pub mod lumped;
 pub mod model;
 pub mod schema;
 
@@ -99,11 +100,15 @@ pub struct Measured {
     pub cfc: Option<Cfc>,
     /// The holdout test and its condition.
     pub holdout: Option<(Histories, Vec<(String, f64)>)>,
-    /// What the readers noticed (resampling, ISO-MME notes, deck warnings).
+    /// What the readers noticed (resampling, ISO-MME notes, deck warnings), and the
+    /// scatter between repeated tests.
     pub notes: Vec<String>,
     /// The measurement noise the test itself states, where `[test] sigma` is not given: a
     /// Kolsky bar's gauge noise before its pulse.
     pub sigma: Option<f64>,
+    /// The scatter between repeated calibration tests, per channel (a lumped model's;
+    /// empty otherwise).
+    pub scatter: Vec<impactcal_models::lumped::ChannelScatter>,
 }
 
 impl Experiment {
@@ -217,6 +222,24 @@ impl Experiment {
         let in_test = |e: ExperimentError| e.in_section(&self.name, "test");
         let mut notes = Vec::new();
         let mut sigma = None;
+        let cfc = t
+            .cfc
+            .map(Cfc::from_class)
+            .transpose()
+            .map_err(|e| in_test(e.into()))?;
+        if let ModelSpec::Lumped(spec) = &self.spec {
+            let m = lumped::measured(spec, base, &mut notes).map_err(in_test)?;
+            notes.extend(lumped::scatter_notes(&m.scatter));
+            return Ok(Measured {
+                test: m.test,
+                map: None,
+                cfc,
+                holdout: m.holdout,
+                notes,
+                sigma: None,
+                scatter: m.scatter,
+            });
+        }
         let test = match (&self.spec, &t.data) {
             (ModelSpec::KolskyBar { test }, _) => {
                 let (h, s, n) = kolsky::measured(&resolve(base, test))
@@ -241,11 +264,6 @@ impl Experiment {
             .map(|m| ChannelMap::read(resolve(base, m)))
             .transpose()
             .map_err(|e| in_test(e.into()))?;
-        let cfc = t
-            .cfc
-            .map(Cfc::from_class)
-            .transpose()
-            .map_err(|e| in_test(e.into()))?;
         let test = match (&self.spec, &map) {
             (ModelSpec::KolskyBar { .. }, Some(map)) => {
                 kolsky::mapped(test, map).map_err(in_test)?
@@ -267,6 +285,7 @@ impl Experiment {
             holdout,
             notes,
             sigma,
+            scatter: Vec::new(),
         })
     }
 

@@ -10,6 +10,8 @@
 //!   quantity +-20 % about the deck's value);
 //! - the drop tower (`kind = "drop-tower"`) at the condition `set`;
 //! - the Kolsky bar (`kind = "kolsky-bar"`) on its bar test (`test`; module `kolsky`);
+//! - a driven lumped system (`kind = "lumped"`, [`crate::lumped`]) driven by each test's
+//!   own input;
 //! - an external solver (`[solver]`): the space a bounds file naming the template's
 //!   parameters, the candidates and held quantities those of `[candidates]` and `[held]`
 //!   ([`DeclaredModel`], its runs the runner's);
@@ -135,6 +137,8 @@ pub enum ModelSpec {
         /// The bar test's file.
         test: PathBuf,
     },
+    /// A driven lumped system and the tests that drive it.
+    Lumped(crate::lumped::LumpedSpec),
     /// An external solver through a deck template.
     External {
         /// The `[solver]` table.
@@ -158,6 +162,8 @@ pub enum ExperimentModel {
     DropTower(DropTower),
     /// The Kolsky bar.
     KolskyBar(Box<KolskyModel>),
+    /// A driven lumped system on its calibration or holdout tests.
+    Lumped(Box<impactcal_models::lumped::LumpedRepeats>),
     /// A deck template or parameterised deck with declared candidates and held quantities.
     Declared(Box<DeclaredModel>),
 }
@@ -171,6 +177,7 @@ macro_rules! each {
             ExperimentModel::Deck($m) => $body,
             ExperimentModel::DropTower($m) => $body,
             ExperimentModel::KolskyBar($m) => $body,
+            ExperimentModel::Lumped($m) => $body,
             ExperimentModel::Declared($m) => $body,
         }
     };
@@ -180,6 +187,7 @@ macro_rules! each {
             ExperimentModel::Deck($m) => ExperimentModel::Deck(Box::new($body)),
             ExperimentModel::DropTower($m) => ExperimentModel::DropTower($body),
             ExperimentModel::KolskyBar($m) => ExperimentModel::KolskyBar(Box::new($body)),
+            ExperimentModel::Lumped($m) => ExperimentModel::Lumped(Box::new($body)),
             ExperimentModel::Declared($m) => ExperimentModel::Declared(Box::new($body)),
         }
     };
@@ -269,6 +277,9 @@ impl ModelSpec {
         if m.kind.as_deref() == Some("kolsky-bar") && m.airframe.is_none() && m.deck.is_none() {
             return crate::kolsky::spec(&m, file, name);
         }
+        if m.kind.as_deref() != Some(crate::lumped::KIND) {
+            crate::lumped::refuse_elsewhere(file, name)?;
+        }
         if m.test.is_some() {
             return Err(fault(
                 "[model] test names the bar test of kind = \"kolsky-bar\"; other models \
@@ -281,6 +292,9 @@ impl ModelSpec {
             ));
         }
         match (&m.kind, &m.airframe, &m.deck, &file.solver) {
+            (Some(k), None, None, None) if k == crate::lumped::KIND => {
+                crate::lumped::LumpedSpec::of(file, name).map(ModelSpec::Lumped)
+            }
             (Some(k), None, None, None) if k == "drop-tower" => {
                 if !no_space || !params.is_empty() || m.end_time.is_some() {
                     return Err(fault(
@@ -295,7 +309,8 @@ impl ModelSpec {
             }
             (Some(k), None, None, None) => Err(fault(&format!(
                 "[model] kind = \"{k}\": unknown (the built-in models are \"drop-tower\" and \
-                 \"kolsky-bar\"; the airframe and decks are `airframe = \"coarse\"`, `deck = \"model.k\"`)"
+                 \"kolsky-bar\" and \"lumped\"; the airframe and decks are `airframe = \"coarse\"`, \
+                 `deck = \"model.k\"`)"
             ))),
             (None, Some(mesh), None, None) => {
                 if !params.is_empty() {
@@ -391,6 +406,7 @@ impl ModelSpec {
                 })
             }
             ModelSpec::KolskyBar { test } => crate::kolsky::build(&resolve(base, test)),
+            ModelSpec::Lumped(spec) => spec.build(base),
             ModelSpec::External {
                 solver,
                 space,

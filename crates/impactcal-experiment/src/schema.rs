@@ -3,7 +3,9 @@
 //! ```toml
 //! [model]                  # one of: airframe = "coarse" | deck = "model.k" | kind = "drop-tower"
 //!                          # | kind = "kolsky-bar" with test = "copper.toml" (the bar test)
+//!                          # | kind = "lumped" with file = "board.toml" (the lumped system)
 //! airframe = "coarse"
+//! file = "board.toml"      # kind = "lumped": the lumped system's file
 //! end_time = 0.025         # airframe only (s)
 //! set = { "ground.friction" = 0.3 }   # held values (airframe; the drop tower's condition)
 //!
@@ -18,10 +20,12 @@
 //! map = "map.csv"          # optional channel map
 //! cfc = 60                 # optional CFC class
 //! sigma = 0.5              # optional measurement noise; else measured on the test
+//! repeats = ["drop3.csv"]  # kind = "lumped": further tests of the article, calibrated on too
 //!
 //! [holdout]                # the loop's holdout test at another condition
 //! data = "holdout.csv"
-//! set = { v0 = 5.0 }
+//! set = { v0 = 5.0 }       # (kind = "lumped": none; each test's input is its condition)
+//! repeats = ["drop4.csv"]  # kind = "lumped": as many holdout tests as calibration tests
 //!
 //! [solver]                 # instead of [model]: an external solver (deck template, command)
 //! template = "deck.k"
@@ -120,8 +124,10 @@ pub struct CandidateSection {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSection {
-    /// A built-in model by name: `drop-tower`.
+    /// A built-in model by name: `drop-tower`, `lumped`.
     pub kind: Option<String>,
+    /// The model's own file (`kind = "lumped"`: the lumped system), relative to the file.
+    pub file: Option<PathBuf>,
     /// The built-in airframe's mesh density (`coarse`, `medium`, `fine`).
     pub airframe: Option<String>,
     /// A keyword deck (relative to the file).
@@ -159,6 +165,10 @@ pub struct TestSection {
     /// Measurement noise standard deviation of every channel (after the filter); default:
     /// measured on the test.
     pub sigma: Option<f64>,
+    /// Further tests of the same article calibrated on with `data`, each with its own
+    /// input (`kind = "lumped"`).
+    #[serde(default)]
+    pub repeats: Vec<PathBuf>,
 }
 
 /// `[holdout]`.
@@ -167,8 +177,13 @@ pub struct TestSection {
 pub struct HoldoutSection {
     /// The holdout test's data (same map and filter as the test).
     pub data: PathBuf,
-    /// Its condition, as held quantities of the model.
+    /// Its condition, as held quantities of the model (required but for `kind =
+    /// "lumped"`, whose tests' inputs are their conditions).
+    #[serde(default)]
     pub set: BTreeMap<String, f64>,
+    /// Further holdout tests of the same article (`kind = "lumped"`).
+    #[serde(default)]
+    pub repeats: Vec<PathBuf>,
 }
 
 /// The sections of a file and their keys (`None`: any key, as in `[parameters]`). Tables
@@ -176,14 +191,16 @@ pub struct HoldoutSection {
 pub const SECTIONS: &[(&str, Option<&[&str]>)] = &[
     (
         "model",
-        Some(&["kind", "airframe", "deck", "end_time", "set", "test"]),
+        Some(&[
+            "kind", "file", "airframe", "deck", "end_time", "set", "test",
+        ]),
     ),
     ("parameters", None),
     ("candidates", None),
     ("held", None),
     ("space", Some(&["preset", "bounds"])),
-    ("test", Some(&["data", "map", "cfc", "sigma"])),
-    ("holdout", Some(&["data", "set"])),
+    ("test", Some(&["data", "map", "cfc", "sigma", "repeats"])),
+    ("holdout", Some(&["data", "set", "repeats"])),
     (
         "solver",
         Some(&[

@@ -218,8 +218,7 @@ pub fn run_loop_on<M: Enrichable>(
         .rounds
         .last()
         .map_or_else(|| det0.clone(), |r| r.detection.clone());
-    let (verdict, unattributed) =
-        report::verdict(&outcome, &det, &nominal.labels, nominal.test.samples())?;
+    let (verdict, unattributed) = report::verdict(&outcome, &det, &nominal.labels, &nominal.test)?;
     let ctx = &setting.ctx;
     let draws = ctx
         .model_noise

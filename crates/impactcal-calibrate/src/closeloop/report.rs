@@ -14,7 +14,7 @@ use super::selection::Outcome;
 use crate::error::Result;
 
 /// The detection stage's conclusion from `det`, the detection on the outcome's fit:
-/// model-form error left after the last round is [`Verdict::Unattributed`] (with its low-rank discrepancy on `labels` over `samples`,
+/// model-form error left after the last round is [`Verdict::Unattributed`] (with its low-rank discrepancy on `labels` over the samples of `test`,
 /// the closest three candidates of the last attribution named beside it), none with
 /// nothing added is [`Verdict::NoModelFormError`], none after additions
 /// [`Verdict::Attributed`].
@@ -25,7 +25,7 @@ pub(super) fn verdict(
     outcome: &Outcome,
     det: &Detection,
     labels: &[String],
-    samples: usize,
+    test: &impactcal_core::Histories,
 ) -> Result<(Verdict, Option<Discrepancy>)> {
     let verdict = if det.model_form_error {
         Verdict::Unattributed
@@ -53,7 +53,7 @@ pub(super) fn verdict(
     let d = discrepancy::fit(
         labels,
         &outcome.fit.residual,
-        samples,
+        (test.samples(), test.start(), test.dt()),
         det.coherent_rank,
         closest,
     )?;
@@ -130,7 +130,7 @@ mod tests {
             toy::with_setting(&model, &test, &options, |setting, nominal| {
                 let (_, outcome) = recalibration(setting, &model, &nominal.point, &options)?;
                 let det = outcome.rounds.last().unwrap().detection.clone();
-                let (v, d) = verdict(&outcome, &det, &nominal.labels, toy::T)?;
+                let (v, d) = verdict(&outcome, &det, &nominal.labels, &nominal.test)?;
                 Ok((outcome, v, d))
             })
             .unwrap()

@@ -6,7 +6,10 @@
 //! - [`integrate`]: the integrator, exact for the linear part and symplectic for the
 //!   contacts ([`Dynamics`]);
 //! - [`model`]: the system driven by a test record's base channel, as a `Model` and an
-//!   `Enrichable` with its held quantities ([`LumpedModel`]).
+//!   `Enrichable` with its held quantities ([`LumpedModel`]);
+//! - [`repeats`]: repeated tests of one article as one data set, calibration and holdout
+//!   tests each with its own input ([`LumpedRepeats`]), and the scatter between repeats
+//!   ([`scatter`]).
 //!
 //! ```
 //! use impactcal_core::{Enrichable, Histories, Model};
@@ -40,8 +43,10 @@
 
 pub mod integrate;
 pub mod model;
+pub mod repeats;
 pub mod system;
 
 pub use integrate::{Dynamics, GapLink, SpringLink, Trajectory};
 pub use model::LumpedModel;
+pub use repeats::{ChannelScatter, LumpedRepeats, REPEAT_SET, repeat_label, scatter, side_by_side};
 pub use system::{BASE, Dashpot, Gap, GapSides, LumpedSystem, Node, Output, Spring};

@@ -103,6 +103,29 @@ impl LumpedModel {
     /// channel with a non-finite sample (naming it) or that never moves; [`ModelsError::Invalid`]
     /// when two output labels give the same saturation parameter name.
     pub fn new(system: LumpedSystem, record: &Histories) -> Result<LumpedModel> {
+        LumpedModel::scaled(system, record, None)
+    }
+
+    /// The model of `system` driven by the base channel of `record`, its held quantities
+    /// scaled by `peak` (m/s^2) in place of the record's own peak base acceleration: what
+    /// repeated tests of one article share, so that a rattle's gap or a rail means the same
+    /// on every test ([`crate::lumped::LumpedRepeats`]).
+    ///
+    /// # Errors
+    /// As [`LumpedModel::new`]; [`ModelsError::Invalid`] for a `peak` that is not positive
+    /// and finite.
+    pub fn with_scale(system: LumpedSystem, record: &Histories, peak: f64) -> Result<LumpedModel> {
+        if !(peak.is_finite() && peak > 0.0) {
+            return Err(ModelsError::invalid(
+                "peak base acceleration",
+                peak,
+                "must be positive and finite",
+            ));
+        }
+        LumpedModel::scaled(system, record, Some(peak))
+    }
+
+    fn scaled(system: LumpedSystem, record: &Histories, scale: Option<f64>) -> Result<LumpedModel> {
         let raw = record.channel_by_label(&system.base_channel)?;
         let what = format!("base channel `{}`", system.base_channel);
         if raw.len() < 2 {
@@ -122,6 +145,7 @@ impl LumpedModel {
                 "is zero throughout: nothing drives the system",
             ));
         }
+        let peak = scale.unwrap_or(peak);
         let dt = record.dt();
         let duration = dt * (raw.len() - 1) as f64;
         let total: f64 = system.masses.iter().map(|m| m.1).sum();
