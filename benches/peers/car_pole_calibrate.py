@@ -16,7 +16,7 @@ finished run is never run again):
       on one scale without looking at the target). CORS-RBF (`optimize suggest`, batches of
       4, 200 evaluations of the surrogate, seed 0) minimises it over the study's box;
       `optimize answer` gives the calibrated point. Writes WORK/calibration.json.
-  verify WORK RESULTS [THREADS]
+  verify WORK RESULTS [THREADS [CONTROL]]
       Runs our solver at the calibrated point of TARGET and at five held-out designs with
       the calibration carried over (each parameter scaled by its calibrated factor
       p*_i / p0_i); the held-out designs are the first five of RESULTS' maximin order
@@ -25,6 +25,11 @@ finished run is never run again):
       The candidate effect CONTROL (a controlled rerun of car_pole_crosscode.py, e.g.
       hourglass-viscous) added to the model, the nine parameters at each design's own
       values: runs at the target and the held-out designs, WORK/effect-CONTROL.csv.
+  recalibrate WORK RESULTS CONTROL
+      The nine parameters calibrated again with CONTROL added: its effect (the mean shift
+      of our outputs over the `effect` runs) added to the surrogate; then
+      `verify WORK RESULTS THREADS CONTROL` runs the model with CONTROL at the new point
+      and carries it to the held-out designs (WORK/verify-CONTROL.csv).
   report WORK RESULTS
       Errors before (our solver at the design as given, from RESULTS) and after (at the
       calibrated or carried-over point) against LS-DYNA, per output and design; and the
@@ -81,7 +86,7 @@ def misfit(s, y, sig):
     return sum(((s[k] - y[k]) / sig[k]) ** 2 for k in OUTPUTS) / len(OUTPUTS)
 
 
-def predict(work, points):
+def predict(work, points, shift=None):
     path = os.path.join(work, "query.csv")
     with open(path, "w") as f:
         f.write(",".join(NAMES) + "\n")
@@ -91,11 +96,15 @@ def predict(work, points):
     run(["surrogate", "predict", "--model", os.path.join(work, "model.json"), "--params",
          path, "--out", out])
     with open(out) as f:
-        return [{k: float(r[k]) for k in OUTPUTS} for r in csv.DictReader(f)]
+        return [{k: float(r[k]) + (shift[k] if shift else 0.0) for k in OUTPUTS}
+                for r in csv.DictReader(f)]
 
 
-def calibrate(results, work, target="base"):
+def calibrate(results, work, target="base", shift=None, tag=""):
+    """See the module docs; with `shift` (output -> value) the surrogate's outputs are
+    moved by it (a candidate effect added to the model), and the files carry `tag`."""
     os.makedirs(work, exist_ok=True)
+    shift = shift or {k: 0.0 for k in OUTPUTS}
     rows = design_rows(results)
     x_all = read_x()
     x = [x_all[int(r["row"])] for r in rows]
@@ -105,7 +114,7 @@ def calibrate(results, work, target="base"):
                "--outputs", p("outputs.csv"), "--kind", "erbf", "--auto", "--out",
                p("model.json")])
     y, sig = lsdyna_at(target), sigma()
-    hist = p("history.csv")
+    hist = p(f"history{tag}.csv")
     if os.path.exists(hist):
         os.remove(hist)
     with open(hist, "w") as f:
@@ -117,24 +126,24 @@ def calibrate(results, work, target="base"):
         with open(p("suggest.csv")) as f:
             pts = [[float(r[k]) for k in NAMES] for r in csv.DictReader(f)]
         with open(hist, "a") as f:
-            for q, s in zip(pts, predict(work, pts)):
+            for q, s in zip(pts, predict(work, pts, shift)):
                 f.write(",".join(repr(v) for v in q) + f",{misfit(s, y, sig)!r}\n")
         n += len(pts)
     run(["optimize", "answer", "--bounds", p("bounds.csv"), "--history", hist, "--out",
-         p("answer.json")])
-    with open(p("answer.json")) as f:
+         p(f"answer{tag}.json")])
+    with open(p(f"answer{tag}.json")) as f:
         ans = json.load(f)
     # The objective is the surrogate's, without noise: the best sample is the answer.
     if "best_sample" not in ans:
         raise SystemExit(f"{p('answer.json')}: no best_sample in {list(ans)}")
     cal = [float(ans["best_sample"]["parameters"][k]) for k in NAMES]
-    s0, s1 = predict(work, [design_of(target), cal])
+    s0, s1 = predict(work, [design_of(target), cal], shift)
     out = {"target": target, "runs": len(rows), "evaluations": n, "lsdyna": y,
            "sigma": sig, "calibrated": dict(zip(NAMES, cal)),
            "surrogate_at_design": s0, "surrogate_at_calibrated": s1,
            "misfit_at_design": misfit(s0, y, sig), "misfit_at_calibrated": misfit(s1, y, sig),
-           "fit_log": log}
-    with open(p("calibration.json"), "w") as f:
+           "shift": shift, "fit_log": log}
+    with open(p(f"calibration{tag}.json"), "w") as f:
         json.dump(out, f, indent=1)
     print(log.strip())
     print(f"target {target}: LS-DYNA " + ", ".join(f"{k} {y[k]:.4g}" for k in OUTPUTS))
@@ -181,12 +190,13 @@ def simulate(deck_values, run_dir, threads, control=None):
     return o
 
 
-def verify(work, results, threads=1):
-    with open(os.path.join(work, "calibration.json")) as f:
+def verify(work, results, threads=1, control=None):
+    tag = f"-{control}" if control else ""
+    with open(os.path.join(work, f"calibration{tag}.json")) as f:
         cal = json.load(f)
     target = cal["target"]
     factor = [cal["calibrated"][k] / v for k, v in zip(NAMES, design_of(target))]
-    path = os.path.join(work, "verify.csv")
+    path = os.path.join(work, f"verify{tag}.csv")
     done = set()
     if os.path.exists(path):
         with open(path) as f:
@@ -200,7 +210,8 @@ def verify(work, results, threads=1):
         values = [v * a for v, a in zip(design_of(design), factor)]
         print(f"== {design}: " + ", ".join(f"{k} {v:.4g}" for k, v in zip(NAMES, values)),
               flush=True)
-        o = simulate(values, os.path.join(work, f"run-{design}"), threads)
+        o = simulate(values, os.path.join(work, f"run{tag}-cal-{design}" if tag else
+                                          f"run-{design}"), threads, control)
         with open(path, "a") as f:
             f.write(f"{design}," + ",".join(repr(v) for v in values) + ","
                     + ",".join(repr(o[k]) for k in OUTPUTS + ["HE"]) + "\n")
@@ -228,6 +239,26 @@ def effect(work, results, control, threads=1):
                      threads, control)
         with open(path, "a") as f:
             f.write(f"{design}," + ",".join(repr(o[k]) for k in OUTPUTS + ["HE"]) + "\n")
+
+
+def recalibrate(work, results, control):
+    """The loop's recalibration: the nine parameters calibrated again with the candidate
+    `control` added, its effect taken as the mean shift of our outputs over the runs of
+    `effect` (ours with it minus ours without, at the target and the held-out designs),
+    added to the surrogate of the model without it. Writes WORK/calibration-CONTROL.json."""
+    with open(results) as f:
+        before = {r["row"]: r for r in csv.DictReader(f)}
+    with open(os.path.join(work, f"effect-{control}.csv")) as f:
+        rows = [r for r in csv.DictReader(f) if r["design"] in before]
+    if not rows:
+        raise SystemExit(f"{work}/effect-{control}.csv: no run to take the effect from")
+    shift = {k: sum(float(r[k]) - float(before[r["design"]][k]) for r in rows) / len(rows)
+             for k in OUTPUTS}
+    print(f"{control}: mean shift over {len(rows)} designs: "
+          + ", ".join(f"{k} {v:+.4g}" for k, v in shift.items()))
+    with open(os.path.join(work, "calibration.json")) as f:
+        target = json.load(f)["target"]
+    calibrate(results, work, target, shift, f"-{control}")
 
 
 def report(work, results):
@@ -258,6 +289,7 @@ def report(work, results):
         label = f"{design} (target)" if design == target else f"{design} (held out)"
         print(f"| {label} | " + " | ".join(cells)
               + f" | {misfit(b, y, sig):.3f} | {misfit(a, y, sig):.3f} |")
+    loop_table(work, target, sig, before, after, results)
     if target != "base" or target not in after:
         return
     # The residual at the target, in sigma units, against each candidate's direction
@@ -292,6 +324,37 @@ def report(work, results):
     if best:
         print()
         print(f"Largest share within reach: {best[0]} ({100 * best[1]:.0f} %)")
+
+
+def loop_table(work, target, sig, before, after, results):
+    """The errors at the target and the held-out designs at each stage: as given, the nine
+    calibrated, each candidate added as is, and added with the nine recalibrated."""
+    stages = [("as given", before, "row"), ("nine calibrated", after, "design")]
+    for name in sorted(os.listdir(work)):
+        if name.startswith("effect-") and name.endswith(".csv"):
+            control = name[len("effect-"):-len(".csv")]
+            for label, path in ((f"{control} added", name),
+                                (f"{control} added, nine recalibrated",
+                                 f"verify-{control}.csv")):
+                if os.path.exists(os.path.join(work, path)):
+                    with open(os.path.join(work, path)) as f:
+                        stages.append((label, {r["design"]: r for r in csv.DictReader(f)},
+                                       "design"))
+    print()
+    print("The loop's stages: relative error of each output against LS-DYNA, and J")
+    print()
+    print("| design | stage | " + " | ".join(OUTPUTS) + " | J |")
+    print("|---|---|" + "---|" * (len(OUTPUTS) + 1))
+    for design in [target] + held_out(results, target):
+        y = lsdyna_at(design)
+        for label, rows, _ in stages:
+            if design not in rows:
+                continue
+            o = {k: float(rows[design][k]) for k in OUTPUTS}
+            name = f"{design} (target)" if design == target else f"{design} (held out)"
+            print(f"| {name} | {label} | "
+                  + " | ".join(f"{100 * (o[k] / y[k] - 1):+.1f} %" for k in OUTPUTS)
+                  + f" | {misfit(o, y, sig):.3f} |")
 
 
 # How far each controlled change can be carried, in units of the change the control made
@@ -331,7 +394,10 @@ def main(argv):
     if argv[0] == "calibrate":
         calibrate(argv[1], argv[2], argv[3] if len(argv) > 3 else "base")
     elif argv[0] == "verify":
-        verify(argv[1], argv[2], int(argv[3]) if len(argv) > 3 else 1)
+        verify(argv[1], argv[2], int(argv[3]) if len(argv) > 3 else 1,
+               argv[4] if len(argv) > 4 else None)
+    elif argv[0] == "recalibrate":
+        recalibrate(argv[1], argv[2], argv[3])
     elif argv[0] == "effect":
         effect(argv[1], argv[2], argv[3], int(argv[4]) if len(argv) > 4 else 1)
     elif argv[0] == "report":
