@@ -190,6 +190,16 @@ def simulate(deck_values, run_dir, threads, control=None):
     return o
 
 
+def designs_done(path, header):
+    """The designs a resumable results file already holds; a new file gets `header`."""
+    if not os.path.exists(path):
+        with open(path, "w") as f:
+            f.write(",".join(header) + "\n")
+        return set()
+    with open(path) as f:
+        return {r["design"] for r in csv.DictReader(f)}
+
+
 def verify(work, results, threads=1, control=None):
     tag = f"-{control}" if control else ""
     with open(os.path.join(work, f"calibration{tag}.json")) as f:
@@ -197,13 +207,7 @@ def verify(work, results, threads=1, control=None):
     target = cal["target"]
     factor = [cal["calibrated"][k] / v for k, v in zip(NAMES, design_of(target))]
     path = os.path.join(work, f"verify{tag}.csv")
-    done = set()
-    if os.path.exists(path):
-        with open(path) as f:
-            done = {r["design"] for r in csv.DictReader(f)}
-    else:
-        with open(path, "w") as f:
-            f.write("design," + ",".join(NAMES) + "," + ",".join(OUTPUTS) + ",HE\n")
+    done = designs_done(path, ["design"] + NAMES + OUTPUTS + ["HE"])
     for design in [target] + held_out(results, target):
         if design in done:
             continue
@@ -224,13 +228,7 @@ def effect(work, results, control, threads=1):
     with open(os.path.join(work, "calibration.json")) as f:
         target = json.load(f)["target"]
     path = os.path.join(work, f"effect-{control}.csv")
-    done = set()
-    if os.path.exists(path):
-        with open(path) as f:
-            done = {r["design"] for r in csv.DictReader(f)}
-    else:
-        with open(path, "w") as f:
-            f.write("design," + ",".join(OUTPUTS) + ",HE\n")
+    done = designs_done(path, ["design"] + OUTPUTS + ["HE"])
     for design in [target] + held_out(results, target):
         if design in done:
             continue
