@@ -47,7 +47,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from car_pole_crosscode import (  # noqa: E402
-    BASE_REPEATS, BOUNDS, CONTROLS, DATA, NAMES, OUTPUTS, control_include, outputs,
+    BASE_REPEATS, CONTROLS, DATA, NAMES, OUTPUTS, control_include, outputs,
     parameter_deck, read_x, read_y)
 from car_pole_sobol import BIN, run, write_inputs  # noqa: E402
 
