@@ -116,6 +116,11 @@ CONTROLS = {
                                    "the membrane modes at a tenth",
     "hourglass-sixteenth": "every *HOURGLASS QM 0.02 set to 0.00125: the forces a 1/4 in "
                            "the hourglass vector would give at QM 0.02",
+    "contact-stiffness-double": "the single-surface contact's SFS and SFM 0 (1) set to 2: the "
+                                "penalty stiffness doubled",
+    "contact-friction": "the single-surface contact's FS and FD 0 set to 0.2 (the ground "
+                        "wall's value)",
+    "shear-factor": "every *SECTION_SHELL SHRF 0 (1) set to 0.8333 (5/6)",
 }
 
 
@@ -174,6 +179,26 @@ def control_include(name, text):
         return set_hourglass_field(name, lines, 20, "0.02", f"{0.002:10.3f}")
     if name == "hourglass-sixteenth":
         return set_hourglass_field(name, lines, 20, "0.02", f"{0.00125:10.5f}")
+    if name in ("contact-stiffness-double", "contact-friction"):
+        i = lines.index("*CONTACT_AUTOMATIC_SINGLE_SURFACE_ID")
+        data = [j for j in range(i + 1, i + 12) if not lines[j].startswith("$")]
+        # data[0] cid, data[1] ssid..., data[2] fs fd ..., data[3] sfs sfm ...
+        k, new = (data[3], f"{2.0:10.1f}") if name == "contact-stiffness-double" else (
+            data[2], f"{0.2:10.1f}")
+        if lines[k][:20].split() != ["0.0", "0.0"]:
+            raise SystemExit(f"{name}: contact card {lines[k]!r} is not the expected one")
+        lines[k] = new + new + lines[k][20:]
+        return "\n".join(lines)
+    if name == "shear-factor":
+        out, n = [], 0
+        for k, line in enumerate(lines):
+            if k > 1 and lines[k - 2].startswith("*SECTION_SHELL") and line[20:30].strip() == "0.0":
+                line = line[:20] + f"{0.8333:10.4f}" + line[30:]
+                n += 1
+            out.append(line)
+        if n != 7:
+            raise SystemExit(f"shear-factor: {n} *SECTION_SHELL cards changed, 7 expected")
+        return "\n".join(out)
     if name == "warping-projection":
         if any(line.startswith("*CONTROL_SHELL") for line in lines):
             raise SystemExit("warping-projection: the model already has *CONTROL_SHELL")

@@ -9,7 +9,7 @@
 # the study's way, keeps them (WORK/results.csv) and the run's log, and deletes the
 # histories. A design already in results.csv is not run again, so an interrupted
 # measurement resumes. Then the controlled reruns at the base design (`car_pole_crosscode.py
-# controls`; CONTROLS=0 skips them), each one change of the model in a copy of the include
+# controls`; CONTROLS=0 skips them, CONTROLS=a,b runs only those), each one change of the model in a copy of the include
 # under WORK. At the end it prints the comparison table.
 #
 #   benches/peers/car_pole_crosscode.sh [N] [WORK] [THREADS]
@@ -38,8 +38,13 @@ results=$work/results.csv
 failures=$work/failures.txt
 touch "$failures"
 echo "$(nproc) CPUs: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"
+# CONTROLS=0: no controlled reruns; CONTROLS=a,b: only those; default: all of them.
 controls=
-[ "${CONTROLS:-1}" = 0 ] || controls=$($py controls)
+case "${CONTROLS:-1}" in
+0) ;;
+1) controls=$($py controls) ;;
+*) controls=$(echo "$CONTROLS" | tr ',' ' ') ;;
+esac
 for row in base $($py select "$n") $controls; do
     if grep -q "^$row," "$results" || grep -q "^$row:" "$failures"; then
         continue
