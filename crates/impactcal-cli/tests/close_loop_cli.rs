@@ -127,6 +127,7 @@ fn report_has_provenance_and_geometry(v: &serde_json::Value, out: &Path) {
         geometry.channels.insert(l.clone(), at);
     }
     let again = out.join("again");
+    std::fs::create_dir_all(&again).unwrap();
     let done = impactcal::experiment::write_loop(result, Some(&geometry), None, &again).unwrap();
     for f in ["fig-residual-structure-before", "fig-residual-structure-after"] {
         assert!(
