@@ -11,7 +11,9 @@
 
 use std::path::PathBuf;
 
-use impactcal::calibrate::report::{self, Axis, Block, Figure, Marker, Plot, Report, Section, Structure};
+use impactcal::calibrate::report::{
+    self, Axis, Block, Figure, Marker, Plot, Report, Section, Structure,
+};
 use impactcal::calibrate::study::document::{Revealed, reveal_section};
 use impactcal::experiment::model::geometry_of;
 use impactcal::shell::airframe::{Airframe, AirframeOptions, MeshDensity, Preset};
@@ -103,7 +105,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let doc = Report {
         title: "The airframe demo's figures on the structure".into(),
-        lead: vec!["The coarse airframe's mesh with the demo's sensors, an impact shape and the reveal.".into()],
+        lead: vec![
+            "The coarse airframe's mesh with the demo's sensors, an impact shape and the reveal."
+                .into(),
+        ],
         sections: vec![
             Section {
                 heading: "Sensors and an impact shape".into(),

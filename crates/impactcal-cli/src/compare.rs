@@ -108,7 +108,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
 /// The first five labels of `h`, quoted, for messages.
 fn first_labels(h: &Histories) -> String {
-    let mut s: Vec<String> = h.labels().iter().take(5).map(|l| format!("`{l}`")).collect();
+    let mut s: Vec<String> = h
+        .labels()
+        .iter()
+        .take(5)
+        .map(|l| format!("`{l}`"))
+        .collect();
     if h.labels().len() > 5 {
         s.push(format!("and {} more", h.labels().len() - 5));
     }

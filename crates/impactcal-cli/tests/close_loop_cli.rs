@@ -97,7 +97,10 @@ fn finds_the_hidden_damping_and_writes_the_report() {
 /// again with a geometry that places each channel).
 fn report_has_provenance_and_geometry(v: &serde_json::Value, out: &Path) {
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
-    let provenance = md.split("## Provenance").nth(1).expect("a provenance section");
+    let provenance = md
+        .split("## Provenance")
+        .nth(1)
+        .expect("a provenance section");
     let digest = v["digest"].as_str().unwrap();
     for item in [
         format!("impactcal {}", env!("CARGO_PKG_VERSION")),
@@ -129,7 +132,10 @@ fn report_has_provenance_and_geometry(v: &serde_json::Value, out: &Path) {
     let again = out.join("again");
     std::fs::create_dir_all(&again).unwrap();
     let done = impactcal::experiment::write_loop(result, Some(&geometry), None, &again).unwrap();
-    for f in ["fig-residual-structure-before", "fig-residual-structure-after"] {
+    for f in [
+        "fig-residual-structure-before",
+        "fig-residual-structure-after",
+    ] {
         assert!(
             done.files.figures.contains(&again.join(format!("{f}.svg"))),
             "{f} not drawn"

@@ -186,13 +186,22 @@ fn compare_names_the_channels_it_dropped() {
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("warning") && err.contains("`b`") && err.contains("`x`"), "{err}");
+    assert!(
+        err.contains("warning") && err.contains("`b`") && err.contains("`x`"),
+        "{err}"
+    );
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["channels"], serde_json::json!(["a", "c"]));
     assert_eq!(v["dropped"]["test"], serde_json::json!(["b"]));
     assert_eq!(v["dropped"]["model"], serde_json::json!(["x", "y"]));
     // Nothing dropped: an empty `dropped`, no warning.
-    let o = impactcal(&["compare", "--test", t.to_str().unwrap(), "--analysis", t.to_str().unwrap()]);
+    let o = impactcal(&[
+        "compare",
+        "--test",
+        t.to_str().unwrap(),
+        "--analysis",
+        t.to_str().unwrap(),
+    ]);
     assert!(o.status.success());
     assert!(!String::from_utf8_lossy(&o.stderr).contains("warning"));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -218,7 +227,10 @@ fn impossible_requests_fail_cleanly() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("share no channel") && err.contains("`d`"), "{err}");
+    assert!(
+        err.contains("share no channel") && err.contains("`d`"),
+        "{err}"
+    );
     let o = impactcal(&[
         "expand",
         "--measured",

@@ -475,7 +475,10 @@ pub fn geometry_of(airframe: &Airframe) -> Geometry {
                 .ok()
                 .and_then(|i| nodes.get(i.wrapping_sub(1)));
             if let Some(at) = at.filter(|_| seen.insert((part.id(), n))) {
-                regions.entry(part.name().to_string()).or_default().push(*at);
+                regions
+                    .entry(part.name().to_string())
+                    .or_default()
+                    .push(*at);
             }
         }
     }

@@ -322,25 +322,32 @@ mod tests {
     fn the_filters_end_samples_leave_the_likelihood() {
         let model = Toy::new(0.0, 0.0, 1.0);
         let (a, b) = model.channels(&[1.0]);
-        let test = Histories::from_channels(
-            vec!["a".into(), "b".into()],
-            vec![a, b],
-            toy::DT,
-            0.0,
-            "",
-        )
-        .unwrap();
+        let test =
+            Histories::from_channels(vec!["a".into(), "b".into()], vec![a, b], toy::DT, 0.0, "")
+                .unwrap();
         let cfc = impactcal_core::Cfc::from_class(60).unwrap();
         let (head, tail) = cfc.end_samples(toy::T, toy::DT, 0.1).unwrap();
-        assert!(head >= 1 && tail >= 1 && head + tail < toy::T, "{head}, {tail}");
-        toy::with_filtered_setting(&model, &test, &toy::options(0.01), Some(cfc), |setting, _| {
-            for ch in setting.ctx.frame.weights.chunks(toy::T) {
-                assert!(ch[..head].iter().all(|w| *w == 0.0), "head kept: {ch:?}");
-                assert!(ch[toy::T - tail..].iter().all(|w| *w == 0.0), "tail kept");
-                assert!(ch[head..toy::T - tail].iter().all(|w| *w > 0.0), "inside masked");
-            }
-            Ok(())
-        })
+        assert!(
+            head >= 1 && tail >= 1 && head + tail < toy::T,
+            "{head}, {tail}"
+        );
+        toy::with_filtered_setting(
+            &model,
+            &test,
+            &toy::options(0.01),
+            Some(cfc),
+            |setting, _| {
+                for ch in setting.ctx.frame.weights.chunks(toy::T) {
+                    assert!(ch[..head].iter().all(|w| *w == 0.0), "head kept: {ch:?}");
+                    assert!(ch[toy::T - tail..].iter().all(|w| *w == 0.0), "tail kept");
+                    assert!(
+                        ch[head..toy::T - tail].iter().all(|w| *w > 0.0),
+                        "inside masked"
+                    );
+                }
+                Ok(())
+            },
+        )
         .unwrap();
     }
 

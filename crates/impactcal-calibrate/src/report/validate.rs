@@ -254,7 +254,12 @@ fn check_heat_map(fig: &str, p: &HeatMap) -> Result<()> {
     }
     for (what, weights, len, axis) in [
         ("row weights", &p.row_weights, rows, &p.row_weights_axis),
-        ("column weights", &p.column_weights, cols, &p.column_weights_axis),
+        (
+            "column weights",
+            &p.column_weights,
+            cols,
+            &p.column_weights_axis,
+        ),
     ] {
         if !weights.is_empty() {
             check_values(|| format!("{fig}, {what}"), weights, len)?;

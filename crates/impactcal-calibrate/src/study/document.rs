@@ -395,11 +395,7 @@ fn m2_section(r: &StudyResult, geometry: Option<&Geometry>) -> Section {
             ));
         }
         if let Some(g) = geometry {
-            blocks.extend(shape_figures(
-                &m.baseline,
-                &r.channels.objective,
-                g,
-            ));
+            blocks.extend(shape_figures(&m.baseline, &r.channels.objective, g));
         }
     }
     Section {
@@ -580,7 +576,9 @@ fn change_limit(space: &ParameterSpace, g: &Geometry) -> f64 {
         .parameters()
         .iter()
         .filter(|p| region_of(&p.name, g).is_some() && p.nominal != 0.0)
-        .map(|p| 100.0 * ((p.upper - p.nominal).abs().max((p.nominal - p.lower).abs()) / p.nominal.abs()))
+        .map(|p| {
+            100.0 * ((p.upper - p.nominal).abs().max((p.nominal - p.lower).abs()) / p.nominal.abs())
+        })
         .fold(0.0, f64::max)
 }
 

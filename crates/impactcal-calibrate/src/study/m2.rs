@@ -34,7 +34,10 @@ pub const SHAPES_DRAWN: usize = 2;
 /// positive.
 fn signed_shape(shapes: faer::MatRef<'_, f64>, j: usize) -> Vec<f64> {
     let col: Vec<f64> = (0..shapes.nrows()).map(|i| shapes[(i, j)]).collect();
-    let peak = col.iter().copied().fold(0.0_f64, |a, v| if v.abs() > a.abs() { v } else { a });
+    let peak = col
+        .iter()
+        .copied()
+        .fold(0.0_f64, |a, v| if v.abs() > a.abs() { v } else { a });
     let sign = if peak < 0.0 { -1.0 } else { 1.0 };
     col.into_iter().map(|v| sign * v).collect()
 }
@@ -89,12 +92,22 @@ mod tests {
         let other: Vec<f64> = t.iter().map(|t| (150.0 * t).sin() * 0.01).collect();
         let mut data: Vec<f64> = pulse.iter().zip(&other).map(|(p, o)| 3.0 * p + o).collect();
         data.extend(pulse.iter().zip(&other).map(|(p, o)| -4.0 * p + o));
-        let h = Histories::new(vec!["a".into(), "b".into()], t.len(), 1e-3, 0.0, "in/s", data)
+        let h = Histories::new(
+            vec!["a".into(), "b".into()],
+            t.len(),
+            1e-3,
+            0.0,
+            "in/s",
+            data,
+        )
         .expect("histories");
         let r = m2(&h, &h, &["a".into(), "b".into()], 2).expect("m2");
         assert_eq!(r.test_shapes.len(), 2);
         let s = &r.test_shapes[0];
-        assert!((s[0] + 0.6).abs() < 1e-3 && (s[1] - 0.8).abs() < 1e-3, "{s:?}");
+        assert!(
+            (s[0] + 0.6).abs() < 1e-3 && (s[1] - 0.8).abs() < 1e-3,
+            "{s:?}"
+        );
         let norm: f64 = r.test_shapes[1].iter().map(|v| v * v).sum();
         assert!((norm - 1.0).abs() < 1e-9);
     }

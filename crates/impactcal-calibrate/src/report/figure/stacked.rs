@@ -5,7 +5,9 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::band;
-use super::{Area, Drawn, LEFT_AREA, MARGIN, WIDTH, abscissa, cartesian, colour, label_font, line, padded};
+use super::{
+    Area, Drawn, LEFT_AREA, MARGIN, WIDTH, abscissa, cartesian, colour, label_font, line, padded,
+};
 use crate::Result;
 use crate::report::document::Stacked;
 
@@ -162,7 +164,8 @@ mod tests {
         ];
         let (at, rows) = legend_layout(&names);
         assert!(rows >= 2, "{rows} rows");
-        let width = |n: &str| SWATCH + SWATCH_GAP + (n.chars().count() as f64 * LABEL_CHAR_W).ceil() as i32;
+        let width =
+            |n: &str| SWATCH + SWATCH_GAP + (n.chars().count() as f64 * LABEL_CHAR_W).ceil() as i32;
         for (k, (n, &(x, y))) in names.iter().zip(&at).enumerate() {
             assert!(x + width(n) <= (WIDTH - 2 * MARGIN) as i32, "{n} runs off");
             if let Some(&(x2, y2)) = at.get(k + 1) {

@@ -325,7 +325,10 @@ mod tests {
                     x1: cx + MARKER,
                     y1: cy + MARKER,
                 };
-                assert!(!x.meets(&disc, GAP - 1), "{x:?} covers the marker at {cx}, {cy}");
+                assert!(
+                    !x.meets(&disc, GAP - 1),
+                    "{x:?} covers the marker at {cx}, {cy}"
+                );
             }
         }
         // The three coincident markers all find a place (rings around a free spot).
