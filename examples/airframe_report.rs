@@ -1,8 +1,9 @@
 //! Writes the figures of the airframe demo's study report that are drawn on the structure,
 //! on the real coarse airframe (its mesh only; no simulation): the 41 sensors the demo
 //! placed (`impactcal demo`, Table 2; mirror pairs such as 237.y/253.y coincide in the
-//! side view), an impact shape's vertical entries at every node, and the reveal's hidden
-//! change beside a calibrated change on one colour scale. The headless-browser check
+//! side view), a signed pattern over the 24 channels of the closed-loop demo (as its
+//! residual's sensor pattern is drawn), an impact shape's vertical entries at every node,
+//! and the reveal's hidden change. The headless-browser check
 //! (`tests/browser/check_report.sh`) renders it and requires that no two labels overlap.
 //!
 //! ```text
@@ -25,6 +26,13 @@ const SENSORS: [&str; 41] = [
     "629.z", "697.z", "879.x", "902.x", "903.x", "910.x", "914.x", "918.x", "921.x", "924.x",
     "934.x", "1068.z", "1072.z", "1181.x", "1195.z", "1215.x", "1228.z", "1231.z", "1261.z",
     "1267.z", "1271.y",
+];
+
+/// The channels `impactcal demo --close-loop` compares (the 24 that move most).
+const LOOP_CHANNELS: [&str; 24] = [
+    "629.z", "245.z", "1231.z", "407.z", "532.z", "1228.z", "502.z", "566.z", "1246.z", "1119.z",
+    "1261.z", "732.z", "697.z", "767.z", "1280.z", "1198.z", "1200.z", "468.z", "404.z", "310.z",
+    "308.z", "1277.z", "1167.z", "344.z",
 ];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -71,6 +79,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         })
         .collect();
+    // A signed pattern over the loop's channels, as the residual's u_1 is drawn.
+    let residual = LOOP_CHANNELS
+        .iter()
+        .enumerate()
+        .map(|(i, l)| marker(l, Some((0.7 * i as f64).sin() * 0.4)))
+        .collect::<Result<Vec<_>, _>>()?;
     let space = Preset::Table2.space()?;
     let hidden = [
         ("belly_panel.t", 1.2, 1.12),
@@ -117,6 +131,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         name: "fig-sensors".into(),
                         caption: "Sensor locations (41 channels)".into(),
                         plot: structure(sensors, "-"),
+                    }),
+                    Block::Figure(Figure {
+                        name: "fig-residual-structure".into(),
+                        caption: "A residual pattern over the closed-loop demo's 24 channels"
+                            .into(),
+                        plot: structure(residual, "u_1 entry (-)"),
                     }),
                     Block::Figure(Figure {
                         name: "fig-shape-1".into(),
