@@ -112,6 +112,8 @@ fn mac_map() -> HeatMap {
         column_axis: Axis::new("baseline model shape"),
         row_weights: weights.clone(),
         column_weights: weights.iter().map(|w| 0.9 * w).collect(),
+        row_weights_axis: Axis::new("contribution (%)"),
+        column_weights_axis: Axis::new("contribution (%)"),
         marked,
         annotate: true,
     }
@@ -164,6 +166,8 @@ fn airframe(values: bool) -> Structure {
         points,
         unit: "in".into(),
         marked,
+        value_axis: Axis::new("residual (noise units)"),
+        limit: None,
     }
 }
 

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Renders a sample report with every kind of figure and a real closed-loop report (the
-# drop-tower loop of examples/loop_report.rs, about 15 s) in headless Chromium and checks
+# Renders a sample report with every kind of figure, a real closed-loop report (the
+# drop-tower loop of examples/loop_report.rs, about 15 s) and the airframe demo's figures
+# drawn on the structure (examples/airframe_report.rs: the 41 placed sensors, an impact
+# shape, the reveal) in headless Chromium and checks
 # that each page is not blank, shows every figure and has no two text labels of a figure
 # overlapping (tests/browser/check_report.py), then that the check rejects deliberately
 # broken copies of the sample page. Installs Chromium (Debian package
@@ -55,3 +57,5 @@ cargo test --workspace --no-run --quiet
 python3 tests/browser/check_report.py --chromium "$CHROMIUM" --report "$OUT/report" --negative-controls
 "${CARGO_TARGET_DIR:-target}/debug/examples/loop_report" "$OUT/loop" >/dev/null
 python3 tests/browser/check_report.py --chromium "$CHROMIUM" --report "$OUT/loop"
+"${CARGO_TARGET_DIR:-target}/debug/examples/airframe_report" "$OUT/airframe" >/dev/null
+python3 tests/browser/check_report.py --chromium "$CHROMIUM" --report "$OUT/airframe"

@@ -7,14 +7,14 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args as ClapArgs;
-use impactcal::calibrate::report::{Block, Plot, Report};
+use impactcal::calibrate::report::{Block, Plot, Provenance, Report};
 use impactcal::calibrate::study::document::{Geometry, Revealed, report, reveal_section};
 use impactcal::calibrate::study::{
     StudyOptions, StudyResult, Subspace, TestData, ValidStudyOptions, run_model,
 };
 use impactcal::core::{Cfc, Model, ParamGuard};
 use impactcal::experiment::model::geometry_of;
-use impactcal::experiment::write_study;
+use impactcal::experiment::{command_line, write_study};
 use impactcal::shell::airframe::{
     Airframe, AirframeModel, AirframeOptions, MeshDensity, Preset, catalogue, space_of,
 };
@@ -190,9 +190,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
             cfc,
         };
         let progress = Progress::new();
+        let started = Instant::now();
         let result = pool.install(|| run_model(&sub, &description, test, options, dir, &progress));
         progress.done();
-        let done = write_study(result?, Some(&geometry), dir)?;
+        let result = result?;
+        let provenance = Provenance::now(
+            command_line(),
+            result.fingerprint.clone(),
+            result.options.seed,
+            started.elapsed().as_secs_f64(),
+        );
+        let done = write_study(result, Some(&geometry), Some(&provenance), dir)?;
         crate::output::print_finished(&done, "");
         Ok(done.result)
     };
@@ -225,7 +233,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .map_or(p.nominal, |c| c.calibrated_point[i]),
         })
         .collect();
-    let doc = demo_report(&r1, &r2, &reveal, &geometry);
+    let provenance = Provenance::now(
+        command_line(),
+        format!(
+            "Table 1 study {}; Table 2 study {}",
+            r1.fingerprint, r2.fingerprint
+        ),
+        r2.options.seed,
+        started.elapsed().as_secs_f64(),
+    );
+    let doc = demo_report(&r1, &r2, &reveal, &geometry, &provenance);
     let e = r2.errors.as_ref();
     let m2 = r2.m2.as_ref();
     let summary = Summary {
@@ -261,12 +278,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The demo's report: Table 1's M1 screening, Table 2's whole study, the reveal.
+/// The demo's report: Table 1's M1 screening, Table 2's whole study, the reveal (the hidden
+/// change drawn on the airframe beside the calibrated change of Table 2's report), and the
+/// provenance of the whole run.
 pub fn demo_report(
     t1: &StudyResult,
     t2: &StudyResult,
     reveal: &[Revealed],
     geometry: &Geometry,
+    provenance: &Provenance,
 ) -> Report {
     let first = report(t1, None);
     let second = report(t2, Some(geometry));
@@ -294,7 +314,8 @@ pub fn demo_report(
     lead.extend(second.lead.iter().skip(1).cloned());
     let mut sections = screening;
     sections.extend(second.sections);
-    sections.push(reveal_section(reveal, 0.05));
+    sections.push(reveal_section(reveal, 0.05, Some((geometry, &t2.space))));
+    sections.push(provenance.section());
     Report {
         title: "The source paper's calibration study on the coarse airframe".into(),
         lead,

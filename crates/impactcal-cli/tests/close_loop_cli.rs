@@ -87,6 +87,60 @@ fn finds_the_hidden_damping_and_writes_the_report() {
     assert!(out.join("report.html").exists() && out.join("report.md").exists());
     assert!(err.contains("verdict: attributed"));
     progress_tells_the_story(&err, &out, v["runs"].as_u64().unwrap() as usize);
+    report_has_provenance_and_geometry(&v, &out);
+}
+
+/// The report `close-loop` wrote ends with its provenance: this version, the command line
+/// as given, the loop's digest and seed from `loop.json`. The same writer draws the
+/// residual's pattern on a structure when the model places its channels (the drop tower
+/// places none; the airframe's runs are too slow for a test, so its `loop.json` is written
+/// again with a geometry that places each channel).
+fn report_has_provenance_and_geometry(v: &serde_json::Value, out: &Path) {
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let provenance = md
+        .split("## Provenance")
+        .nth(1)
+        .expect("a provenance section");
+    let digest = v["digest"].as_str().unwrap();
+    for item in [
+        format!("impactcal {}", env!("CARGO_PKG_VERSION")),
+        "close-loop --config".to_string(),
+        digest.to_string(),
+        format!("| seed | {} |", v["seed"]),
+    ] {
+        assert!(provenance.contains(&item), "{item} not in {provenance}");
+    }
+    assert!(!out.join("fig-residual-structure-before.svg").exists());
+
+    let result: impactcal::calibrate::closeloop::LoopResult =
+        serde_json::from_value(v.clone()).unwrap();
+    let labels: Vec<String> = v["detection"]["u1"]
+        .as_object()
+        .unwrap()
+        .keys()
+        .cloned()
+        .collect();
+    let mut geometry = impactcal::calibrate::study::document::Geometry {
+        unit: "in".into(),
+        ..Default::default()
+    };
+    for (i, l) in labels.iter().enumerate() {
+        let at = [10.0 * i as f64, 0.0, 5.0];
+        geometry.points.push(at);
+        geometry.channels.insert(l.clone(), at);
+    }
+    let again = out.join("again");
+    std::fs::create_dir_all(&again).unwrap();
+    let done = impactcal::experiment::write_loop(result, Some(&geometry), None, &again).unwrap();
+    for f in [
+        "fig-residual-structure-before",
+        "fig-residual-structure-after",
+    ] {
+        assert!(
+            done.files.figures.contains(&again.join(format!("{f}.svg"))),
+            "{f} not drawn"
+        );
+    }
 }
 
 /// Whether a progress text is a stage of runs: `<title>: <done>/<total> runs[ (...)]`.

@@ -162,6 +162,52 @@ fn empty_and_missing_files_fail_cleanly() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/y.csv"));
 }
 
+/// Files that share some channels: M2 on the shared ones, the others named in a warning and
+/// in the JSON's `dropped`, each side's in its file's order.
+#[test]
+fn compare_names_the_channels_it_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    let t = write(
+        dir.path(),
+        "t.csv",
+        "time,a,b,c\n0,1,0,2\n0.1,2,1,4\n0.2,3,0,7\n0.3,1,2,1\n",
+    );
+    let m = write(
+        dir.path(),
+        "m.csv",
+        "time,c,a,x,y\n0,2,1,0,0\n0.1,4,2,1,1\n0.2,6,3,0,1\n0.3,1,1,1,0\n",
+    );
+    let o = impactcal(&[
+        "compare",
+        "--test",
+        t.to_str().unwrap(),
+        "--analysis",
+        m.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("warning") && err.contains("`b`") && err.contains("`x`"),
+        "{err}"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["channels"], serde_json::json!(["a", "c"]));
+    assert_eq!(v["dropped"]["test"], serde_json::json!(["b"]));
+    assert_eq!(v["dropped"]["model"], serde_json::json!(["x", "y"]));
+    // Nothing dropped: an empty `dropped`, no warning.
+    let o = impactcal(&[
+        "compare",
+        "--test",
+        t.to_str().unwrap(),
+        "--analysis",
+        t.to_str().unwrap(),
+    ]);
+    assert!(o.status.success());
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("warning"));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["dropped"]["test"], serde_json::json!([]));
+}
+
 #[test]
 fn impossible_requests_fail_cleanly() {
     let dir = tempfile::tempdir().unwrap();
@@ -170,15 +216,21 @@ fn impossible_requests_fail_cleanly() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("rank 1"));
     let q = write(dir.path(), "z.csv", "time,a,c\n0,1,2\n0.1,2,4\n0.2,3,6\n");
+    // Files that share no channel: nothing to compare.
+    let r = write(dir.path(), "r.csv", "time,d,e\n0,1,2\n0.1,2,4\n0.2,3,6\n");
     let o = impactcal(&[
         "compare",
         "--test",
         p.to_str().unwrap(),
         "--analysis",
-        q.to_str().unwrap(),
+        r.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("channel"));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("share no channel") && err.contains("`d`"),
+        "{err}"
+    );
     let o = impactcal(&[
         "expand",
         "--measured",

@@ -34,10 +34,11 @@ pub mod schema;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::Instant;
 
 use impactcal_calibrate::CalibrateError;
 use impactcal_calibrate::closeloop::{Holdout, LoopOptions, LoopResult, run_loop_on};
-use impactcal_calibrate::report::{Report, ReportFiles};
+use impactcal_calibrate::report::{Provenance, Report, ReportFiles};
 use impactcal_calibrate::study::document::Geometry;
 use impactcal_calibrate::study::{
     InProcess, ModelRuns, Observer, Silent, SolverRuns, StudyResult, TestData, ValidStudyOptions,
@@ -393,6 +394,7 @@ impl Experiment {
     /// The options' errors, the model's and the test's, the study's
     /// ([`impactcal_calibrate::study::run`]), and I/O errors writing the results.
     pub fn study_with(&self, out: &Path, observer: &dyn Observer) -> Result<Finished<StudyResult>> {
+        let started = Instant::now();
         let options = self.study_options()?;
         let built = self.build()?;
         let measured = self.measured()?;
@@ -427,7 +429,13 @@ impl Experiment {
             CalibrateError::TestShorterThanModel { .. } => self.in_window(e),
             e => ExperimentError::from(e).in_section(&self.name, "study"),
         })?;
-        write_study(result, built.geometry.as_ref(), out)
+        let provenance = Provenance::now(
+            command_line(),
+            result.fingerprint.clone(),
+            result.options.seed,
+            started.elapsed().as_secs_f64(),
+        );
+        write_study(result, built.geometry.as_ref(), Some(&provenance), out)
     }
 
     /// The runs of a study that go through the runner's solver: an external `[solver]` on
@@ -541,6 +549,7 @@ impl Experiment {
         out: &Path,
         observer: &dyn Observer,
     ) -> Result<Finished<LoopResult>> {
+        let started = Instant::now();
         let built = self.build()?;
         let Some(model) = &built.model else {
             return Err(ExperimentError::File {
@@ -578,7 +587,13 @@ impl Experiment {
             CalibrateError::TestShorterThanModel { .. } => self.in_window(e),
             e => ExperimentError::from(e).in_section(&self.name, "loop"),
         })?;
-        write_loop(result, out)
+        let provenance = Provenance::now(
+            command_line(),
+            result.digest.clone(),
+            result.seed,
+            started.elapsed().as_secs_f64(),
+        );
+        write_loop(result, built.geometry.as_ref(), Some(&provenance), out)
     }
 
     /// The worker of a loop: for an external solver, the solver on `[executor]` (any
@@ -666,26 +681,41 @@ fn write_json(result: &impl Serialize, path: &Path) -> Result<()> {
     std::fs::write(path, json + "\n").map_err(io(path))
 }
 
+/// The command line of this process, its arguments joined by spaces: what a report's
+/// provenance records as the command.
+pub fn command_line() -> String {
+    std::env::args().collect::<Vec<_>>().join(" ")
+}
+
 /// Writes a study's `study.json` and report (`report.html`, `report.md`, SVG figures) into
-/// `out`; `geometry` places the airframe's sensors in the report's figures.
+/// `out`; `geometry` places the airframe's sensors, impact shapes and changes in the
+/// report's figures; `provenance`, when given, ends the report.
 ///
 /// # Errors
 /// I/O and rendering errors.
 pub fn write_study(
     result: StudyResult,
     geometry: Option<&Geometry>,
+    provenance: Option<&Provenance>,
     out: &Path,
 ) -> Result<Finished<StudyResult>> {
-    let report = impactcal_calibrate::study::document::report(&result, geometry);
+    let report = impactcal_calibrate::study::document::report_with(&result, geometry, provenance);
     finish(result, report, out, "study.json")
 }
 
-/// Writes a loop's `loop.json` and report into `out`.
+/// Writes a loop's `loop.json` and report into `out`; `geometry` draws the residual's
+/// sensor pattern on the structure; `provenance`, when given, ends the report.
 ///
 /// # Errors
 /// I/O and rendering errors.
-pub fn write_loop(result: LoopResult, out: &Path) -> Result<Finished<LoopResult>> {
-    let report = impactcal_calibrate::closeloop::document::report(&result);
+pub fn write_loop(
+    result: LoopResult,
+    geometry: Option<&Geometry>,
+    provenance: Option<&Provenance>,
+    out: &Path,
+) -> Result<Finished<LoopResult>> {
+    let report =
+        impactcal_calibrate::closeloop::document::report_with(&result, geometry, provenance);
     finish(result, report, out, "loop.json")
 }
 

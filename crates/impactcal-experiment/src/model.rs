@@ -495,7 +495,8 @@ fn airframe(
     })
 }
 
-/// The airframe's nodes and the position of each sensor channel.
+/// The airframe's nodes, the position of each sensor channel and the nodes of each part
+/// (named as its parameters are: `belly_panel` for `belly_panel.t`).
 pub fn geometry_of(airframe: &Airframe) -> Geometry {
     let nodes = airframe.node_positions();
     let mut channels = BTreeMap::new();
@@ -509,10 +510,26 @@ pub fn geometry_of(airframe: &Airframe) -> Geometry {
             }
         }
     }
+    let mut regions: BTreeMap<String, Vec<[f64; 3]>> = BTreeMap::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for (shell, part) in airframe.shells() {
+        for n in shell {
+            let at = usize::try_from(n)
+                .ok()
+                .and_then(|i| nodes.get(i.wrapping_sub(1)));
+            if let Some(at) = at.filter(|_| seen.insert((part.id(), n))) {
+                regions
+                    .entry(part.name().to_string())
+                    .or_default()
+                    .push(*at);
+            }
+        }
+    }
     Geometry {
         points: nodes.to_vec(),
         unit: "in".into(),
         channels,
+        regions,
     }
 }
 

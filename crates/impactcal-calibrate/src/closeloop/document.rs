@@ -272,6 +272,8 @@ fn detection(r: &LoopResult, geometry: Option<&Geometry>) -> Section {
                                 value: Some(d.u1.get(l).copied().unwrap_or(0.0)),
                             })
                             .collect(),
+                        value_axis: Axis::new("u_1 entry (-)"),
+                        limit: None,
                     }),
                 }));
             }
@@ -326,6 +328,8 @@ fn sensor_map(r: &LoopResult, labels: &[String]) -> Block {
             column_axis: Axis::new(format!("channel, 1 to {}", labels.len())),
             row_weights: vec![d0.sigma1, d1.sigma1],
             column_weights: Vec::new(),
+            row_weights_axis: Axis::new("sigma_1 (noise units)"),
+            column_weights_axis: Axis::new("-"),
             marked: Vec::new(),
             annotate: labels.len() <= 12,
         }),

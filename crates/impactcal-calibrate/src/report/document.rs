@@ -162,6 +162,14 @@ pub struct HeatMap {
     pub row_weights: Vec<f64>,
     /// Weights of the columns drawn as a bar above the map, `values[0].len()` long, or empty.
     pub column_weights: Vec<f64>,
+    /// What the row weights are, with their unit (e.g. `"model shape contribution (%)"`):
+    /// the description under the bars beside the map. Must not be blank when `row_weights`
+    /// is not empty.
+    pub row_weights_axis: Axis,
+    /// What the column weights are, with their unit (e.g. `"test shape contribution (%)"`):
+    /// the description beside the bars above the map. Must not be blank when
+    /// `column_weights` is not empty.
+    pub column_weights_axis: Axis,
     /// Cells `(row, column)` to outline (the optimal pairing).
     pub marked: Vec<(usize, usize)>,
     /// Write each cell's value inside it (for small matrices).
@@ -194,6 +202,12 @@ pub struct Structure {
     pub unit: String,
     /// Marked points with their labels (sensor labels), drawn large.
     pub marked: Vec<Marker>,
+    /// What the markers' values are, with their unit (e.g. `"change from nominal (%)"`),
+    /// written along the colour bar. Must not be blank when a marker carries a value.
+    pub value_axis: Axis,
+    /// Half-width `L > 0` of the colour scale (values from `-L` to `+L`); `None` takes
+    /// `max |value|` over the markers. Give figures that are to be compared the same `L`.
+    pub limit: Option<f64>,
 }
 
 /// A marked point of a [`Structure`].

@@ -63,6 +63,8 @@ fn heat_map(rows: usize, cols: usize) -> HeatMap {
         column_axis: Axis::new("model shape"),
         row_weights: (0..rows).map(|i| 50.0 / (i + 1) as f64).collect(),
         column_weights: (0..cols).map(|j| 40.0 / (j + 1) as f64).collect(),
+        row_weights_axis: Axis::new("test contribution (%)"),
+        column_weights_axis: Axis::new("model contribution (%)"),
         marked: (0..rows.min(cols)).map(|i| (i, i)).collect(),
         annotate: true,
     }
@@ -97,6 +99,8 @@ fn structure(points: usize, markers: usize, values: bool) -> Structure {
                 value: values.then_some(m as f64 - 1.0),
             })
             .collect(),
+        value_axis: Axis::new("residual (noise units)"),
+        limit: None,
     }
 }
 
@@ -453,6 +457,8 @@ fn structure_keeps_one_scale_across_and_up() {
         points: vec![[0.0, 0.0, 0.0], [100.0, 10.0, 5.0]],
         unit: "in".into(),
         marked: vec![],
+        value_axis: Axis::new("-"),
+        limit: None,
     };
     let svg = svg_of(Plot::Structure(p));
     let doc = parse(&svg);

@@ -252,12 +252,18 @@ fn check_heat_map(fig: &str, p: &HeatMap) -> Result<()> {
             &format!("({lo}, {hi}) must have low < high"),
         ));
     }
-    for (what, weights, len) in [
-        ("row weights", &p.row_weights, rows),
-        ("column weights", &p.column_weights, cols),
+    for (what, weights, len, axis) in [
+        ("row weights", &p.row_weights, rows, &p.row_weights_axis),
+        (
+            "column weights",
+            &p.column_weights,
+            cols,
+            &p.column_weights_axis,
+        ),
     ] {
         if !weights.is_empty() {
             check_values(|| format!("{fig}, {what}"), weights, len)?;
+            check_axis(fig, what, axis)?;
         }
     }
     if let Some(&(i, j)) = p.marked.iter().find(|&&(i, j)| i >= rows || j >= cols) {
@@ -314,6 +320,17 @@ fn check_structure(fig: &str, p: &Structure) -> Result<()> {
         check_finite(|| format!("{fig}: marker {i} (`{}`)", m.label), &m.at)?;
         if let Some(v) = m.value {
             check_finite(|| format!("{fig}: marker {i} (`{}`) value", m.label), &[v])?;
+        }
+    }
+    if p.marked.iter().any(|m| m.value.is_some()) {
+        check_axis(fig, "value", &p.value_axis)?;
+    }
+    if let Some(l) = p.limit {
+        if !(l.is_finite() && l > 0.0) {
+            return Err(document_error(
+                format!("{fig}: colour limit"),
+                &format!("{l} must be a finite number above 0"),
+            ));
         }
     }
     Ok(())

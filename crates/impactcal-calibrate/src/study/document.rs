@@ -3,10 +3,12 @@
 
 use std::collections::BTreeMap;
 
+use impactcal_core::ParameterSpace;
+
 use super::result::{Errors, StudyResult};
 use crate::report::{
-    Axis, Block, Envelope, Figure, HeatMap, Lines, Marker, Plot, Report, Section, Series, Stacked,
-    Structure, Table,
+    Axis, Block, Envelope, Figure, HeatMap, Lines, Marker, Plot, Provenance, Report, Section,
+    Series, Stacked, Structure, Table,
 };
 
 /// Where the channels are, for the sensor figure: every point of the structure and the
@@ -19,6 +21,10 @@ pub struct Geometry {
     pub unit: String,
     /// Position of the node of each channel label.
     pub channels: BTreeMap<String, [f64; 3]>,
+    /// The nodes of each named region of the structure (the airframe's parts, by the name
+    /// its parameters start with: `belly_panel` for `belly_panel.t`): where a change of a
+    /// region's parameter is drawn. Empty when the model names no regions.
+    pub regions: BTreeMap<String, Vec<[f64; 3]>>,
 }
 
 fn axis(label: impl Into<String>) -> Axis {
@@ -66,9 +72,20 @@ fn pct(v: f64) -> String {
     }
 }
 
-/// The report of a study. `geometry` (when the model has one) places the sensors on the
-/// structure; without it the sensor figure is left out and the sensors are listed.
+/// The report of a study without provenance: [`report_with`]`(r, geometry, None)`.
 pub fn report(r: &StudyResult, geometry: Option<&Geometry>) -> Report {
+    report_with(r, geometry, None)
+}
+
+/// The report of a study. `geometry` (when the model has one) places the sensors, the
+/// test's first impact shapes and the calibrated change of each region's parameter on the
+/// structure; without it those figures are left out and the sensors are listed.
+/// `provenance`, when given, is the last section.
+pub fn report_with(
+    r: &StudyResult,
+    geometry: Option<&Geometry>,
+    provenance: Option<&Provenance>,
+) -> Report {
     let mut lead = vec![
         format!("M1 verdict: {}. {}.", r.m1.verdict.as_str(), r.m1.statement),
         format!("{}.", r.test_preparation.describe()),
@@ -86,7 +103,7 @@ pub fn report(r: &StudyResult, geometry: Option<&Geometry>) -> Report {
         sections.push(sensors_section(r, geometry));
     }
     if r.m2.is_some() {
-        sections.push(m2_section(r));
+        sections.push(m2_section(r, geometry));
     }
     if r.surrogate.is_some() {
         sections.push(surrogate_section(r));
@@ -95,8 +112,9 @@ pub fn report(r: &StudyResult, geometry: Option<&Geometry>) -> Report {
         sections.push(sensitivity_section(r));
     }
     if r.errors.is_some() {
-        sections.push(reconcile_section(r));
+        sections.push(reconcile_section(r, geometry));
     }
+    sections.extend(provenance.map(Provenance::section));
     Report {
         title: format!("Calibration study: {}", r.model),
         lead,
@@ -322,6 +340,8 @@ fn sensors_section(r: &StudyResult, geometry: Option<&Geometry>) -> Section {
                 points: geo.points.clone(),
                 unit: geo.unit.clone(),
                 marked,
+                value_axis: axis("-"),
+                limit: None,
             }),
         ));
     }
@@ -339,12 +359,14 @@ fn heat(m: &super::m2::M2Result) -> Plot {
         column_axis: axis("test shape"),
         row_weights: m.model_contributions.iter().map(|c| 100.0 * c).collect(),
         column_weights: m.test_contributions.iter().map(|c| 100.0 * c).collect(),
+        row_weights_axis: axis("contribution (%)"),
+        column_weights_axis: axis("contribution (%)"),
         marked: m.pairs.iter().map(|p| (p.0, p.1)).collect(),
         annotate: m.matrix.len() <= 12,
     })
 }
 
-fn m2_section(r: &StudyResult) -> Section {
+fn m2_section(r: &StudyResult, geometry: Option<&Geometry>) -> Section {
     let mut blocks = Vec::new();
     if let Some(m) = &r.m2 {
         blocks.push(Block::Paragraph(format!(
@@ -371,6 +393,9 @@ fn m2_section(r: &StudyResult) -> Section {
                 "M2 of the calibrated model".into(),
                 heat(c),
             ));
+        }
+        if let Some(g) = geometry {
+            blocks.extend(shape_figures(&m.baseline, &r.channels.objective, g));
         }
     }
     Section {
@@ -477,7 +502,150 @@ fn sensitivity_section(r: &StudyResult) -> Section {
     }
 }
 
-fn reconcile_section(r: &StudyResult) -> Section {
+/// The test's first impact shapes on the structure (the source paper's Fig. 8): for each
+/// shape, the entries of the channels along the direction that carries most of the
+/// shape's energy (the label's suffix after its last `.`, `x`, `y` or `z` for nodal
+/// channels), one marker per node, larger magnitudes drawn over smaller. Nothing when the
+/// result kept no shapes or the geometry does not place the compared channels.
+fn shape_figures(m: &super::m2::M2Result, labels: &[String], g: &Geometry) -> Vec<Block> {
+    let placed = labels.iter().all(|l| g.channels.contains_key(l));
+    if !placed {
+        return Vec::new();
+    }
+    m.test_shapes
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.len() == labels.len())
+        .map(|(j, shape)| {
+            let direction = |l: &str| l.rsplit_once('.').map_or("", |(_, d)| d).to_string();
+            let mut energy: BTreeMap<String, f64> = BTreeMap::new();
+            for (l, v) in labels.iter().zip(shape) {
+                *energy.entry(direction(l)).or_default() += v * v;
+            }
+            let (dir, share) = energy
+                .iter()
+                .max_by(|a, b| a.1.total_cmp(b.1))
+                .map_or((String::new(), 0.0), |(d, e)| (d.clone(), *e));
+            let mut marked: Vec<Marker> = labels
+                .iter()
+                .zip(shape)
+                .filter(|(l, _)| direction(l) == dir)
+                .map(|(l, v)| Marker {
+                    label: String::new(),
+                    at: g.channels[l],
+                    value: Some(*v),
+                })
+                .collect();
+            marked.sort_by(|a, b| {
+                let size = |m: &Marker| m.value.map_or(0.0, f64::abs);
+                size(a).total_cmp(&size(b))
+            });
+            let along = if dir.is_empty() {
+                "every compared channel".to_string()
+            } else {
+                format!("the {dir} channels")
+            };
+            let contribution = m.test_contributions.get(j).copied().unwrap_or(f64::NAN);
+            figure(
+                &format!("fig-shape-{}", j + 1),
+                format!(
+                    "Impact shape {} of the test (contribution {}) on the structure: its                      entries at {along} ({} nodes, {:.0} % of the shape's energy); red and                      blue move in opposite directions, and the shape as a whole is fixed only                      up to sign",
+                    j + 1,
+                    pct(contribution),
+                    marked.len(),
+                    100.0 * share
+                ),
+                Plot::Structure(Structure {
+                    points: g.points.clone(),
+                    unit: g.unit.clone(),
+                    marked,
+                    value_axis: axis("shape entry (-)"),
+                    limit: None,
+                }),
+            )
+        })
+        .collect()
+}
+
+/// The largest change from nominal a study of `space` allows to a parameter of a region of
+/// `g`, in percent: the colour limit of every figure of changes on the structure, so that
+/// the hidden and the calibrated change read on one scale and a full colour means a
+/// parameter at the end of its range.
+fn change_limit(space: &ParameterSpace, g: &Geometry) -> f64 {
+    space
+        .parameters()
+        .iter()
+        .filter(|p| region_of(&p.name, g).is_some() && p.nominal != 0.0)
+        .map(|p| {
+            100.0 * ((p.upper - p.nominal).abs().max((p.nominal - p.lower).abs()) / p.nominal.abs())
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The region of `g` a parameter `name` (`<region>.<field>`) belongs to.
+fn region_of<'a>(name: &str, g: &'a Geometry) -> Option<&'a Vec<[f64; 3]>> {
+    name.split_once('.')
+        .and_then(|(region, _)| g.regions.get(region))
+}
+
+/// A figure of relative changes `(parameter, change)` drawn on the regions of `g` the
+/// parameters name (the source paper's Fig. 13): every node of a changed region a marker
+/// coloured by the change in %, on the scale of [`change_limit`]. `None` when no changed
+/// parameter names a region.
+fn change_figure(
+    name: &str,
+    what: &str,
+    changes: &[(String, f64)],
+    threshold: f64,
+    limit: f64,
+    g: &Geometry,
+) -> Option<Block> {
+    let mut drawn: Vec<(&str, f64, &Vec<[f64; 3]>)> = changes
+        .iter()
+        .filter(|(_, c)| c.abs() > threshold)
+        .filter_map(|(n, c)| region_of(n, g).map(|nodes| (n.as_str(), *c, nodes)))
+        .collect();
+    if drawn.is_empty() || limit.is_nan() || limit <= 0.0 {
+        return None;
+    }
+    drawn.sort_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
+    let marked = drawn
+        .iter()
+        .flat_map(|(_, c, nodes)| {
+            nodes.iter().map(move |at| Marker {
+                label: String::new(),
+                at: *at,
+                value: Some(100.0 * c),
+            })
+        })
+        .collect();
+    let listed = drawn
+        .iter()
+        .rev()
+        .map(|(n, c, _)| format!("{n} {:+.1} %", 100.0 * c))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Some(figure(
+        name,
+        format!(
+            "{what} on the structure: the nodes of each region whose parameter changed by              more than {:.0} % from nominal ({listed}), coloured by the change; the colour              scale ends at {limit:.0} %, the largest change the parameters' ranges allow",
+            100.0 * threshold
+        ),
+        Plot::Structure(Structure {
+            points: g.points.clone(),
+            unit: g.unit.clone(),
+            marked,
+            value_axis: axis("change from nominal (%)"),
+            limit: Some(limit),
+        }),
+    ))
+}
+
+/// The share by which calibration moved a parameter from nominal, below which a move is
+/// not drawn on the structure (a move of 1 % is within what the search resolves).
+const DRAWN_MOVE: f64 = 0.01;
+
+fn reconcile_section(r: &StudyResult, geometry: Option<&Geometry>) -> Section {
     let mut blocks = Vec::new();
     if let (Some(e), Some(c)) = (&r.errors, &r.reconcile) {
         blocks.push(Block::Paragraph(format!(
@@ -490,6 +658,24 @@ fn reconcile_section(r: &StudyResult) -> Section {
             c.best_from,
             before_after_sentence(r, e.reduction, &e.baseline, &e.calibrated)
         )));
+        if let Some(g) = geometry {
+            let moves: Vec<(String, f64)> = r
+                .space
+                .parameters()
+                .iter()
+                .zip(&c.calibrated_point)
+                .filter(|(p, _)| p.nominal != 0.0)
+                .map(|(p, v)| (p.name.clone(), v / p.nominal - 1.0))
+                .collect();
+            blocks.extend(change_figure(
+                "fig-calibrated-change",
+                "The calibrated change",
+                &moves,
+                DRAWN_MOVE,
+                change_limit(&r.space, g),
+                g,
+            ));
+        }
         let (b, a) = (&e.baseline, &e.calibrated);
         let m2 = |x: &Errors| x.m2_matched_above_0_9.map_or("-".into(), |n| n.to_string());
         let noise = r.noise.relative_spread_sensors.unwrap_or(f64::NAN);
@@ -630,8 +816,14 @@ impl Revealed {
 
 /// The reveal of a study on a synthetic test (the source paper's §5.4): what was changed to
 /// make the test, against what calibration moved. A parameter counts as changed or moved
-/// when it differs from nominal by more than `threshold` (relative).
-pub fn reveal_section(items: &[Revealed], threshold: f64) -> Section {
+/// when it differs from nominal by more than `threshold` (relative). With `geometry` and
+/// the study's `space`, the hidden change is drawn on the structure (the paper's Fig. 13a)
+/// on the colour scale of the calibrated change the study's report draws (Fig. 13b).
+pub fn reveal_section(
+    items: &[Revealed],
+    threshold: f64,
+    structure: Option<(&Geometry, &ParameterSpace)>,
+) -> Section {
     let changed: Vec<&str> = items
         .iter()
         .filter(|r| r.changed_by().abs() > threshold)
@@ -656,6 +848,20 @@ pub fn reveal_section(items: &[Revealed], threshold: f64) -> Section {
             ]
         })
         .collect();
+    let drawn = structure.and_then(|(g, space)| {
+        let changes: Vec<(String, f64)> = items
+            .iter()
+            .map(|r| (r.name.clone(), r.changed_by()))
+            .collect();
+        change_figure(
+            "fig-hidden-change",
+            "The hidden change that made the test",
+            &changes,
+            threshold,
+            change_limit(space, g),
+            g,
+        )
+    });
     Section {
         heading: "The reveal: what was changed, what calibration moved".into(),
         blocks: vec![
@@ -685,6 +891,9 @@ pub fn reveal_section(items: &[Revealed], threshold: f64) -> Section {
                 ],
                 rows,
             ),
-        ],
+        ]
+        .into_iter()
+        .chain(drawn)
+        .collect(),
     }
 }

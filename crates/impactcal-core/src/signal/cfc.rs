@@ -151,6 +151,58 @@ impl Cfc {
         Ok(y)
     }
 
+    /// The samples at the ends of a record of `n` samples at step `dt` where
+    /// [`Cfc::filter`] does not pass white noise as it does inside the record: `(head,
+    /// tail)`, the number of leading and of trailing samples (each run counted from its end
+    /// inward, up to the first sample within bounds) whose standard deviation of filtered
+    /// unit white noise differs from the stationary one by more than `tolerance`
+    /// (relative).
+    ///
+    /// The cause is the end treatment: the record is extended by reflection through its
+    /// end value (`2 x[n-1] - x[n-1-k]`), so the filtered end sample is pinned near the raw
+    /// end value and keeps that sample's own noise unfiltered (at CFC 1000 and 10 kHz the
+    /// end sample's noise is about 1.7 times the interior's; one sample in). A noise model
+    /// of the filtered record as stationary does not hold there.
+    ///
+    /// Exact: the variance of output sample `k` is `sum_i F_ki^2`, `F` the filter as a
+    /// matrix, built column by column from unit impulses (`O(n (n + 2 m))` operations, `m`
+    /// the extension length); the stationary variance is
+    /// `(1 / pi) int_0^pi |H(e^{i w})|^4 dw` ([`Cfc::power_response`], trapezoid rule on
+    /// 4,096 intervals).
+    ///
+    /// # Errors
+    /// As [`Cfc::filter`]; [`CoreError::Invalid`] for a `tolerance` that is not finite and
+    /// positive.
+    pub fn end_samples(self, n: usize, dt: f64, tolerance: f64) -> Result<(usize, usize)> {
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(CoreError::Invalid(format!(
+                "CFC end samples: tolerance {tolerance} must be finite and positive"
+            )));
+        }
+        let mut variance = vec![0.0; n];
+        let mut impulse = vec![0.0; n];
+        for i in 0..n {
+            impulse[i] = 1.0;
+            let column = self.filter(&impulse, dt, "unit impulse")?;
+            impulse[i] = 0.0;
+            for (v, f) in variance.iter_mut().zip(&column) {
+                *v += f * f;
+            }
+        }
+        const STEPS: usize = 4096;
+        let h = std::f64::consts::PI / STEPS as f64;
+        let mut integral = 0.0;
+        for j in 0..=STEPS {
+            let w = if j == 0 || j == STEPS { 0.5 } else { 1.0 };
+            integral += w * self.power_response(j as f64 * h, dt)?;
+        }
+        let stationary = (integral * h / std::f64::consts::PI).sqrt();
+        let off = |v: &f64| (v.sqrt() / stationary - 1.0).abs() > tolerance;
+        let head = variance.iter().take_while(|v| off(v)).count();
+        let tail = variance.iter().rev().take_while(|v| off(v)).count();
+        Ok((head, tail.min(n - head)))
+    }
+
     /// The power response of [`Cfc::filter`] away from the record's ends at normalised
     /// angular frequency `omega` (radians per sample) for step `dt`: one pass is
     /// `H(z) = b0 (1 + z^-1)^2 / (1 - a1 z^-1 - a2 z^-2)`, the forward and the backward
@@ -268,6 +320,25 @@ mod tests {
                 .fold(0.0f64, |a, b| a.max(b.abs()))
         };
         peak(&y) / peak(&x)
+    }
+
+    /// The filtered end samples of white noise: the exact standard deviation of the first
+    /// and last sample at CFC 1000 and 10 kHz is about 1.7 times the interior's (a Monte
+    /// Carlo of 400 records of 151 samples gave 1.68 and 1.74), the next ones within 10 %:
+    /// one sample at each end. Inside, the exact variance matches the power response's
+    /// integral. A record too short for the class is end effect throughout.
+    #[test]
+    fn end_samples_are_those_the_reflection_leaves_unfiltered() {
+        let (head, tail) = Cfc::Cfc1000.end_samples(151, 1e-4, 0.1).unwrap();
+        assert_eq!((head, tail), (1, 1));
+        let (head, tail) = Cfc::Cfc1000.end_samples(151, 1e-4, 0.5).unwrap();
+        assert_eq!((head, tail), (1, 1));
+        let (head, tail) = Cfc::Cfc1000.end_samples(151, 1e-4, 0.9).unwrap();
+        assert_eq!((head, tail), (0, 0));
+        let (head, tail) = Cfc::Cfc60.end_samples(151, 1e-4, 0.1).unwrap();
+        assert!(head + tail > 20, "{head} + {tail}");
+        assert!(head + tail <= 151);
+        assert!(Cfc::Cfc1000.end_samples(151, 1e-4, 0.0).is_err());
     }
 
     #[test]

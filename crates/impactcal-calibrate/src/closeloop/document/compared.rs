@@ -290,6 +290,8 @@ fn m2_plot(m: &M2Result, stage: &str) -> Plot {
         column_axis: Axis::new("test shape"),
         row_weights: m.model_contributions.iter().map(|c| 100.0 * c).collect(),
         column_weights: m.test_contributions.iter().map(|c| 100.0 * c).collect(),
+        row_weights_axis: Axis::new("contribution (%)"),
+        column_weights_axis: Axis::new("contribution (%)"),
         marked: m.pairs.iter().map(|p| (p.0, p.1)).collect(),
         annotate: m.matrix.len() <= 12,
     })

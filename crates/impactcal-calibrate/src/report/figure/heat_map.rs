@@ -13,17 +13,18 @@ use crate::Result;
 use crate::report::document::HeatMap;
 
 /// Width of the panel of row weights and of the colour bar, in pixels.
-const ROW_PANEL: u32 = 170;
+const ROW_PANEL: u32 = 200;
 const BAR_PANEL: u32 = 100;
 /// Height of the panel of column weights, and of the key strip when there is no such panel.
-const COLUMN_PANEL: u32 = 150;
+const COLUMN_PANEL: u32 = 200;
 const KEY_STRIP: u32 = 44;
 
 /// Draws the heat map of `p`: cells coloured over `p.range` (values outside it take the end
 /// colours) on the sequential scale, or on the blue-white-red diverging scale with white at
 /// zero when the range holds values of both signs (`low < 0 < high`, see [`scale`]), the marked cells outlined, values written in the
 /// cells if asked, row weights as horizontal bars on the right, column weights as vertical
-/// bars on top, each bar labelled with its value, and a colour bar.
+/// bars on top, each bar labelled with its value and each set of bars described by its own
+/// axis label (`row_weights_axis`, `column_weights_axis`), and a colour bar.
 pub(super) fn draw(p: &HeatMap, svg: &mut String, name: &str) -> Result<()> {
     let rows = p.values.len();
     let cols = p.values.first().map_or(0, Vec::len);
@@ -53,11 +54,21 @@ pub(super) fn draw(p: &HeatMap, svg: &mut String, name: &str) -> Result<()> {
 
     draw_cells(p, &map_area, name)?;
     if !p.row_weights.is_empty() {
-        draw_row_weights(&p.row_weights, &weights_area, name)?;
+        draw_row_weights(
+            &p.row_weights,
+            &p.row_weights_axis.label,
+            &weights_area,
+            name,
+        )?;
     }
     let (column_area, key_area) = upper.split_horizontally(left);
     if !p.column_weights.is_empty() {
-        draw_column_weights(&p.column_weights, &column_area, name)?;
+        draw_column_weights(
+            &p.column_weights,
+            &p.column_weights_axis.label,
+            &column_area,
+            name,
+        )?;
     }
     if !p.marked.is_empty() {
         draw_key(&key_area, name)?;
@@ -67,6 +78,7 @@ pub(super) fn draw(p: &HeatMap, svg: &mut String, name: &str) -> Result<()> {
         &bar_area,
         (lo, hi),
         |t| scale(p.range, lo + t * (hi - lo)),
+        None,
         name,
     )?;
     root.present().drawn(name)
@@ -182,7 +194,7 @@ fn weight_limit(weights: &[f64]) -> f64 {
     if top > 0.0 { 1.25 * top } else { 1.0 }
 }
 
-fn draw_row_weights(weights: &[f64], area: &Area<'_>, name: &str) -> Result<()> {
+fn draw_row_weights(weights: &[f64], desc: &str, area: &Area<'_>, name: &str) -> Result<()> {
     let rows = weights.len();
     let lowest = weights.iter().copied().fold(0.0, f64::min);
     let mut chart = ChartBuilder::on(area)
@@ -197,7 +209,7 @@ fn draw_row_weights(weights: &[f64], area: &Area<'_>, name: &str) -> Result<()> 
         .x_labels(3)
         .label_style(tick_font())
         .axis_desc_style(label_font())
-        .x_desc("weight")
+        .x_desc(desc)
         .draw()
         .drawn(name)?;
     chart
@@ -227,7 +239,7 @@ fn draw_row_weights(weights: &[f64], area: &Area<'_>, name: &str) -> Result<()> 
     Ok(())
 }
 
-fn draw_column_weights(weights: &[f64], area: &Area<'_>, name: &str) -> Result<()> {
+fn draw_column_weights(weights: &[f64], desc: &str, area: &Area<'_>, name: &str) -> Result<()> {
     let cols = weights.len();
     let lowest = weights.iter().copied().fold(0.0, f64::min);
     let mut chart = ChartBuilder::on(area)
@@ -242,7 +254,7 @@ fn draw_column_weights(weights: &[f64], area: &Area<'_>, name: &str) -> Result<(
         .y_labels(3)
         .label_style(tick_font())
         .axis_desc_style(label_font())
-        .y_desc("weight")
+        .y_desc(desc)
         .draw()
         .drawn(name)?;
     chart

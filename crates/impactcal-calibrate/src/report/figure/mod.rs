@@ -210,11 +210,6 @@ pub(crate) fn band(
     Ok(())
 }
 
-/// Draws the legend of `chart` in its upper right corner, over a translucent white box.
-pub(crate) fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, name: &str) -> Result<()> {
-    legend_in(chart, SeriesLabelPosition::UpperRight, name)
-}
-
 /// Draws the legend of `chart` in `corner` (see `legend_place`), over a translucent white
 /// box.
 pub(crate) fn legend_in<'a, 'b: 'a>(
@@ -306,8 +301,15 @@ pub(crate) fn dark(background: RGBColor) -> bool {
 }
 
 /// Draws a vertical colour bar for values in `range` into `area`, coloured by `scale` of
-/// the value's position `t in [0, 1]` along the range, with ticks on its right.
-pub(crate) fn colour_bar<F>(area: &Area<'_>, range: (f64, f64), scale: F, name: &str) -> Result<()>
+/// the value's position `t in [0, 1]` along the range, with ticks on its right and, when
+/// given, the description `desc` (quantity and unit) along them.
+pub(crate) fn colour_bar<F>(
+    area: &Area<'_>,
+    range: (f64, f64),
+    scale: F,
+    desc: Option<&str>,
+    name: &str,
+) -> Result<()>
 where
     F: Fn(f64) -> RGBColor,
 {
@@ -317,17 +319,19 @@ where
         .margin_top(MARGIN)
         .margin_bottom(BOTTOM_AREA + MARGIN)
         .margin_left(8)
-        .right_y_label_area_size(60)
+        .right_y_label_area_size(if desc.is_some() { 90 } else { 60 })
         .build_cartesian_2d(0.0..1.0, lo..hi)
         .drawn(name)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
+    let mut mesh = chart.configure_mesh();
+    mesh.disable_mesh()
         .disable_x_axis()
         .y_labels(6)
         .y_label_style(tick_font())
-        .draw()
-        .drawn(name)?;
+        .axis_desc_style(label_font());
+    if let Some(d) = desc {
+        mesh.y_desc(d);
+    }
+    mesh.draw().drawn(name)?;
     let step = (hi - lo) / STEPS as f64;
     chart
         .draw_series((0..STEPS).map(|k| {
