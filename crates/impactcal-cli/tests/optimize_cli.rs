@@ -92,7 +92,7 @@ fn shell_loop_reproduces_the_library_loop() {
 #[test]
 fn search_options_reproduce_the_library_loop() {
     let f = test_functions::by_name("branin").unwrap();
-    let cases: [(&[&str], CorsOptions); 16] = [
+    let cases: [(&[&str], CorsOptions); 17] = [
         (
             &["--local-half-width", "0.15"],
             CorsOptions {
@@ -165,7 +165,14 @@ fn search_options_reproduce_the_library_loop() {
         (
             &["--perturb-horizon", "20"],
             CorsOptions {
-                perturbation: Some(Perturbation { horizon: 20 }),
+                perturbation: Some(Perturbation { horizon: Some(20) }),
+                ..CorsOptions::with_seed(3)
+            },
+        ),
+        (
+            &["--budget", "30"],
+            CorsOptions {
+                budget: Some(30),
                 ..CorsOptions::with_seed(3)
             },
         ),
@@ -276,6 +283,7 @@ fn search_options_reproduce_the_library_loop() {
         suggest(&bounds, &history, &extra)
     };
     assert_ne!(run(&[]), run(&["--global-only"]));
+    assert_ne!(run(&[]), run(&["--budget", "30"]));
 }
 
 #[test]
@@ -398,6 +406,7 @@ fn bad_search_options_are_input_errors() {
         (&["--local-half-width", "0"][..], "local_region"),
         (&["--restart-patience", "0"][..], "patience"),
         (&["--perturb-horizon", "1"][..], "perturbation.horizon"),
+        (&["--budget", "0"][..], "budget"),
         (&["--local-escape", "0"][..], "local_escape"),
         (&["--second-region", "0"][..], "second_region"),
         (
