@@ -285,7 +285,11 @@ fn search_options_reproduce_the_library_loop() {
         points
     };
     assert_ne!(run(&[]), run(&["--global-only"]));
-    assert_ne!(run(&[]), run(&["--budget", "12"]));
+    // `--budget` leaves Branin's first 24 points as they are (its walk takes no Gaussian
+    // candidate of the local cycles, the only ones the schedule acts on); that it reaches
+    // the options is shown by `--budget 0` being refused as `budget`
+    // (`bad_search_options_are_input_errors`), and that the budget changes a walk by the
+    // library's `budget_sets_the_perturbation_horizon` (Hartmann-6).
 }
 
 #[test]
