@@ -458,7 +458,10 @@ mod tests {
             assert_eq!(rel[0], 0.0);
             for (k, p) in (-9..=2).enumerate() {
                 let expected = 10f64.powi(p);
-                assert!((rel[k + 1] / expected - 1.0).abs() < 1e-12, "{base:?}: {rel:?}");
+                assert!(
+                    (rel[k + 1] / expected - 1.0).abs() < 1e-12,
+                    "{base:?}: {rel:?}"
+                );
             }
         }
     }
