@@ -63,12 +63,12 @@ enum Basis {
 /// How `--auto` and `--kind auto` pick among their candidates.
 #[derive(ValueEnum, Clone, Copy, Debug, Default)]
 enum Pick {
+    /// The lowest leave-one-out error.
+    #[default]
+    MinLoo,
     /// The smoothest candidate within one standard error of the lowest leave-one-out
     /// error (paired over the samples).
-    #[default]
     OneSe,
-    /// The lowest leave-one-out error.
-    MinLoo,
 }
 
 impl From<Kind> for SurrogateKind {
@@ -104,9 +104,9 @@ struct FitArgs {
     /// smoothing by leave-one-out, per output (or per shape coordinate).
     #[arg(long)]
     auto: bool,
-    /// How `--auto` and `--kind auto` pick a candidate: the smoothest within one standard
-    /// error of the lowest leave-one-out error (default), or the lowest.
-    #[arg(long, value_enum, default_value = "one-se")]
+    /// How `--auto` and `--kind auto` pick a candidate: the lowest leave-one-out error
+    /// (default), or the smoothest within one standard error of it.
+    #[arg(long, value_enum, default_value = "min-loo")]
     select: Pick,
     /// Where to write the model (JSON); stdout when absent.
     #[arg(long)]
