@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # How `impactcal surrogate fit` chooses among its candidates (--auto, --kind auto), on data
-# the rule was not designed on: the one-standard-error rule (`--select one-se`, the
-# default) against the lowest leave-one-out error (`--select min-loo`, the rule before it),
+# the rule was not designed on: the one-standard-error rule (`--select one-se`) against
+# the lowest leave-one-out error (`--select min-loo`, the default),
 # both against the better of two yardsticks fitted on the same runs: a linear regression
 # and scipy's smoothed cubic RBF with its smoothing chosen by 10-fold cross-validation.
 #
