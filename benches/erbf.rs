@@ -43,6 +43,7 @@ fn bench(c: &mut Criterion) {
         kind: SurrogateKind::Cubic,
         basis: OutputBasis::Shapes { count: None },
         tuning: Tuning::Off,
+        ..FitOptions::default()
     };
     let fit_shapes =
         || ResponseSurrogate::fit_with(&space, x.as_ref(), f.as_ref(), names.clone(), &shapes);

@@ -9,7 +9,10 @@
 //! [--perturb-horizon H | --no-perturb] [--repeat-refinement N | --no-repeat-refinement] [--candidate-floor N [--candidate-horizon H] |
 //! --no-candidate-decay] [--merit-weights 0.3,0.5,0.8,0.95]
 //! [--adaptive-region restore|escape|restart|restart-outside [--grow-after 3] [--shrink-after N] [--halvings 6] [--sigma-only] |
-//! --no-adaptive-region] [--points]`
+//! --no-adaptive-region] [--unknown-budget] [--points]`
+//!
+//! The study is told its budget (`CorsOptions::budget`), so that the perturbation schedule
+//! falls over it as DYCORS's does; `--unknown-budget` leaves it out (the horizon of 300).
 //!
 //! `--noise LEVEL --noise-file FILE` runs the whole budget on `f(x) + LEVEL * range * z_k`,
 //! with the range of each function and the draws `z_k` of each seed read from the table
@@ -142,6 +145,9 @@ fn main() {
             let mut options = CorsOptions {
                 transform,
                 kernel,
+                // The study knows its budget, as pySOT's strategies do (`max_evals`);
+                // `--unknown-budget` measures the schedule of a study that does not.
+                budget: (!args.iter().any(|a| a == "--unknown-budget")).then_some(budget),
                 ..CorsOptions::with_seed(seed)
             };
             if let Some(c) = get("--candidates") {
@@ -176,7 +182,7 @@ fn main() {
             }
             if let Some(h) = get("--perturb-horizon") {
                 options.perturbation = Some(Perturbation {
-                    horizon: h.parse().unwrap(),
+                    horizon: Some(h.parse().unwrap()),
                 });
             }
             if args.iter().any(|a| a == "--no-perturb") {

@@ -118,6 +118,7 @@ fn shapes_options(kind: SurrogateKind) -> FitOptions {
         kind,
         basis: OutputBasis::Shapes { count: None },
         tuning: Tuning::Off,
+        ..FitOptions::default()
     }
 }
 

@@ -153,9 +153,15 @@ struct SuggestArgs {
     no_second_region: bool,
     /// DYCORS-style coordinate perturbation in the local cycles: each coordinate of a
     /// candidate around the best point moves with a probability that falls over this many
-    /// evaluations after the initial set (default 300).
+    /// evaluations after the initial set (default: the `--budget` less the initial set, or
+    /// 300 without a budget).
     #[arg(long, conflicts_with = "no_perturbation")]
     perturb_horizon: Option<usize>,
+    /// The study's budget: the rows the history will hold in all (existing runs and design
+    /// included). The perturbation's probability then falls to its floor at the budget,
+    /// as DYCORS's does; it stops nothing. Keep it fixed for the whole study.
+    #[arg(long)]
+    budget: Option<usize>,
     /// Move every coordinate of the candidates around the best point.
     #[arg(long)]
     no_perturbation: bool,
@@ -386,7 +392,9 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
             None
         } else {
             args.perturb_horizon
-                .map(|horizon| Perturbation { horizon })
+                .map(|horizon| Perturbation {
+                    horizon: Some(horizon),
+                })
                 .or(options.perturbation)
         },
         repeat_refinement: if args.no_repeat_refinement {
@@ -404,6 +412,7 @@ fn suggest(args: SuggestArgs) -> Result<(), CliError> {
             horizon: args.candidate_horizon,
         }),
         merit_weights: args.merit_weights,
+        budget: args.budget,
         adaptive_region: args.adaptive_region.map(|on| AdaptiveRegion {
             shrink_after: args.adaptive_shrink_after,
             halvings: args.adaptive_halvings,

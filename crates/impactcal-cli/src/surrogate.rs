@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use clap::{Args as ClapArgs, Subcommand, ValueEnum};
 use impactcal::core::{Samples, Table, TableOptions, read_samples, read_text};
 use impactcal::erbf::{
-    ErbfError, FitOptions, LOO_ROUND_OFF, LooMethod, OutputBasis, ResponseSurrogate, SurrogateKind,
-    Tuning,
+    ErbfError, FitOptions, LOO_ROUND_OFF, LooMethod, OutputBasis, ResponseSurrogate, Selection,
+    SurrogateKind, Tuning,
 };
 
 use impactcal::erbf::{ComponentOptions, RadialFunction, SurrogateModel};
@@ -60,6 +60,17 @@ enum Basis {
     Shapes,
 }
 
+/// How `--auto` and `--kind auto` pick among their candidates.
+#[derive(ValueEnum, Clone, Copy, Debug, Default)]
+enum Pick {
+    /// The lowest leave-one-out error.
+    #[default]
+    MinLoo,
+    /// The smoothest candidate within one standard error of the lowest leave-one-out
+    /// error (paired over the samples).
+    OneSe,
+}
+
 impl From<Kind> for SurrogateKind {
     fn from(k: Kind) -> Self {
         match k {
@@ -93,6 +104,10 @@ struct FitArgs {
     /// smoothing by leave-one-out, per output (or per shape coordinate).
     #[arg(long)]
     auto: bool,
+    /// How `--auto` and `--kind auto` pick a candidate: the lowest leave-one-out error
+    /// (default), or the smoothest within one standard error of it.
+    #[arg(long, value_enum, default_value = "min-loo")]
+    select: Pick,
     /// Where to write the model (JSON); stdout when absent.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -139,6 +154,10 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
         kind: a.kind.into(),
         basis,
         tuning,
+        selection: match a.select {
+            Pick::OneSe => Selection::OneStandardError,
+            Pick::MinLoo => Selection::MinimumLoo,
+        },
     };
     let model = ResponseSurrogate::fit_with(
         &space,

@@ -146,6 +146,10 @@ pub fn dycors_decay(m: usize, horizon: usize) -> f64 {
     (1.0 - ((m + 1) as f64).ln() / (horizon as f64).ln()).clamp(0.0, 1.0)
 }
 
+/// The horizon of the perturbation schedule when neither it nor the study's budget is
+/// given: 300 evaluations after the run's initial set.
+pub const DEFAULT_HORIZON: usize = 300;
+
 /// DYCORS-style coordinate perturbation of the candidates around the best point in the
 /// local cycles (Regis & Shoemaker 2013): each coordinate of such a candidate is perturbed
 /// with probability `p(m) = min(20 / d, 1) phi(m)` ([`dycors_decay`]), and one coordinate
@@ -153,16 +157,32 @@ pub fn dycors_decay(m: usize, horizon: usize) -> f64 {
 /// in a run every coordinate moves; later, in many dimensions, a few at a time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Perturbation {
-    /// Evaluations after the run's initial set over which `p` falls to its floor (DYCORS:
-    /// the budget less the initial set); at least 2.
-    pub horizon: usize,
+    /// Evaluations after the run's initial set over which `p` falls to its floor; at least
+    /// 2. `None` (the default): DYCORS's own rule, the study's
+    /// [`budget`](CorsOptions::budget) less the evaluations before the run's first adaptive
+    /// point, or [`DEFAULT_HORIZON`] when the budget is not known
+    /// ([`horizon_for`](Self::horizon_for)).
+    pub horizon: Option<usize>,
 }
 
 impl Perturbation {
+    /// The horizon of a run whose first adaptive point is evaluation `cycle_origin` (the
+    /// evaluations before it, warm start and design included) in a study of `budget`
+    /// evaluations in all: `horizon` when set, else `budget - cycle_origin` (0 when the
+    /// budget is spent, which makes `phi` 0), else [`DEFAULT_HORIZON`].
+    pub fn horizon_for(&self, budget: Option<usize>, cycle_origin: usize) -> usize {
+        match (self.horizon, budget) {
+            (Some(h), _) => h,
+            (None, Some(b)) => b.saturating_sub(cycle_origin),
+            (None, None) => DEFAULT_HORIZON,
+        }
+    }
+
     /// The probability of perturbing a coordinate at the `m`-th evaluation after the run's
-    /// initial set in `dim` dimensions.
-    pub fn probability(&self, m: usize, dim: usize) -> f64 {
-        (20.0 / dim.max(1) as f64).min(1.0) * dycors_decay(m, self.horizon)
+    /// initial set in `dim` dimensions, the schedule's horizon being `horizon`
+    /// ([`horizon_for`](Self::horizon_for)).
+    pub fn probability(&self, m: usize, dim: usize, horizon: usize) -> f64 {
+        (20.0 / dim.max(1) as f64).min(1.0) * dycors_decay(m, horizon)
     }
 }
 
@@ -379,8 +399,8 @@ pub struct CorsOptions {
     /// without `local_region`.
     pub second_region: Option<f64>,
     /// DYCORS-style perturbation of the candidates around the best point in the local
-    /// cycles (`None`: every coordinate of every such candidate moves). Default: a horizon
-    /// of 300 evaluations.
+    /// cycles (`None`: every coordinate of every such candidate moves). Default: the
+    /// horizon follows [`budget`](Self::budget) (300 evaluations when it is `None`).
     pub perturbation: Option<Perturbation>,
     /// Refinement steps repeated while they improve the run's best value
     /// ([`RepeatRefinement`]); `None`: the pattern advances by one at every evaluation.
@@ -401,6 +421,14 @@ pub struct CorsOptions {
     /// (pySOT: `[0.3, 0.5, 0.8, 0.95]`); the pattern then only counts the steps of a cycle
     /// for the local cycles. `None`: CORS's constrained step.
     pub merit_weights: Option<Vec<f64>>,
+    /// The study's evaluation budget when it is known: every evaluation it will hold, warm
+    /// start, design and adaptive points together. A run's perturbation schedule then
+    /// falls to its floor at the budget, as DYCORS's does (Regis & Shoemaker 2013:
+    /// `phi(n) = 1 - ln(n - n0 + 1) / ln(N - n0)` for a budget `N` and an initial set of
+    /// `n0`); it stops nothing (the caller stops asking, or [`Cors::minimize`](crate::Cors::minimize)
+    /// at its own budget). `None` (the default): unknown, and the horizon is
+    /// [`DEFAULT_HORIZON`]. At least 1.
+    pub budget: Option<usize>,
     /// Seed of the design and of every candidate set.
     pub seed: u64,
 }
@@ -427,11 +455,12 @@ impl Default for CorsOptions {
             local_first: false,
             local_escape: Some(60),
             second_region: Some(0.5),
-            perturbation: Some(Perturbation { horizon: 300 }),
+            perturbation: Some(Perturbation { horizon: None }),
             repeat_refinement: Some(RepeatRefinement::default()),
             adaptive_region: None,
             candidate_decay: None,
             merit_weights: None,
+            budget: None,
             seed: 0,
         }
     }
@@ -461,7 +490,7 @@ impl ParamGuard for CorsOptions {
     /// [`CoreError::InvalidOption`] for an empty pattern or a `beta` outside `[0, 1]`, a
     /// design of fewer than 2 points, no candidates, no polishing start, a distance that is
     /// negative or not finite, a zero patience (stopping or restart) or a negative or
-    /// non-finite improvement threshold, a decay horizon below 2, a candidate floor of 0
+    /// non-finite improvement threshold, a decay horizon below 2, a budget of 0, a candidate floor of 0
     /// or above `candidates_per_dim`, a repeated refinement with `max_beta` outside
     /// `[0, 1]` or no repeat, or an adaptive region with a zero count or halvings outside
     /// `[1, 30]`.
@@ -538,14 +567,13 @@ impl ParamGuard for CorsOptions {
                 "must be finite and positive",
             );
         }
-        if let Some(p) = &self.perturbation
-            && p.horizon < 2
+        if let Some(h) = self.perturbation.and_then(|p| p.horizon)
+            && h < 2
         {
-            return bad(
-                "perturbation.horizon",
-                p.horizon.to_string(),
-                "must be at least 2",
-            );
+            return bad("perturbation.horizon", h.to_string(), "must be at least 2");
+        }
+        if self.budget == Some(0) {
+            return bad("budget", "0".into(), "must be at least 1");
         }
         if let Some(r) = &self.repeat_refinement {
             if !(r.max_beta >= 0.0 && r.max_beta <= 1.0) {
@@ -679,10 +707,10 @@ mod tests {
         assert_eq!(dycors_decay(299, 300), 0.0);
         assert_eq!(dycors_decay(1000, 300), 0.0);
         assert_eq!(dycors_decay(0, 1), 0.0);
-        let p = Perturbation { horizon: 300 };
-        assert_eq!(p.probability(0, 6), 1.0);
-        assert!((p.probability(0, 40) - 0.5).abs() < 1e-15);
-        assert!((p.probability(1, 40) - 0.5 * second).abs() < 1e-15);
+        let p = Perturbation { horizon: None };
+        assert_eq!(p.probability(0, 6, 300), 1.0);
+        assert!((p.probability(0, 40, 300) - 0.5).abs() < 1e-15);
+        assert!((p.probability(1, 40, 300) - 0.5 * second).abs() < 1e-15);
         let c = CandidateDecay {
             min_per_dim: 100,
             horizon: 300,
@@ -691,5 +719,23 @@ mod tests {
         // 400 (1 - ln 11 / ln 300) = 231.9...
         assert_eq!(c.per_dim(400, 10), 232);
         assert_eq!(c.per_dim(400, 200), 100);
+    }
+
+    /// The horizon: a fixed one wins; else DYCORS's budget less the evaluations before the
+    /// run's first adaptive point (0 once the budget is spent); else the default 300.
+    #[test]
+    #[allow(clippy::float_cmp)] // exact values by construction
+    fn horizon_follows_the_budget() {
+        let follow = Perturbation { horizon: None };
+        assert_eq!(follow.horizon_for(None, 14), DEFAULT_HORIZON);
+        assert_eq!(follow.horizon_for(Some(60), 14), 46);
+        assert_eq!(follow.horizon_for(Some(150), 50), 100);
+        assert_eq!(follow.horizon_for(Some(10), 14), 0);
+        let fixed = Perturbation { horizon: Some(40) };
+        assert_eq!(fixed.horizon_for(Some(60), 14), 40);
+        assert_eq!(fixed.horizon_for(None, 14), 40);
+        // At a budget of 60 after 14 design points the probability is 0 at the last point.
+        assert_eq!(follow.probability(45, 6, 46), 0.0);
+        assert!(follow.probability(44, 6, 46) > 0.0);
     }
 }

@@ -257,11 +257,10 @@ pub(crate) fn propose(state: &CorsState, q: usize) -> Result<Proposal> {
                     candidates: n_cand,
                     local_candidates: state.options.local_candidates_per_dim * d,
                     polish_starts: state.options.polish_starts,
-                    perturb: state
-                        .options
-                        .perturbation
-                        .filter(|_| local)
-                        .map(|p| p.probability(m, d)),
+                    perturb: state.options.perturbation.filter(|_| local).map(|p| {
+                        let horizon = p.horizon_for(state.options.budget, plan.cycle_origin);
+                        p.probability(m, d, horizon)
+                    }),
                     merit_weight: state.options.merit_weights.as_ref().map(|w| w[m % w.len()]),
                     sigma_scale,
                 };

@@ -405,6 +405,54 @@ fn from_history_matches_the_library_loop() {
     assert_replays(&f, &options, &study, &[0, 3, 10, 11, 24]);
 }
 
+/// A known budget sets the perturbation schedule's horizon by DYCORS's rule, the budget
+/// less the evaluations before the run's first adaptive point: a study of budget 40 walks
+/// the points of one with the horizon fixed at 40 - 14 (Hartmann-6's design of 14), and
+/// after 20 existing evaluations at 40 - 20. Without a budget the horizon stays 300, and a
+/// state saved before the budget existed (a fixed horizon of 300, no `budget` field) loads
+/// and goes on as it did.
+#[test]
+fn budget_sets_the_perturbation_horizon() {
+    let f = test_functions::by_name("hartmann6").unwrap();
+    let space = f.space().unwrap();
+    let walk = |options: CorsOptions, existing: Option<(&[Vec<f64>], &[f64])>| {
+        let mut s = Cors::new(space.clone(), options).unwrap();
+        if let Some((xs, fs)) = existing {
+            s.warm_start_rows(xs, fs).unwrap();
+        }
+        s.minimize(|x| f.eval(x), 26).unwrap();
+        s.evaluations().to_vec()
+    };
+    let fixed = |h: usize| CorsOptions {
+        perturbation: Some(Perturbation { horizon: Some(h) }),
+        ..CorsOptions::with_seed(3)
+    };
+    let budget = CorsOptions {
+        budget: Some(40),
+        ..CorsOptions::with_seed(3)
+    };
+    let by_budget = walk(budget.clone(), None);
+    assert_eq!(by_budget, walk(fixed(26), None));
+    let unknown = walk(CorsOptions::with_seed(3), None);
+    assert_eq!(unknown, walk(fixed(300), None));
+    assert_ne!(by_budget, unknown);
+    let xs: Vec<Vec<f64>> = unknown[..20].iter().map(|e| e.x.clone()).collect();
+    let fs: Vec<f64> = unknown[..20].iter().map(|e| e.value.unwrap()).collect();
+    let warm = walk(budget, Some((&xs, &fs)));
+    assert_eq!(warm, walk(fixed(20), Some((&xs, &fs))));
+    // A state of the format before the budget: `"horizon": 300` and no `budget`.
+    let mut old = Cors::new(space.clone(), CorsOptions::with_seed(3)).unwrap();
+    old.minimize(|x| f.eval(x), 20).unwrap();
+    let json = old.to_json().unwrap();
+    let before = json
+        .replace("\"horizon\": null", "\"horizon\": 300")
+        .replace("\"budget\": null,", "");
+    assert!(!before.contains("budget") && before.contains("\"horizon\": 300"));
+    let mut resumed = Cors::from_json(&before, "old.json").unwrap();
+    resumed.minimize(|x| f.eval(x), 6).unwrap();
+    assert_eq!(resumed.evaluations(), &unknown[..26]);
+}
+
 /// The search options of the DYCORS and SRBF variants (coordinate perturbation, falling
 /// candidate count, weight cycle) and repeated refinement keep a study a function of its history: resuming from
 /// JSON and rebuilding from the rows give the library loop's points bit for bit.
@@ -413,7 +461,7 @@ fn search_variants_resume_and_replay_exactly() {
     let f = test_functions::by_name("hartmann6").unwrap();
     let variants = [
         CorsOptions {
-            perturbation: Some(Perturbation { horizon: 40 }),
+            perturbation: Some(Perturbation { horizon: Some(40) }),
             candidate_decay: Some(CandidateDecay {
                 min_per_dim: 50,
                 horizon: 40,
@@ -435,6 +483,10 @@ fn search_variants_resume_and_replay_exactly() {
             local_escape: Some(3),
             local_first: true,
             ..CorsOptions::with_seed(7)
+        },
+        CorsOptions {
+            budget: Some(40),
+            ..CorsOptions::with_seed(13)
         },
         // Short counts, so that the width shrinks, converges and escapes within 40 points.
         CorsOptions {
@@ -743,7 +795,7 @@ fn options_are_validated() {
             ..CorsOptions::default()
         },
         CorsOptions {
-            perturbation: Some(Perturbation { horizon: 1 }),
+            perturbation: Some(Perturbation { horizon: Some(1) }),
             ..CorsOptions::default()
         },
         CorsOptions {
@@ -804,6 +856,10 @@ fn options_are_validated() {
         },
         CorsOptions {
             merit_weights: Some(vec![]),
+            ..CorsOptions::default()
+        },
+        CorsOptions {
+            budget: Some(0),
             ..CorsOptions::default()
         },
         CorsOptions {

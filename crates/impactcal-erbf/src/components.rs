@@ -20,7 +20,7 @@ use crate::error::{ErbfError, Result};
 use crate::loo::LooMethod;
 use crate::rbf::{RbfInterpolant, relative_max_error};
 use crate::shape_basis::{ShapeBasis, ShapeSpectrum, choose_count};
-use crate::tuning::{ComponentOptions, candidates, tune};
+use crate::tuning::{ComponentOptions, Selection, candidates, tune};
 
 /// How the outputs are represented for the surrogate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -142,7 +142,8 @@ pub struct Components {
 }
 
 impl Components {
-    /// Fits the surrogate: targets from `basis`, options from `base` (and [`Tuning`]).
+    /// Fits the surrogate: targets from `basis`, options from `base` (and [`Tuning`], the
+    /// tuned candidates picked by `selection`).
     ///
     /// Steps: the targets (shape coordinates up to the numerical rank, or the outputs);
     /// with tuning, the options per target column (or for all when there are more than 64
@@ -165,6 +166,7 @@ impl Components {
         base: ComponentOptions,
         basis: OutputBasis,
         tuning: Tuning,
+        selection: Selection,
     ) -> Result<Self> {
         let training = values.into();
         let values = training.view();
@@ -199,7 +201,7 @@ impl Components {
                     Tuning::Kinds => classic_candidates(unit.as_ref()),
                     _ => candidates(base, unit.as_ref()),
                 };
-                let tuned = tune(space, points, targets, &cands, per_column)?;
+                let tuned = tune(space, points, targets, &cands, per_column, selection)?;
                 (tuned.options, Some(tuned.loo))
             }
         };

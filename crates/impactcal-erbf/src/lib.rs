@@ -101,4 +101,4 @@ pub use surrogate::{
     FitOptions, LOO_ROUND_OFF, LooComparison, ResponseSurrogate, SurrogateKind, SurrogateModel,
 };
 pub use trend::linear_trend_loo;
-pub use tuning::ComponentOptions;
+pub use tuning::{ComponentOptions, Selection};

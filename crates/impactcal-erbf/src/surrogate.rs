@@ -18,7 +18,7 @@ use crate::loo::{ErrorSummary, LooMethod};
 use crate::options::ValidErbfOptions;
 use crate::radial::RadialFunction;
 use crate::rbf::{RbfInterpolant, RbfOptions};
-use crate::tuning::ComponentOptions;
+use crate::tuning::{ComponentOptions, Selection};
 
 /// The kinds of surrogate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -87,6 +87,10 @@ pub struct FitOptions {
     pub basis: OutputBasis,
     /// What is chosen by leave-one-out.
     pub tuning: Tuning,
+    /// How the tuned candidates are chosen from their leave-one-out errors (no effect
+    /// with [`Tuning::Off`]).
+    #[serde(default)]
+    pub selection: Selection,
 }
 
 impl Default for SurrogateKind {
@@ -240,6 +244,7 @@ impl ResponseSurrogate {
             options.kind.component_options(),
             options.basis,
             options.tuning,
+            options.selection,
         )?;
         Ok(ResponseSurrogate {
             output_names,

@@ -53,6 +53,7 @@ fn shapes(kind: SurrogateKind, count: Option<usize>) -> FitOptions {
         kind,
         basis: OutputBasis::Shapes { count },
         tuning: Tuning::Off,
+        ..FitOptions::default()
     }
 }
 
@@ -255,6 +256,7 @@ fn owned_and_borrowed_outputs_fit_the_same_model() {
             kind,
             basis,
             tuning,
+            ..FitOptions::default()
         };
         let borrowed =
             ResponseSurrogate::fit_with(&space, x.as_ref(), f.as_ref(), names(), &options).unwrap();

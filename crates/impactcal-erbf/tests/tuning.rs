@@ -46,6 +46,7 @@ fn auto(kind: SurrogateKind, tuning: Tuning) -> FitOptions {
         kind,
         basis: OutputBasis::Full,
         tuning,
+        ..FitOptions::default()
     }
 }
 

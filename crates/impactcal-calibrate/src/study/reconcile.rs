@@ -74,6 +74,8 @@ pub fn reconcile(
         // range: the answer farther from the truth in 71 of 120 seeds, closer in 49), and
         // on the study test's noiseless model it ties (docs/cors.md).
         repeat_refinement: None,
+        // Every run the study will hold: the perturbation schedule falls over the new runs.
+        budget: Some(start.len() + budget),
         ..CorsOptions::with_seed(seed)
     };
     let mut cors = Cors::new(space.clone(), options)?;

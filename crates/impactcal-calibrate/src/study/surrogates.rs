@@ -129,6 +129,7 @@ pub fn choose(
                 kind,
                 basis,
                 tuning: Tuning::Off,
+                ..FitOptions::default()
             };
             let outcome = (|| {
                 let s =
