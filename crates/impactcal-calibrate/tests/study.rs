@@ -377,6 +377,8 @@ fn the_report_document_holds_the_study_numbers() {
             "fig-sensors",
             "fig-m2-baseline",
             "fig-m2-calibrated",
+            "fig-shape-1",
+            "fig-shape-2",
             "fig-sensitivity",
             "fig-q",
             "fig-sensor"

@@ -308,9 +308,9 @@ impl ModelSpec {
                 })
             }
             (Some(k), None, None, None) => Err(fault(&format!(
-                "[model] kind = \"{k}\": unknown (the built-in models are \"drop-tower\" and \
-                 \"kolsky-bar\" and \"lumped\"; the airframe and decks are `airframe = \"coarse\"`, \
-                 `deck = \"model.k\"`)"
+                "[model] kind = \"{k}\": unknown (the built-in models are \"drop-tower\", \
+                 \"kolsky-bar\" and \"lumped\"; the airframe and decks are \
+                 `airframe = \"coarse\"`, `deck = \"model.k\"`)"
             ))),
             (None, Some(mesh), None, None) => {
                 if !params.is_empty() {

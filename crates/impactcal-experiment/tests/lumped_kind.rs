@@ -238,7 +238,7 @@ fn malformed_lumped_files_are_refused_naming_what_is_wrong() {
         ),
         (
             format!("[model]\nkind = \"lumpy\"\n{test}"),
-            "the built-in models are \"drop-tower\" and \"lumped\"",
+            "the built-in models are \"drop-tower\", \"kolsky-bar\" and \"lumped\"",
         ),
         (
             format!("{head}{test}repeats = [\"drop2.csv\"]\n[holdout]\ndata = \"drop3.csv\"\n"),
