@@ -397,6 +397,20 @@ fn the_report_document_holds_the_study_numbers() {
                 let marked: Vec<[f64; 2]> = e.marked.iter().map(|m| [m.0, m.1]).collect();
                 assert_eq!(marked, r.m1.intervals);
             }
+            (Plot::Structure(st), name) if name.starts_with("fig-shape-") => {
+                // Each marker is an entry of the test's shape at its channel's node.
+                let j: usize = name["fig-shape-".len()..].parse::<usize>().unwrap() - 1;
+                let shape = &m2.baseline.test_shapes[j];
+                assert!(!st.marked.is_empty(), "{name}");
+                for m in &st.marked {
+                    let v = m.value.unwrap();
+                    assert!(
+                        shape.iter().any(|s| *s == v)
+                            && geometry.channels.values().any(|at| *at == m.at),
+                        "{name}: {m:?}"
+                    );
+                }
+            }
             (Plot::Structure(st), _) => {
                 let labels: Vec<&str> = st.marked.iter().map(|m| m.label.as_str()).collect();
                 assert_eq!(labels, r.sensors.as_ref().unwrap().selected);

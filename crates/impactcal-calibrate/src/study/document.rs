@@ -549,7 +549,10 @@ fn shape_figures(m: &super::m2::M2Result, labels: &[String], g: &Geometry) -> Ve
             figure(
                 &format!("fig-shape-{}", j + 1),
                 format!(
-                    "Impact shape {} of the test (contribution {}) on the structure: its                      entries at {along} ({} nodes, {:.0} % of the shape's energy); red and                      blue move in opposite directions, and the shape as a whole is fixed only                      up to sign",
+                    "Impact shape {} of the test (contribution {}) on the structure: its \
+                     entries at {along} ({} nodes, {:.0} % of the shape's energy); red and \
+                     blue move in opposite directions, and the shape as a whole is fixed \
+                     only up to sign",
                     j + 1,
                     pct(contribution),
                     marked.len(),
