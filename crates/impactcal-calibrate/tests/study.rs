@@ -405,8 +405,7 @@ fn the_report_document_holds_the_study_numbers() {
                 for m in &st.marked {
                     let v = m.value.unwrap();
                     assert!(
-                        shape.iter().any(|s| *s == v)
-                            && geometry.channels.values().any(|at| *at == m.at),
+                        shape.contains(&v) && geometry.channels.values().any(|at| *at == m.at),
                         "{name}: {m:?}"
                     );
                 }
