@@ -18,6 +18,10 @@
 # and left out of the statistics (the table names it). Defaults: 21 (one more than the 20
 # compared, in case one fails; the greedy order keeps the first 20 whatever N), /tmp/car_pole_crosscode, 2. Build first: cargo build --release -p
 # impactcal-cli. Standard-library Python 3 only. Each run is 30-100 s of CPU.
+#
+# VARIANT=NAME runs every design on the model with the one change NAME of the controlled
+# reruns (e.g. hourglass-viscous: the runs a surrogate of that model needs), its include
+# written once under WORK; no controlled reruns then. Keep a separate WORK per variant.
 set -eu
 here=$(cd "$(dirname "$0")/../.." && pwd)
 n=${1:-21}
@@ -40,6 +44,15 @@ touch "$failures"
 echo "$(nproc) CPUs: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"
 # CONTROLS=0: no controlled reruns; CONTROLS=a,b: only those; default: all of them.
 controls=
+variant=${VARIANT:-}
+include=$data/decks/car6_crash_v223.k
+if [ -n "$variant" ]; then
+    CONTROLS=0
+    mkdir -p "$work/variant-$variant"
+    $py control "$variant" "$work/variant-$variant"
+    include=$work/variant-$variant/car6_crash_v223.k
+    echo "every design runs with $variant"
+fi
 case "${CONTROLS:-1}" in
 0) ;;
 1) controls=$($py controls) ;;
@@ -54,7 +67,7 @@ for row in base $($py select "$n") $controls; do
     case " $controls " in
     *" $row "*) $py control "$row" "$dir" ;;
     *)
-        ln -sf "$data/decks/car6_crash_v223.k" "$dir/car6_crash_v223.k"
+        ln -sf "$include" "$dir/car6_crash_v223.k"
         $py deck "$row" "$dir"
         ;;
     esac
