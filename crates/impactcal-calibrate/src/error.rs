@@ -117,6 +117,47 @@ pub enum CalibrateError {
         /// What to change (the key that sets the model's window, where one is known).
         advice: String,
     },
+    /// A scalar test names a scalar the model's runs do not have.
+    #[error(
+        "scalar `{scalar}` of the test is not among the model's outputs ({})",
+        available.join(", ")
+    )]
+    UnknownScalar {
+        /// The scalar.
+        scalar: String,
+        /// The outputs the runs have.
+        available: Vec<String>,
+    },
+    /// A set of model outputs lacks a scalar of the test.
+    #[error("{origin}: no output `{scalar}`, which the test needs (it has: {})", available.join(", "))]
+    MissingScalar {
+        /// The scalar.
+        scalar: String,
+        /// The outputs (a run, the surrogates at a point).
+        origin: String,
+        /// The outputs it has.
+        available: Vec<String>,
+    },
+    /// A scalar's value (the test's, its scale, or a model output) that is NaN or infinite.
+    #[error("scalar `{scalar}`: {origin} is {value}, not a finite number")]
+    NonFiniteScalar {
+        /// The scalar.
+        scalar: String,
+        /// Whose value: the test's value, the scale, run `i`.
+        origin: String,
+        /// The value.
+        value: f64,
+    },
+    /// A scalar's scale that is zero or negative: its errors cannot be normalised.
+    #[error(
+        "scalar `{scalar}`: scale {scale} must be positive (the spread or uncertainty its error is measured in)"
+    )]
+    NonPositiveScale {
+        /// The scalar.
+        scalar: String,
+        /// The scale given.
+        scale: f64,
+    },
     /// A stage whose memory estimate, beside what the process holds, exceeds the limit (the
     /// user's, or what the machine can still give): stopped before it allocates.
     #[error(
@@ -191,7 +232,11 @@ impl CalibrateError {
             | CalibrateError::Study { .. }
             | CalibrateError::ForeignJournal { .. }
             | CalibrateError::TestShorterThanModel { .. }
-            | CalibrateError::Memory { .. } => ErrorKind::BadInput,
+            | CalibrateError::Memory { .. }
+            | CalibrateError::UnknownScalar { .. }
+            | CalibrateError::MissingScalar { .. }
+            | CalibrateError::NonFiniteScalar { .. }
+            | CalibrateError::NonPositiveScale { .. } => ErrorKind::BadInput,
             CalibrateError::Render { .. } => ErrorKind::Numerical,
             CalibrateError::Shapes(e) => e.kind(),
             CalibrateError::Sensors(e) => e.kind(),

@@ -77,6 +77,7 @@ pub mod memory;
 pub mod metrics;
 pub mod progress;
 pub mod report;
+pub mod scalar;
 pub mod study;
 
 pub use error::{CalibrateError, Result};
