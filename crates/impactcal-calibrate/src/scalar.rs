@@ -180,6 +180,10 @@ pub fn misfit_of(errors: &[ScalarError]) -> f64 {
     errors.iter().map(|e| e.normalised * e.normalised).sum()
 }
 
+/// Distance in the unit box below which a run is taken to be at the nominal point, and the
+/// nominal point is not added to the search's warm start.
+pub const NOMINAL_TOLERANCE: f64 = 1e-9;
+
 /// Runs of the model: a point of the parameter space and the model's scalar outputs there.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ScalarRuns {
@@ -249,8 +253,9 @@ pub struct ScalarCalibration {
 /// Calibrates the parameters of `space` to `test` from the model's `runs`: one surrogate per
 /// scalar of the test (chosen by leave-one-out among the study's kinds), and CORS-RBF on
 /// `ln J` of the surrogates (a sum of squares spans decades near its minimum), its
-/// perturbation horizon set to the whole search, warm-started from the nominal point and
-/// the runs' points; `options.budget` further evaluations in batches of `options.batch`.
+/// perturbation horizon set to the whole search, warm-started from the runs' points and the
+/// nominal point (unless a run lies within [`NOMINAL_TOLERANCE`] of it); `options.budget`
+/// further evaluations in batches of `options.batch`.
 /// Scalars of the runs the test does not name are ignored.
 ///
 /// # Errors
@@ -328,7 +333,23 @@ pub fn calibrate(
             .collect()
     };
     let nominal = space.nominal();
-    let mut start = vec![nominal.clone()];
+    // The nominal point first unless a run is already there (CORS refuses a point twice).
+    let unit_nominal = space.to_unit(&nominal)?;
+    let mut run_at_nominal = false;
+    for p in &runs.points {
+        let u = space.to_unit(p)?;
+        let d2: f64 = u
+            .iter()
+            .zip(&unit_nominal)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum();
+        run_at_nominal |= d2.sqrt() < NOMINAL_TOLERANCE;
+    }
+    let mut start = if run_at_nominal {
+        Vec::new()
+    } else {
+        vec![nominal.clone()]
+    };
     start.extend(runs.points.iter().cloned());
     let cors_options = CorsOptions {
         transform: Transform::Log,

@@ -99,6 +99,21 @@ pub struct Args {
     /// airframe's undeclared quantities when absent).
     #[arg(long, value_delimiter = ',')]
     pub candidates: Option<Vec<String>>,
+    /// The car pole crash instead: our model's nine parameters calibrated to LS-DYNA's four
+    /// outputs (dmax, fmax, vfin, IE) at one design of the public LS-OPT car pole study, kept
+    /// in DIR (`p9_problem.txt`, `p9_X.csv`, `p9_Y_*.csv`, `decks/`); needs `--runs`. Writes
+    /// `car-pole.json`, `report.md` and `calibrated.k` (the deck of the calibrated point).
+    #[arg(long, value_name = "DIR")]
+    pub car_pole: Option<PathBuf>,
+    /// Car pole: our solver's outputs per design, reused (a CSV with a `row` column, `base`
+    /// or a row of `p9_X.csv`, and dmax, fmax, vfin, IE; benches/peers/car_pole_crosscode.sh
+    /// writes it).
+    #[arg(long, value_name = "RESULTS")]
+    pub runs: Option<PathBuf>,
+    /// Car pole: the design whose LS-DYNA outputs are the test: `base` (the box centre, the
+    /// mean of LS-DYNA's five repeats) or a row of `p9_X.csv`.
+    #[arg(long, default_value = "base")]
+    pub target: String,
     /// Keep every channel of every run in its `result.csv` (by default a run after the
     /// nominal and jitter runs stores only the channels compared).
     #[arg(long)]
@@ -126,6 +141,9 @@ struct Summary<'a> {
 pub fn run(args: Args) -> Result<(), CliError> {
     if args.close_loop {
         return crate::demo_loop::run(&args);
+    }
+    if let Some(dir) = &args.car_pole {
+        return crate::demo_car_pole::run(dir, args.runs.as_deref(), &args.target, &args.out);
     }
     let started = Instant::now();
     let pool = thread_pool(args.threads)?;

@@ -10,6 +10,7 @@ mod close_loop;
 mod compare;
 mod convert;
 mod demo;
+mod demo_car_pole;
 mod demo_loop;
 mod error;
 mod expand;
