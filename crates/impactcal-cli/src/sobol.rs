@@ -117,7 +117,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let indices = analyze(&layout, view, &options)?;
     if !indices.low_variance_outputs.is_empty() {
         eprintln!(
-            "impactcal: warning: {} output column(s) have (near-)zero variance; their indices are null: {}",
+            "impactcal: warning: {} output column(s) have a variance at most 1e-10 of their own mean square (constant to float resolution); their indices are null: {}",
             indices.low_variance_outputs.len(),
             indices.low_variance_outputs.join(", ")
         );

@@ -32,9 +32,17 @@ pub struct SobolOptions {
     pub confidence: f64,
     /// Seed of the bootstrap resampling.
     pub seed: u64,
-    /// A column whose output variance `V(t)` is at most this fraction of the largest
-    /// column variance (or is zero) is flagged as low-variance; its indices are NaN (`null`
-    /// in JSON) and it is left out of the aggregated indices (default 1e-10).
+    /// A column whose output variance `V(t)` is at most this fraction of its own mean
+    /// square `mean(y(t)^2)` (or is zero) is flagged as low-variance; its indices are NaN
+    /// (`null` in JSON) and it is left out of the aggregated indices (default 1e-10).
+    ///
+    /// The criterion is the column's own: `V / mean(y^2) = cv^2 / (1 + cv^2)` carries no
+    /// unit, so columns in different units (a velocity of 1 beside an energy of 1e13) are
+    /// judged alike, and a constant column is flagged whatever its size. `1e-10` is a
+    /// spread below 1e-5 of the values' size: outputs of crash solvers are written in
+    /// single precision (`eps = 1.2e-7`), whose rounding then makes up a few tenths of a
+    /// percent of the spread's standard deviation, and smaller spreads are soon mostly
+    /// rounding.
     pub low_variance_tolerance: f64,
     /// Parameter names (default `x1, x2, ...`).
     pub parameter_names: Option<Vec<String>>,
@@ -180,7 +188,8 @@ pub struct SobolIndices {
     pub interaction_share: Vec<f64>,
     /// Aggregated indices over the columns.
     pub aggregated: AggregatedIndices,
-    /// Names of the columns with (near-)zero output variance.
+    /// Names of the columns whose output variance is at most the low-variance tolerance times
+    /// their own mean square (see [`SobolOptions::low_variance_tolerance`]).
     pub low_variance_outputs: Vec<String>,
     /// Bootstrap settings, when bootstrapped.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -198,6 +207,9 @@ struct Estimates {
     total_den: Vec<f64>,
     second: Vec<f64>,
     variance: Vec<f64>,
+    /// `mean(y^2)` of the pooled `A` and `B` rows (the outputs as given, not centred), per
+    /// column (the full sample only).
+    mean_square: Vec<f64>,
 }
 
 impl Estimates {
@@ -373,7 +385,7 @@ pub fn analyze(
     };
     let weights = resample_weights(n, options.bootstrap, options.seed);
     let items = accumulate::accumulate(&plan, outputs, &centre, &weights);
-    let est = estimates_from_sums(&plan, options, &items, weights.groups, cols);
+    let est = estimates_from_sums(&plan, options, &items, weights.groups, cols, &centre);
     Ok(assemble(&plan, options, &est, cols))
 }
 
@@ -383,6 +395,7 @@ fn estimates_from_sums(
     items: &[accumulate::ItemSums],
     groups: usize,
     cols: usize,
+    centre: &[f64],
 ) -> Estimates {
     let d = plan.layout.d();
     let np = plan.pairs.len();
@@ -398,6 +411,7 @@ fn estimates_from_sums(
         total_den: vec![0.0; size],
         second: vec![0.0; groups * cols * np],
         variance: vec![0.0; groups * cols],
+        mean_square: vec![0.0; cols],
     };
     let k_terms = plan.terms();
     let mut s_first = vec![0.0; d];
@@ -417,6 +431,13 @@ fn estimates_from_sums(
                 };
                 let v = shared.variance();
                 e.variance[g * cols + t] = v;
+                if g == 0 {
+                    // The moments are of the centred outputs `y - c`: mean(y^2) is
+                    // mean((y - c)^2) + 2 c mean(y - c) + c^2.
+                    let c = centre[t];
+                    e.mean_square[t] =
+                        0.5 * (shared.qa + shared.qb) + c * (shared.ma + shared.mb) + c * c;
+                }
                 for (i, s) in s_first.iter_mut().enumerate() {
                     let o = plan.param_offset(i);
                     let p = if plan.full {
@@ -483,11 +504,10 @@ fn assemble(plan: &Plan, options: &SobolOptions, e: &Estimates, cols: usize) -> 
     let d = plan.layout.d();
     let resamples = options.bootstrap;
     let output_names = names(&options.output_names, "y", cols);
-    let vmax = (0..cols).map(|t| e.variance[t]).fold(0.0_f64, f64::max);
     let low: Vec<bool> = (0..cols)
         .map(|t| {
             let v = e.variance[t];
-            !(v > 0.0 && v > options.low_variance_tolerance * vmax)
+            !(v > 0.0 && v > options.low_variance_tolerance * e.mean_square[t])
         })
         .collect();
     let mask = |t: usize, x: f64| if low[t] { f64::NAN } else { x };

@@ -107,7 +107,8 @@ pub struct GivenDataIndices {
     pub normalised_first_order_share: Vec<Vec<f64>>,
     /// Output variance per column (divisor `n`).
     pub variance: Vec<f64>,
-    /// Names of the columns with (near-)zero variance; their indices are NaN.
+    /// Names of the columns whose variance is at most the low-variance tolerance times their
+    /// own mean square; their indices are NaN.
     pub low_variance_outputs: Vec<String>,
 }
 
@@ -180,10 +181,17 @@ pub fn given_data_first_order(
             *s += (v - m) * (v - m);
         }
     }
-    let vmax = sst.iter().fold(0.0_f64, |a, &b| a.max(b));
+    // The column's own scale: its sum of squares about zero (see `SobolOptions`).
+    let mut ssq = vec![0.0; cols];
+    for row in outputs.row_iter() {
+        ssq.iter_mut()
+            .zip(row.iter())
+            .for_each(|(q, v)| *q += v * v);
+    }
     let low: Vec<bool> = sst
         .iter()
-        .map(|&s| !(s > 0.0 && s > options.low_variance_tolerance * vmax))
+        .zip(&ssq)
+        .map(|(&s, &q)| !(s > 0.0 && s > options.low_variance_tolerance * q))
         .collect();
 
     // ssb[i][t] for every parameter.

@@ -402,3 +402,64 @@ fn unit_space_design_matches_plain_sequence() {
         assert_eq!(row(p, d.layout.ba_row(j, 1)), [b[0], a[1]]);
     }
 }
+
+/// Outputs in different units side by side (a final velocity of order 1 beside an energy
+/// of order 1e13, as in a crash study's output file): each column is judged by its own
+/// scale, so both get the indices they get alone, while a constant column (here a large
+/// constant, 9e12) and one whose spread is below float resolution of its values are still
+/// flagged. A test of the column's own criterion: against the largest column's variance,
+/// the velocity (variance ~10) sat 1e-23 below the energy's (~1e24) and was nulled.
+#[test]
+fn low_variance_is_judged_per_column_in_mixed_units() {
+    let d = SaltelliDesign::generate(&ishigami_space(), 1024, Method::ScrambledSobol, false, 3)
+        .unwrap();
+    let mixed = |x: &[f64], y: &mut [f64]| {
+        let v = ishigami(x, 7.0, 0.1);
+        y[0] = 0.1 * v; // a velocity, variance ~0.14
+        y[1] = 9.0e12 + 1.0e11 * v; // an energy, variance ~1.4e23
+        y[2] = 9.0e12; // a constant
+        y[3] = 9.0e12 * (1.0 + 1e-15 * v.signum()); // a spread at the float resolution
+    };
+    let s = run(&d, 4, mixed, &SobolOptions::default());
+    assert_eq!(s.low_variance_outputs, vec!["y3", "y4"]);
+    let alone = run(
+        &d,
+        1,
+        |x, y| y[0] = ishigami(x, 7.0, 0.1),
+        &SobolOptions::default(),
+    );
+    for c in 0..2 {
+        for i in 0..3 {
+            assert!(
+                (s.first_order[c][i] - alone.first_order[0][i]).abs() < 1e-6,
+                "column {c}, parameter {i}: {} against {}",
+                s.first_order[c][i],
+                alone.first_order[0][i]
+            );
+            assert!((s.total[c][i] - alone.total[0][i]).abs() < 1e-6);
+        }
+    }
+
+    // The given-data estimator judges its columns the same way.
+    let x = impactcal_core::sampling::sample(&ishigami_space(), Method::LatinHypercube, 2048, 5)
+        .unwrap()
+        .points;
+    let rows = to_rows(x.as_ref());
+    let mut y = Vec::new();
+    for r in &rows {
+        let mut out = [0.0; 4];
+        mixed(r, &mut out);
+        y.extend(out);
+    }
+    let g = given_data_first_order(
+        x.as_ref(),
+        MatRef::from_row_major_slice(&y, rows.len(), 4),
+        &GivenDataOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(g.low_variance_outputs, vec!["y3", "y4"]);
+    for i in 0..3 {
+        assert!((g.first_order[0][i] - g.first_order[1][i]).abs() < 1e-6);
+        assert!(g.first_order[0][i].is_finite());
+    }
+}
