@@ -45,6 +45,12 @@
 //! journal that makes them resumable; the crate `impactcal-experiment` runs them from a
 //! file.
 //!
+//! # Scalar tests ([`scalar`], docs/study.md)
+//!
+//! A test of a handful of named scalars (an intrusion, a peak force, an energy), each with
+//! its own scale `sigma_k`: one surrogate per scalar from the model's runs and CORS-RBF on
+//! `J(p) = sum_k ((s_k(p) - y_k) / sigma_k)^2`, with the errors per scalar before and after.
+//!
 //! # Metrics ([`metrics`], docs/metrics.md)
 //!
 //! [`metrics`] judges a computed time history against a measured one with the curve metrics

@@ -83,15 +83,18 @@ fn table(path: &Path) -> Result<Vec<Vec<f64>>, CliError> {
         .collect()
 }
 
+/// Parameter names and their bounds.
+type Problem = (Vec<String>, Vec<(f64, f64)>);
+
 /// `p9_problem.txt`: a Python dict literal with `names` and `bounds`.
-fn problem(path: &Path) -> Result<(Vec<String>, Vec<(f64, f64)>), CliError> {
+fn problem(path: &Path) -> Result<Problem, CliError> {
     #[derive(serde::Deserialize)]
-    struct Problem {
+    struct File {
         names: Vec<String>,
         bounds: Vec<[f64; 2]>,
     }
     let text = read(path)?.replace('\'', "\"");
-    let p: Problem = serde_json::from_str(&text).map_err(|e| {
+    let p: File = serde_json::from_str(&text).map_err(|e| {
         CliError::input(format!(
             "{}: not the study's problem (names and bounds): {e}",
             path.display()
