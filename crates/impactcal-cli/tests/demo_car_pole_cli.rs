@@ -11,6 +11,7 @@ mod common;
 
 use std::fmt::Write as _;
 use std::path::Path;
+use std::process::Output;
 
 use common::impactcal;
 
@@ -127,6 +128,18 @@ fn misfit(o: [f64; 4], y: [f64; 4], scale: &[f64]) -> f64 {
     (0..4).map(|k| ((o[k] - y[k]) / scale[k]).powi(2)).sum()
 }
 
+fn demo(data: &Path, runs: &Path, out: &Path) -> Output {
+    impactcal(&[
+        "demo",
+        "--car-pole",
+        data.to_str().unwrap(),
+        "--runs",
+        runs.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
 #[test]
 fn calibrates_the_stand_in_to_its_known_point() {
     let tmp = tempfile::tempdir().unwrap();
@@ -135,15 +148,7 @@ fn calibrates_the_stand_in_to_its_known_point() {
     let results = tmp.path().join("results.csv");
     our_results(&results, &x, 30);
     let out = tmp.path().join("out");
-    let o = impactcal(&[
-        "demo",
-        "--car-pole",
-        data.to_str().unwrap(),
-        "--runs",
-        results.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = demo(&data, &results, &out);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     let stdout = String::from_utf8_lossy(&o.stdout);
@@ -209,15 +214,7 @@ fn absent_data_and_bad_runs_are_clear_messages() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
     let absent = tmp.path().join("nowhere");
-    let o = impactcal(&[
-        "demo",
-        "--car-pole",
-        absent.to_str().unwrap(),
-        "--runs",
-        "r.csv",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = demo(&absent, Path::new("r.csv"), &out);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("no car pole study here"), "{err}");
@@ -226,15 +223,7 @@ fn absent_data_and_bad_runs_are_clear_messages() {
     let data = tmp.path().join("car_pole");
     let x = study(&data);
     let run = |runs: &Path| {
-        let o = impactcal(&[
-            "demo",
-            "--car-pole",
-            data.to_str().unwrap(),
-            "--runs",
-            runs.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let o = demo(&data, runs, &out);
         (
             o.status.code(),
             String::from_utf8_lossy(&o.stderr).to_string(),
