@@ -89,13 +89,7 @@ pub fn estimate(
     candidates: &[ComponentOptions],
     per_column: bool,
 ) -> Result<NestedEstimate> {
-    let n = values.nrows();
-    if n < 2 * OUTER_FOLDS {
-        return Err(ErbfError::InvalidModel(format!(
-            "nested cross-validation needs at least {} samples, got {n}",
-            2 * OUTER_FOLDS
-        )));
-    }
+    check_samples(values.nrows())?;
     let all = Scores::new(space, points, values, candidates, per_column)?;
     Ok(estimate_from(
         space, points, values, candidates, per_column, &all,
@@ -197,13 +191,7 @@ pub(crate) fn tune_nested(
     per_column: bool,
 ) -> Result<Tuned> {
     let scored = if per_column { values.ncols() } else { 1 };
-    let n = values.nrows();
-    if n < 2 * OUTER_FOLDS {
-        return Err(ErbfError::InvalidModel(format!(
-            "nested cross-validation needs at least {} samples, got {n}",
-            2 * OUTER_FOLDS
-        )));
-    }
+    check_samples(values.nrows())?;
     let all = Scores::new(space, points, values, candidates, per_column)?;
     let est = estimate_from(space, points, values, candidates, per_column, &all);
     let chosen: Vec<usize> = (0..scored)
@@ -227,6 +215,17 @@ pub(crate) fn tune_nested(
         })
         .collect();
     finish(space, points, values, candidates, per_column, &chosen)
+}
+
+/// Two samples per outer fold at least, or [`ErbfError::InvalidModel`].
+fn check_samples(n: usize) -> Result<()> {
+    if n < 2 * OUTER_FOLDS {
+        return Err(ErbfError::InvalidModel(format!(
+            "nested cross-validation needs at least {} samples, got {n}",
+            2 * OUTER_FOLDS
+        )));
+    }
+    Ok(())
 }
 
 /// Positions in `scores.entries` of the candidates `members` that could be fitted.
