@@ -127,7 +127,8 @@ def evaluate(label, case, names, bounds, xf, yf, xq, truth, scale):
                                   truth, scale)
     for j in range(yf.shape[1]):
         rows.append((label, f"{case[j]}", best[j], {k: v[j] for k, v in errs.items()}))
-    print(f"# {label} {case}: done", file=sys.stderr, flush=True)
+        ratios = " ".join(f"{m}/{r}={errs[(m, r)][j] / best[j]:.3f}" for m, r in errs)
+        print(f"# {label} | {case[j]} | {best[j]:.3g} | {ratios}", file=sys.stderr, flush=True)
 
 
 if DATA:
