@@ -1,5 +1,5 @@
 //! Nested cross-validation for the choice of a surrogate's options
-//! ([`Selection::Nested`](crate::Selection::Nested)).
+//! ([`crate::Selection::Nested`]).
 //!
 //! The minimum of many leave-one-out (LOO) scores is biased low: it rewards the candidate
 //! that fitted the noise of these samples best, so the score of the chosen candidate

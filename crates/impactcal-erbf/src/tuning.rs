@@ -196,8 +196,8 @@ fn smoothing_unit(radial: RadialFunction, diameter: f64) -> f64 {
 /// ([`Selection`]; [`Selection::MinimumLoo`] keeps the first on ties, so order candidates
 /// from least to most smoothing). The scores are kept per sample (`N` values per scored
 /// column and candidate); the LOO errors of the chosen candidates are formed again at the
-/// end. [`Selection::Nested`] is [`crate::nested::tune_nested`] with its classes
-/// ([`crate::nested::class_of`]).
+/// end. [`Selection::Nested`] chooses the class of candidates by nested cross-validation
+/// first ([`crate::nested`], classes by [`crate::nested::class_of`]).
 ///
 /// # Errors
 /// The error of the first candidate when no candidate can be fitted (so bad input reports
