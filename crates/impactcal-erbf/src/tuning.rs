@@ -164,6 +164,9 @@ pub enum Selection {
     /// and the class is the one whose "choose by LOO, then fit" has the lowest error on
     /// held-out samples of an outer split, where the samples that score a choice took no
     /// part in making it.
+    ///
+    /// Not the default: its check on data it was not designed on is incomplete
+    /// (docs/validation.md, "Surrogate choice by nested cross-validation").
     Nested,
 }
 
