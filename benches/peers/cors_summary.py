@@ -1,6 +1,7 @@
 """Summarises the JSON lines of cors_pysot.sh: per function and tool, the median and
 quartiles of evaluations to 1% relative error (failures count as beyond the budget), the
-success rate within the budget, and the median overhead per adaptive iteration.
+success rate within the budget, and the median overhead per adaptive iteration, with the
+ratio of ours to the faster pySOT strategy (both timed in the same run).
 
 Lines of noisy runs (with a "noise" key) are summarised apart: per function, noise level,
 tool and answer (the luckiest sample; ours also the smoothed surrogate's answer), the median
@@ -35,6 +36,19 @@ if rows:
             ok = np.isfinite(e).sum()
             over = np.median([r["overhead_s"] for r in g]) * 1e3
             print(f"| {f} | {t} | {len(g)} | {fmt(med)} | {fmt(q1)}-{fmt(q3)} | {ok}/{len(g)} | {over:.2f} |")
+    # Overheads of both sides from the same run: the ratio of ours to the faster pySOT strategy.
+    over = {k: np.median([r["overhead_s"] for r in g]) * 1e3 for k, g in groups.items()}
+    if any(t == "impactcal-cors" for _, t in over) and any(t != "impactcal-cors" for _, t in over):
+        print()
+        print("| function | impactcal-cors (ms) | pySOT DYCORS (ms) | pySOT SRBF (ms) | ratio to the faster pySOT |")
+        print("|---|---|---|---|---|")
+        for f in functions:
+            if (f, tools[0]) not in over:
+                continue
+            peers = [over[(f, t)] for t in tools[1:] if (f, t) in over]
+            cells = " | ".join(f"{over[(f, t)]:.2f}" if (f, t) in over else "-" for t in tools)
+            ratio = f"{over[(f, tools[0])] / min(peers):.2f}" if peers else "-"
+            print(f"| {f} | {cells} | {ratio} |")
 
 if noisy:
     answers = defaultdict(list)

@@ -16,9 +16,12 @@
 #
 # Printed: per case the ratio of each method's error to the yardstick, whether it is within
 # 5 %, and how often the new rule is worse than the old one (at all, and by more than 5 %).
+# RULES="min-loo one-se" (the default) compares those two; the first listed is the old rule,
+# the last the new (RULES="min-loo nested" for nested cross-validation).
 #
 # Usage: benches/peers/surrogate_choice.sh [car-pole-dir] (or IMPACTCAL_CAR_POLE; without
-# it only the synthetic families run). SPLITS=5 SEEDS=5 METHODS="auto cubic erbf".
+# it only the synthetic families run). SPLITS=5 SEEDS=5 METHODS="auto cubic erbf"
+# RULES="min-loo one-se".
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 DATA="${1:-${IMPACTCAL_CAR_POLE:-}}"

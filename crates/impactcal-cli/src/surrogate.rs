@@ -69,6 +69,9 @@ enum Pick {
     /// The smoothest candidate within one standard error of the lowest leave-one-out
     /// error (paired over the samples).
     OneSe,
+    /// Nested cross-validation: the kernel and whether to smooth by the held-out error of
+    /// five outer folds, the width and smoothing within them by leave-one-out.
+    Nested,
 }
 
 impl From<Kind> for SurrogateKind {
@@ -105,7 +108,8 @@ struct FitArgs {
     #[arg(long)]
     auto: bool,
     /// How `--auto` and `--kind auto` pick a candidate: the lowest leave-one-out error
-    /// (default), or the smoothest within one standard error of it.
+    /// (default), the smoothest within one standard error of it, or by nested
+    /// cross-validation.
     #[arg(long, value_enum, default_value = "min-loo")]
     select: Pick,
     /// Where to write the model (JSON); stdout when absent.
@@ -157,6 +161,7 @@ fn fit(a: FitArgs) -> Result<(), CliError> {
         selection: match a.select {
             Pick::OneSe => Selection::OneStandardError,
             Pick::MinLoo => Selection::MinimumLoo,
+            Pick::Nested => Selection::Nested,
         },
     };
     let model = ResponseSurrogate::fit_with(

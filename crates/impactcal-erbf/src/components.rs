@@ -60,14 +60,14 @@ const PER_COLUMN_LIMIT: usize = 64;
 
 /// A fitted model of one group of target columns.
 #[derive(Debug, Clone)]
-enum Fitted {
+pub(crate) enum Fitted {
     Erbf(Erbf),
     /// In unit-scaled inputs.
     Rbf(RbfInterpolant),
 }
 
 impl Fitted {
-    fn fit(
+    pub(crate) fn fit(
         space: &ParameterSpace,
         points: MatRef<'_, f64>,
         unit: MatRef<'_, f64>,
@@ -80,7 +80,11 @@ impl Fitted {
         })
     }
 
-    fn predict(&self, points: MatRef<'_, f64>, unit: MatRef<'_, f64>) -> Result<Mat<f64>> {
+    pub(crate) fn predict(
+        &self,
+        points: MatRef<'_, f64>,
+        unit: MatRef<'_, f64>,
+    ) -> Result<Mat<f64>> {
         match self {
             Fitted::Erbf(e) => e.predict_batch(points),
             Fitted::Rbf(r) => r.predict_batch(unit),

@@ -74,6 +74,7 @@ mod factor;
 pub mod loo;
 mod lu;
 pub mod metrics;
+pub mod nested;
 pub mod nrbf;
 pub mod options;
 mod projection;

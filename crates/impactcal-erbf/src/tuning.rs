@@ -159,6 +159,15 @@ pub enum Selection {
     /// study, synthetic families at three noise levels) it was more often worse than the
     /// minimum than better (docs/validation.md, "Surrogate choice without selection bias").
     OneStandardError,
+    /// Nested cross-validation ([`crate::nested`]): the candidates fall into a few classes
+    /// (a kernel, interpolating or smoothed); within a class the minimum LOO error chooses,
+    /// and the class is the one whose "choose by LOO, then fit" has the lowest error on
+    /// held-out samples of an outer split, where the samples that score a choice took no
+    /// part in making it.
+    ///
+    /// Not the default: its check on data it was not designed on is incomplete
+    /// (docs/validation.md, "Surrogate choice by nested cross-validation").
+    Nested,
 }
 
 /// The smoothing of a candidate relative to the scale its grid is built on
@@ -190,7 +199,8 @@ fn smoothing_unit(radial: RadialFunction, diameter: f64) -> f64 {
 /// ([`Selection`]; [`Selection::MinimumLoo`] keeps the first on ties, so order candidates
 /// from least to most smoothing). The scores are kept per sample (`N` values per scored
 /// column and candidate); the LOO errors of the chosen candidates are formed again at the
-/// end.
+/// end. [`Selection::Nested`] chooses the class of candidates by nested cross-validation
+/// first ([`crate::nested`], classes by [`crate::nested::class_of`]).
 ///
 /// # Errors
 /// The error of the first candidate when no candidate can be fitted (so bad input reports
@@ -203,61 +213,122 @@ pub fn tune(
     per_column: bool,
     selection: Selection,
 ) -> Result<Tuned> {
-    let unit = space.to_unit_matrix(points)?;
-    let (n, t) = values.shape();
-    let scored = if per_column { t } else { 1 };
-    let diameter = diameter(unit.as_ref());
-    // Per fitted candidate: its index and, per scored column, the squared LOO error of
-    // every sample.
-    let mut scores: Vec<(usize, Vec<Vec<f64>>)> = Vec::new();
-    let mut first_error = None;
-    let mut erbf_cache = ErbfCache::default();
-    let mut loo_of = |candidate: ComponentOptions| match candidate {
-        ComponentOptions::Erbf(o) => erbf_cache.loo(space, points, values, o),
-        ComponentOptions::Rbf(_) => candidate_loo(space, points, unit.as_ref(), values, candidate),
-    };
-    for (index, &candidate) in candidates.iter().enumerate() {
-        let loo = match loo_of(candidate) {
-            Ok(e) => e,
-            Err(e) => {
-                first_error.get_or_insert(e);
-                continue;
-            }
-        };
-        let squared: Vec<Vec<f64>> = (0..scored)
-            .map(|c| {
-                (0..n)
-                    .map(|k| {
-                        if per_column {
-                            loo[(k, c)] * loo[(k, c)]
-                        } else {
-                            (0..t).map(|j| loo[(k, j)] * loo[(k, j)]).sum()
-                        }
-                    })
-                    .collect()
-            })
-            .collect();
-        scores.push((index, squared));
+    if selection == Selection::Nested {
+        return crate::nested::tune_nested(space, points, values, candidates, per_column);
     }
-    if scores.is_empty() {
-        return Err(first_error.unwrap_or_else(|| {
-            crate::error::ErbfError::InvalidModel("no candidate options to choose from".into())
-        }));
-    }
-    let chosen: Vec<usize> = (0..scored)
-        .map(|c| {
-            let column: Vec<(f64, &[f64])> = scores
-                .iter()
-                .map(|(i, sq)| {
-                    (
-                        relative_smoothing(candidates[*i], diameter),
-                        sq[c].as_slice(),
-                    )
+    let scores = Scores::new(space, points, values, candidates, per_column)?;
+    let all: Vec<usize> = (0..scores.entries.len()).collect();
+    let chosen: Vec<usize> = (0..scores.scored)
+        .map(|c| scores.pick(&all, c, selection).unwrap_or(0))
+        .map(|e| scores.entries[e].0)
+        .collect();
+    finish(space, points, values, candidates, per_column, &chosen)
+}
+
+/// The leave-one-out scores of candidates on one set of samples: per fitted candidate its
+/// index and, per scored column (one per output column, or one for all), the squared LOO
+/// error of every sample.
+pub(crate) struct Scores {
+    /// `(candidate index, squared errors per scored column per sample)`.
+    pub(crate) entries: Vec<(usize, Vec<Vec<f64>>)>,
+    /// Relative smoothing of each entry ([`relative_smoothing`]).
+    smoothing: Vec<f64>,
+    /// Scored columns.
+    pub(crate) scored: usize,
+}
+
+impl Scores {
+    /// Scores every candidate that can be fitted.
+    ///
+    /// # Errors
+    /// The first candidate's error when none can be fitted.
+    pub(crate) fn new(
+        space: &ParameterSpace,
+        points: MatRef<'_, f64>,
+        values: MatRef<'_, f64>,
+        candidates: &[ComponentOptions],
+        per_column: bool,
+    ) -> Result<Self> {
+        let unit = space.to_unit_matrix(points)?;
+        let (n, t) = values.shape();
+        let scored = if per_column { t } else { 1 };
+        let diameter = diameter(unit.as_ref());
+        let mut entries: Vec<(usize, Vec<Vec<f64>>)> = Vec::new();
+        let mut first_error = None;
+        let mut loo_of = LooOf::new(space, points, unit.as_ref(), values);
+        for (index, &candidate) in candidates.iter().enumerate() {
+            let loo = match loo_of.loo(candidate) {
+                Ok(e) => e,
+                Err(e) => {
+                    first_error.get_or_insert(e);
+                    continue;
+                }
+            };
+            let squared: Vec<Vec<f64>> = (0..scored)
+                .map(|c| {
+                    (0..n)
+                        .map(|k| {
+                            if per_column {
+                                loo[(k, c)] * loo[(k, c)]
+                            } else {
+                                (0..t).map(|j| loo[(k, j)] * loo[(k, j)]).sum()
+                            }
+                        })
+                        .collect()
                 })
                 .collect();
-            scores[pick(&column, selection)].0
+            entries.push((index, squared));
+        }
+        if entries.is_empty() {
+            return Err(first_error.unwrap_or_else(|| {
+                crate::error::ErbfError::InvalidModel("no candidate options to choose from".into())
+            }));
+        }
+        let smoothing = entries
+            .iter()
+            .map(|(i, _)| relative_smoothing(candidates[*i], diameter))
+            .collect();
+        Ok(Scores {
+            entries,
+            smoothing,
+            scored,
         })
-        .collect();
+    }
+
+    /// The entry (a position in `entries`) that `selection` picks for scored column `c`
+    /// among the entries `among` (`None` when `among` is empty).
+    pub(crate) fn pick(&self, among: &[usize], c: usize, selection: Selection) -> Option<usize> {
+        let column: Vec<(f64, &[f64])> = among
+            .iter()
+            .map(|&e| (self.smoothing[e], self.entries[e].1[c].as_slice()))
+            .collect();
+        (!column.is_empty()).then(|| among[pick(&column, selection)])
+    }
+
+    /// The mean squared LOO error of entry `e` in scored column `c`.
+    pub(crate) fn mean(&self, e: usize, c: usize) -> f64 {
+        let sq = &self.entries[e].1[c];
+        sq.iter().sum::<f64>() / sq.len() as f64
+    }
+}
+
+/// The outcome for the candidates chosen, per scored column, by their index: options per
+/// output column and their LOO errors on the samples.
+///
+/// # Errors
+/// As [`Erbf::fit`] or [`RbfInterpolant::fit`] (a chosen candidate was fitted before, so
+/// only what failed then).
+pub(crate) fn finish(
+    space: &ParameterSpace,
+    points: MatRef<'_, f64>,
+    values: MatRef<'_, f64>,
+    candidates: &[ComponentOptions],
+    per_column: bool,
+    chosen: &[usize],
+) -> Result<Tuned> {
+    let unit = space.to_unit_matrix(points)?;
+    let (n, t) = values.shape();
+    let mut loo_of = LooOf::new(space, points, unit.as_ref(), values);
     let mut options = vec![candidates[chosen[0]]; t];
     let mut loo = Mat::zeros(n, t);
     let mut done: Vec<(usize, Mat<f64>)> = Vec::new();
@@ -265,13 +336,49 @@ pub fn tune(
         let index = chosen[if per_column { c } else { 0 }];
         options[c] = candidates[index];
         if !done.iter().any(|(i, _)| *i == index) {
-            done.push((index, loo_of(candidates[index])?));
+            done.push((index, loo_of.loo(candidates[index])?));
         }
         if let Some((_, e)) = done.iter().find(|(i, _)| *i == index) {
             loo.col_mut(c).copy_from(e.col(c));
         }
     }
     Ok(Tuned { options, loo })
+}
+
+/// Closed-form LOO errors of candidates on one set of samples, ERBF's reusing one
+/// factorisation per radius.
+struct LooOf<'a> {
+    space: &'a ParameterSpace,
+    points: MatRef<'a, f64>,
+    unit: MatRef<'a, f64>,
+    values: MatRef<'a, f64>,
+    erbf: ErbfCache,
+}
+
+impl<'a> LooOf<'a> {
+    fn new(
+        space: &'a ParameterSpace,
+        points: MatRef<'a, f64>,
+        unit: MatRef<'a, f64>,
+        values: MatRef<'a, f64>,
+    ) -> Self {
+        LooOf {
+            space,
+            points,
+            unit,
+            values,
+            erbf: ErbfCache::default(),
+        }
+    }
+
+    fn loo(&mut self, candidate: ComponentOptions) -> Result<Mat<f64>> {
+        match candidate {
+            ComponentOptions::Erbf(o) => self.erbf.loo(self.space, self.points, self.values, o),
+            ComponentOptions::Rbf(_) => {
+                candidate_loo(self.space, self.points, self.unit, self.values, candidate)
+            }
+        }
+    }
 }
 
 /// The position in `column` (per candidate: its relative smoothing and the squared LOO
@@ -289,7 +396,7 @@ fn pick(column: &[(f64, &[f64])], selection: Selection) -> usize {
             best = i;
         }
     }
-    if selection == Selection::MinimumLoo || !sum(column[best].1).is_finite() {
+    if selection != Selection::OneStandardError || !sum(column[best].1).is_finite() {
         return best;
     }
     let reference = column[best].1;
