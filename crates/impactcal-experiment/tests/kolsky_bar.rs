@@ -64,6 +64,24 @@ fn a_bar_test_is_the_model_and_the_measured_test() {
     assert_eq!(h.dt().to_bits(), measured.test.dt().to_bits());
 }
 
+/// A study file and a loop file of kind kolsky-bar take the same noise level: the test's
+/// own gauge noise before the pulse, unless `[test] sigma` gives one, which both take then.
+#[test]
+fn a_bar_study_and_a_bar_loop_take_the_same_noise_level() {
+    let path = examples().join("user.toml");
+    let bar = "[model]\nkind = \"kolsky-bar\"\ntest = \"copper.toml\"\n";
+    let e = Experiment::parse(bar, &path).unwrap();
+    let measured = e.measured().unwrap();
+    let own = measured.sigma.unwrap();
+    assert_eq!(e.noise_sigma(&measured), Some(own));
+    assert_eq!(e.study_options(&measured).unwrap().sigma, Some(own));
+    assert_eq!(e.loop_options(&measured).sigma, Some(own));
+    let given = Experiment::parse(&format!("{bar}[test]\nsigma = 2.5e-6\n"), &path).unwrap();
+    let measured = given.measured().unwrap();
+    assert_eq!(given.study_options(&measured).unwrap().sigma, Some(2.5e-6));
+    assert_eq!(given.loop_options(&measured).sigma, Some(2.5e-6));
+}
+
 #[test]
 fn malformed_bar_files_are_refused_by_name() {
     let m = refused("[model]\nkind = \"kolsky-bar\"\n");
