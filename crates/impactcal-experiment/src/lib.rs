@@ -28,6 +28,7 @@ pub mod builtin;
 pub mod declared;
 pub mod error;
 mod kolsky;
+pub mod kolsky_report;
 pub mod lumped;
 pub mod model;
 pub mod schema;
@@ -601,7 +602,18 @@ impl Experiment {
             result.seed,
             started.elapsed().as_secs_f64(),
         );
-        write_loop(result, built.geometry.as_ref(), Some(&provenance), out)
+        let mut report = impactcal_calibrate::closeloop::document::report_with(
+            &result,
+            built.geometry.as_ref(),
+            Some(&provenance),
+        );
+        if let ExperimentModel::KolskyBar(bar) = model {
+            let at = report.sections.len().min(1);
+            report
+                .sections
+                .insert(at, kolsky_report::section(bar, &result)?);
+        }
+        finish(result, report, out, "loop.json")
     }
 
     /// The worker of a loop: for an external solver, the solver on `[executor]` (any
