@@ -11,11 +11,14 @@
 //! linear regime: a phase-like effect (the dispersion of a bar, a wave's lag growing with
 //! frequency) is, at small amplitude, mostly a delay the fitted offsets and wave speeds
 //! imitate, and only near its full amplitude the ringing that nothing else makes; an effect
-//! linear in its amplitude gives the same direction at either step. Each candidate is scored
-//! on whichever of its two directions has the larger score statistic among the identifiable
-//! ones (the small step when neither is), and the Bonferroni count below counts both
-//! directions of every candidate tried, so choosing the better one does not inflate the
-//! significance. The step used is reported (`Score::step`).
+//! linear in its amplitude gives the same direction at either step. A candidate
+//! identifiable at its small step (confounding ratio at most 0.9, below) is scored on
+//! whichever of its two directions has the larger score statistic among the identifiable
+//! ones; one that is not keeps its small step (the secant of a quantity the fitted ones
+//! imitate locally carries only the curvature of their response). The Bonferroni count
+//! below counts both directions of every candidate, so choosing the better one does not
+//! inflate the significance. The step used is reported (`Score::step`).
+//!
 //! With `J` the whitened Jacobian of the calibrated parameters and nuisance terms and `P_J`
 //! the orthogonal projector onto its columns (the whitening makes the noise unit white):
 //!
@@ -410,14 +413,21 @@ fn steps_of(p: &impactcal_core::Parameter, fraction: f64) -> (f64, Option<f64>) 
 /// Of a candidate's small-step direction `(g, h)` and its secant over the range
 /// `(g_far, h_far)`, the one with the larger score statistic `<g~, r>^2 / <g~, g~>` against
 /// the residual `r` among those with confounding ratio at most [`KAPPA_MAX`]; the small
-/// step when neither is identifiable or on a tie.
+/// step when it is not identifiable itself, when neither is, or on a tie.
+///
+/// The confounding ratio is a linear test: the fitted span is the Jacobian's, the tangent
+/// of the fitted quantities at the calibrated point. A candidate the fitted quantities
+/// imitate locally (a stiffness scale beside the modulus: the same model) has a secant
+/// whose part outside that span is the curvature of their own response over a large
+/// change, which re-tuning them would follow; it is no evidence of the effect, so the
+/// secant is scored only for a candidate identifiable at its small step.
 fn probe(
     near: (Vec<f64>, f64),
     far: (Vec<f64>, f64),
     jac: &Jacobian,
     r: &[f64],
 ) -> (Vec<f64>, f64) {
-    let lm = |g: &[f64]| -> f64 {
+    let lm = |g: &[f64]| -> Option<f64> {
         let pg = jac.project(g);
         let gg = dot(g, g);
         let gt: Vec<f64> = g.iter().zip(&pg).map(|(a, b)| a - b).collect();
@@ -427,13 +437,12 @@ fn probe(
         } else {
             1.0
         };
-        if kappa <= KAPPA_MAX && gtt > 0.0 {
-            dot(&gt, r).powi(2) / gtt
-        } else {
-            0.0
-        }
+        (kappa <= KAPPA_MAX && gtt > 0.0).then(|| dot(&gt, r).powi(2) / gtt)
     };
-    if lm(&far.0) > lm(&near.0) { far } else { near }
+    match (lm(&near.0), lm(&far.0)) {
+        (Some(n), Some(f)) if f > n => far,
+        _ => near,
+    }
 }
 
 /// Scores the candidates of `model` (and the signature directions) against the residual of
