@@ -132,8 +132,8 @@ fn at_values(
 
 /// The specimen's true stress-strain curves on a common strain axis: the classic
 /// three-wave analysis of the test, the plain calibrated model and the enriched one, from
-/// zero strain to the smallest of their largest loading strains. Returns the strains and
-/// the three stresses (MPa).
+/// the largest of their first strains (zero where a branch starts below) to the smallest of
+/// their largest loading strains. Returns the strains and the three stresses (MPa).
 ///
 /// # Errors
 /// The classic analysis' errors and the model's at the calibrated points.
@@ -149,10 +149,13 @@ pub fn stress_strain(base: &KolskyModel, r: &LoopResult) -> Result<(Vec<f64>, [V
     let (m1, p1) = at_values(base, &added, &r.calibrated)?;
     let f0 = m0.faces(&p0)?;
     let f1 = m1.faces(&p1)?;
-    let top = |x: &[f64]| x.iter().copied().fold(0.0, f64::max);
+    let top = |x: &[f64]| x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let first = |x: &[f64]| x.first().copied().unwrap_or(0.0).max(0.0);
     let hi = top(&ce).min(top(&f0.strain)).min(top(&f1.strain));
+    let lo = first(&ce).max(first(&f0.strain)).max(first(&f1.strain));
+    // `lo + (k / (N - 1)) (hi - lo)` ends on `hi` exactly: no point beyond a branch.
     let strain: Vec<f64> = (0..CURVE_POINTS)
-        .map(|k| hi * k as f64 / (CURVE_POINTS - 1) as f64)
+        .map(|k| lo + (k as f64 / (CURVE_POINTS - 1) as f64) * (hi - lo))
         .collect();
     let on = |xs: &[f64], ys: &[f64]| -> Vec<f64> {
         strain

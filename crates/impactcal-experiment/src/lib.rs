@@ -39,7 +39,7 @@ use std::time::Instant;
 
 use impactcal_calibrate::CalibrateError;
 use impactcal_calibrate::closeloop::{Holdout, LoopOptions, LoopResult, run_loop_on};
-use impactcal_calibrate::report::{Provenance, Report, ReportFiles};
+use impactcal_calibrate::report::{Block, Provenance, Report, ReportFiles, Section};
 use impactcal_calibrate::study::document::Geometry;
 use impactcal_calibrate::study::{
     InProcess, ModelRuns, Observer, Silent, SolverRuns, StudyResult, TestData, ValidStudyOptions,
@@ -608,10 +608,15 @@ impl Experiment {
             Some(&provenance),
         );
         if let ExperimentModel::KolskyBar(bar) = model {
+            // A section that cannot be drawn says why; the loop's result is kept.
+            let section = kolsky_report::section(bar, &result).unwrap_or_else(|e| Section {
+                heading: "The bar test".into(),
+                blocks: vec![Block::Paragraph(format!(
+                    "The bar test's figures could not be drawn: {e}"
+                ))],
+            });
             let at = report.sections.len().min(1);
-            report
-                .sections
-                .insert(at, kolsky_report::section(bar, &result)?);
+            report.sections.insert(at, section);
         }
         finish(result, report, out, "loop.json")
     }
