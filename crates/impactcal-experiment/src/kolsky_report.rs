@@ -66,7 +66,7 @@ pub fn band_shares(freq: &[f64], amp: &[f64]) -> Vec<f64> {
 }
 
 /// Channel `s` of a stage's evidence: the test and the model, `T` samples each.
-fn wave<'e>(e: &'e Evidence, s: usize, channels: usize) -> (&'e [f64], &'e [f64]) {
+fn wave(e: &Evidence, s: usize, channels: usize) -> (&[f64], &[f64]) {
     let t = e.test.len() / channels.max(1);
     (&e.test[s * t..(s + 1) * t], &e.model[s * t..(s + 1) * t])
 }
