@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use impactcal_calibrate::report::{Block, Figure, Lines, Plot, Section};
+use impactcal_calibrate::report::{Block, Figure, Lines, Plot, Section, Table};
 use impactcal_core::{Enrichable, Model};
 use impactcal_experiment::{Experiment, ExperimentError, ExperimentModel, ModelSpec};
 use impactcal_models::kolsky::ClassicAnalysis;
@@ -136,6 +136,18 @@ fn close_in(
         .unwrap()
 }
 
+/// The table of `section` whose caption starts with `caption`.
+fn table_of<'a>(section: &'a Section, caption: &str) -> &'a Table {
+    section
+        .blocks
+        .iter()
+        .find_map(|b| match b {
+            Block::Table(t) if t.caption.starts_with(caption) => Some(t),
+            _ => None,
+        })
+        .unwrap_or_else(|| panic!("no table {caption}"))
+}
+
 fn lines<'a>(section: &'a Section, name: &str) -> (&'a Figure, &'a Lines) {
     let figure = section
         .blocks
@@ -211,14 +223,7 @@ fn the_bar_section_draws_the_loop(
     }
     // The band table: the reflected wave's ringing band holds most of the plain model's
     // residual and less of the enriched one's.
-    let table = section
-        .blocks
-        .iter()
-        .find_map(|b| match b {
-            Block::Table(t) if t.caption.starts_with("The residual's energy") => Some(t),
-            _ => None,
-        })
-        .unwrap();
+    let table = table_of(section, "The residual's energy");
     let shares = |row: &Vec<String>| -> Vec<f64> {
         row[2..]
             .iter()
@@ -259,14 +264,7 @@ fn the_bar_section_draws_the_loop(
             assert!(v.is_finite() && v > 0.0, "{}", model.name);
         }
     }
-    let added = section
-        .blocks
-        .iter()
-        .find_map(|b| match b {
-            Block::Table(t) if t.caption.starts_with("The added effects") => Some(t),
-            _ => None,
-        })
-        .unwrap();
+    let added = table_of(section, "The added effects");
     for (row, a) in added.rows.iter().zip(&r.added) {
         assert_eq!(row[0], a.name);
         assert_eq!(row[1], format!("{:.4}", a.value));
