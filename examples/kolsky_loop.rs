@@ -7,7 +7,7 @@
 //! one predicted), `loop-gain500.toml` (the planted gain fault) and `pmma13-loop.toml` (a
 //! PMMA test on another bar, unseen), each into its folder
 //! under OUT with its report, and prints per wave the relative L2 error at the nominal,
-//! calibrated and enriched points (with the loop's trigger offset and biases), the fitted
+//! calibrated and enriched points (each under its own trigger offset and biases), the fitted
 //! timing, what was added and why the loop stopped; for a residual left unattributed, where
 //! in time and in which frequency bands its first components sit. The holdout's transmitted wave is
 //! predicted at the reflected-only calibration with the loop's trigger offset; its own
@@ -16,7 +16,7 @@
 
 use std::path::{Path, PathBuf};
 
-use impactcal::calibrate::closeloop::LoopResult;
+use impactcal::calibrate::closeloop::{Evidence, LoopResult};
 use impactcal::core::enrich::rebuild;
 use impactcal::core::{Histories, Model};
 use impactcal::experiment::{Experiment, ExperimentModel};
@@ -134,18 +134,17 @@ fn added(r: &LoopResult) -> Vec<String> {
     r.added.iter().map(|a| a.name.clone()).collect()
 }
 
-/// Per-wave relative L2 errors of `h` against `measured` under the loop's nuisance terms.
-fn errors(h: &Histories, measured: &Histories, result: &LoopResult) -> Vec<(String, f64)> {
-    let tau = result.nuisance.time_shift;
-    measured
-        .labels()
+/// Per-wave relative L2 errors of one stage's evidence (the test under that stage's own
+/// trigger offset and biases, and the model's response, as the report draws them).
+fn errors(r: &LoopResult, e: Option<&Evidence>) -> Vec<(String, f64)> {
+    let Some(e) = e else { return Vec::new() };
+    let t = e.test.len() / r.channels.len().max(1);
+    r.channels
         .iter()
         .enumerate()
-        .map(|(c, label)| {
-            let i = h.index_of(label).unwrap_or(c);
-            let b = result.nuisance.biases.get(label).copied().unwrap_or(0.0);
-            let y: Vec<f64> = shifted(h, i, tau).iter().map(|v| v + b).collect();
-            (label.clone(), rel_l2(&y, measured.channel(c)))
+        .map(|(s, label)| {
+            let w = s * t..(s + 1) * t;
+            (label.clone(), rel_l2(&e.model[w.clone()], &e.test[w]))
         })
         .collect()
 }
@@ -154,26 +153,12 @@ fn report(name: &str, file: &Path, out: &Path) -> R<(LoopResult, Experiment)> {
     let e = Experiment::from_file(file)?;
     let done = e.close_loop(out.join(name))?;
     let r = done.result;
-    let model = e.build()?.model.ok_or("no model")?;
-    let measured = e.measured()?.test;
     println!("== {name}: {}", done.report.lead.join(" "));
-    let nominal = model.simulate(&model.space().nominal())?;
+    let m = &r.metrics_calibration;
     let stages = [
-        ("nominal", errors(&nominal, &measured, &r)),
-        (
-            "calibrated",
-            match r.rounds.first() {
-                Some(round) => {
-                    let (m, p) = point_of(&model, &[], &round.calibrated)?;
-                    errors(&m.simulate(&p)?, &measured, &r)
-                }
-                None => vec![],
-            },
-        ),
-        ("enriched", {
-            let (m, p) = point_of(&model, &added(&r), &r.calibrated)?;
-            errors(&m.simulate(&p)?, &measured, &r)
-        }),
+        ("nominal", errors(&r, m.nominal.evidence.as_deref())),
+        ("calibrated", errors(&r, m.calibrated.evidence.as_deref())),
+        ("enriched", errors(&r, m.enriched.evidence.as_deref())),
     ];
     for (stage, e) in &stages {
         let list: Vec<String> = e

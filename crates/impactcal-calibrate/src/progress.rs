@@ -59,7 +59,7 @@ fn round_title(name: &str) -> Option<String> {
         ["cors"] => words.push("CORS-RBF search".into()),
         ["candidates"] => {
             words[0] = format!("attribution {}", round + 1);
-            words.push("one run per candidate effect".into());
+            words.push("two runs per candidate effect".into());
         }
         [gn, what] => {
             let i: usize = gn.strip_prefix("gn")?.parse().ok()?;
@@ -124,9 +124,10 @@ impl LoopRunEstimate {
     }
 
     /// The fits of one addition to a model of `d` parameters: the recalibration with it
-    /// (two starts) and the control without it.
+    /// (three starts: the held value, the linear estimate, the far end of its range) and
+    /// the control without it.
     pub fn recalibrations(&self, d: usize) -> usize {
-        self.calibration(d + 1, 2, self.recalibrate) + self.calibration(d, 1, self.recalibrate)
+        self.calibration(d + 1, 3, self.recalibrate) + self.calibration(d, 1, self.recalibrate)
     }
 
     /// The holdout's runs.
@@ -140,16 +141,16 @@ impl LoopRunEstimate {
         let d = self.declared;
         self.ensemble
             + self.calibration(d, 1, self.reconcile)
-            + self.candidates
+            + 2 * self.candidates
             + self.recalibrations(d)
             + self.holdout_runs()
     }
 
     /// Runs left at the start of a round on a model of `d` parameters: an attribution of
-    /// `candidates` runs when the round has one, one addition when the loop `may_add`, and
-    /// the holdout.
+    /// two runs per candidate (`candidates` of them) when the round has one, one addition
+    /// when the loop `may_add`, and the holdout.
     pub fn rest_of_round(&self, d: usize, candidates: usize, may_add: bool) -> usize {
-        candidates + if may_add { self.recalibrations(d) } else { 0 } + self.holdout_runs()
+        2 * candidates + if may_add { self.recalibrations(d) } else { 0 } + self.holdout_runs()
     }
 }
 
@@ -179,7 +180,7 @@ mod tests {
             ),
             (
                 "r0-candidates",
-                "attribution 1, one run per candidate effect",
+                "attribution 1, two runs per candidate effect",
             ),
             ("holdout-enriched", "holdout, enriched model's run"),
             ("reconcile", "reconciliation, CORS-RBF search"),
@@ -192,8 +193,9 @@ mod tests {
     }
 
     /// The estimate by hand for 2 declared parameters, 3 candidates, polish 2:
-    /// calibration(2, 1, 8) = 1 + 8 + 2*3 + 2 = 17; recalibrations(2) = calibration(3, 2, 6)
-    /// (2 + 6 + 8 + 3 = 19) + calibration(2, 1, 6) (1 + 6 + 6 + 2 = 15) = 34.
+    /// calibration(2, 1, 8) = 1 + 8 + 2*3 + 2 = 17; recalibrations(2) = calibration(3, 3, 6)
+    /// (3 + 6 + 8 + 3 = 20) + calibration(2, 1, 6) (1 + 6 + 6 + 2 = 15) = 35; an
+    /// attribution runs two per candidate.
     #[test]
     fn the_loop_estimate_adds_its_stages() {
         let e = LoopRunEstimate {
@@ -206,9 +208,9 @@ mod tests {
             holdout: true,
         };
         assert_eq!(e.calibration(2, 1, 8), 17);
-        assert_eq!(e.recalibrations(2), 34);
-        assert_eq!(e.after_nominal(), 4 + 17 + 3 + 34 + 7);
+        assert_eq!(e.recalibrations(2), 35);
+        assert_eq!(e.after_nominal(), 4 + 17 + 2 * 3 + 35 + 7);
         assert_eq!(e.rest_of_round(3, 0, false), 7);
-        assert_eq!(e.rest_of_round(2, 2, true), 2 + 34 + 7);
+        assert_eq!(e.rest_of_round(2, 2, true), 2 * 2 + 35 + 7);
     }
 }

@@ -28,6 +28,7 @@ pub mod builtin;
 pub mod declared;
 pub mod error;
 mod kolsky;
+pub mod kolsky_report;
 pub mod lumped;
 pub mod model;
 pub mod schema;
@@ -38,7 +39,7 @@ use std::time::Instant;
 
 use impactcal_calibrate::CalibrateError;
 use impactcal_calibrate::closeloop::{Holdout, LoopOptions, LoopResult, run_loop_on};
-use impactcal_calibrate::report::{Provenance, Report, ReportFiles};
+use impactcal_calibrate::report::{Block, Provenance, Report, ReportFiles, Section};
 use impactcal_calibrate::study::document::Geometry;
 use impactcal_calibrate::study::{
     InProcess, ModelRuns, Observer, Silent, SolverRuns, StudyResult, TestData, ValidStudyOptions,
@@ -191,24 +192,33 @@ impl Experiment {
             .map_err(|e| e.in_section(&self.name, "model"))
     }
 
-    /// The study's options: `[study]`, with `[test] sigma` and the memory limit.
+    /// The measurement noise level the study and the loop both take: `[test] sigma` where
+    /// the file gives it, else the level the test itself states (`Measured::sigma`: a
+    /// Kolsky bar's gauge noise before its pulse), else `None` (each then measures it on
+    /// the test its own way).
+    pub fn noise_sigma(&self, measured: &Measured) -> Option<f64> {
+        self.file.test.sigma.or(measured.sigma)
+    }
+
+    /// The study's options: `[study]`, with the noise level of [`Experiment::noise_sigma`]
+    /// and the memory limit.
     ///
     /// # Errors
     /// [`ExperimentError::Section`] naming the option out of range.
-    pub fn study_options(&self) -> Result<ValidStudyOptions> {
+    pub fn study_options(&self, measured: &Measured) -> Result<ValidStudyOptions> {
         let mut options = self.file.study.clone();
-        options.sigma = self.file.test.sigma;
+        options.sigma = self.noise_sigma(measured);
         options.max_memory = self.max_memory;
         options
             .check()
             .map_err(|e| ExperimentError::from(e).in_section(&self.name, "study"))
     }
 
-    /// The loop's options: `[loop]`, with `[test] sigma` and the memory limit (checked when
-    /// the loop starts, against the model's dimension).
-    pub fn loop_options(&self) -> LoopOptions {
+    /// The loop's options: `[loop]`, with the noise level of [`Experiment::noise_sigma`]
+    /// and the memory limit (checked when the loop starts, against the model's dimension).
+    pub fn loop_options(&self, measured: &Measured) -> LoopOptions {
         let mut options = self.file.loop_options.clone();
-        options.sigma = self.file.test.sigma;
+        options.sigma = self.noise_sigma(measured);
         options.max_memory = self.max_memory;
         options
     }
@@ -395,9 +405,9 @@ impl Experiment {
     /// ([`impactcal_calibrate::study::run`]), and I/O errors writing the results.
     pub fn study_with(&self, out: &Path, observer: &dyn Observer) -> Result<Finished<StudyResult>> {
         let started = Instant::now();
-        let options = self.study_options()?;
         let built = self.build()?;
         let measured = self.measured()?;
+        let options = self.study_options(&measured)?;
         self.check_window(&measured.test)?;
         notify(observer, built.notes.iter().chain(&measured.notes));
         let runner = self.study_runner(&built)?;
@@ -571,8 +581,7 @@ impl Experiment {
             histories,
             set: set.as_slice(),
         });
-        let mut options = self.loop_options();
-        options.sigma = options.sigma.or(measured.sigma);
+        let options = self.loop_options(&measured);
         let result = run_loop_on(
             model,
             &built.description,
@@ -593,7 +602,23 @@ impl Experiment {
             result.seed,
             started.elapsed().as_secs_f64(),
         );
-        write_loop(result, built.geometry.as_ref(), Some(&provenance), out)
+        let mut report = impactcal_calibrate::closeloop::document::report_with(
+            &result,
+            built.geometry.as_ref(),
+            Some(&provenance),
+        );
+        if let ExperimentModel::KolskyBar(bar) = model {
+            // A section that cannot be drawn says why; the loop's result is kept.
+            let section = kolsky_report::section(bar, &result).unwrap_or_else(|e| Section {
+                heading: "The bar test".into(),
+                blocks: vec![Block::Paragraph(format!(
+                    "The bar test's figures could not be drawn: {e}"
+                ))],
+            });
+            let at = report.sections.len().min(1);
+            report.sections.insert(at, section);
+        }
+        finish(result, report, out, "loop.json")
     }
 
     /// The worker of a loop: for an external solver, the solver on `[executor]` (any

@@ -5,6 +5,20 @@
 //! by a finite step `h_k` (a fraction of its admissible range, inwards) gives its whitened
 //! direction `g_k = L^-1 w (N(y_k) - N(y*)) / h_k` under the fitted nuisance terms `N`
 //! (`w` the weights, `L^-1` each channel's AR filter of the noise, `closeloop::prewhiten`).
+//!
+//! A second run moves it to the end of its admissible range farther from the held value
+//! (the secant over the range, `h_k` that distance). A small step sees only the effect's
+//! linear regime: a phase-like effect (the dispersion of a bar, a wave's lag growing with
+//! frequency) is, at small amplitude, mostly a delay the fitted offsets and wave speeds
+//! imitate, and only near its full amplitude the ringing that nothing else makes; an effect
+//! linear in its amplitude gives the same direction at either step. A candidate
+//! identifiable at its small step (confounding ratio at most 0.9, below) is scored on
+//! whichever of its two directions has the larger score statistic among the identifiable
+//! ones; one that is not keeps its small step (the secant of a quantity the fitted ones
+//! imitate locally carries only the curvature of their response). The Bonferroni count
+//! below counts both directions of every candidate, so choosing the better one does not
+//! inflate the significance. The step used is reported (`Score::step`).
+//!
 //! With `J` the whitened Jacobian of the calibrated parameters and nuisance terms and `P_J`
 //! the orthogonal projector onto its columns (the whitening makes the noise unit white):
 //!
@@ -16,7 +30,8 @@
 //!   `sqrt(1 / <g~_k, g~_k>)`, and a 95 % interval of 1.96 standard errors; explained
 //!   fraction `c_k = <g~_k, r>^2 / (<g~_k, g~_k> <r, r>)`; score statistic
 //!   `LM_k = <g~_k, r>^2 / <g~_k, g~_k>`, `chi2_1` under "effect absent", significant
-//!   above the `1 - alpha / K` quantile (Bonferroni over the `K` directions);
+//!   above the `1 - alpha / K` quantile (Bonferroni over the `K` directions made: both of
+//!   every candidate, and the signatures);
 //! - the model's own noise, counted coherently (`closeloop::model_noise`): the jitter
 //!   ensemble's whitened draws `d_j` give the amplitude the model's noise alone produces,
 //!   `a_j = <g~_k, d_j> / <g~_k, g~_k>`, of variance `v_k = sum_j a_j^2 / m`; the interval
@@ -101,6 +116,11 @@ pub struct Score {
     /// `|a|` times this.
     #[serde(default)]
     pub response_per_unit: f64,
+    /// The finite step of the direction scored, in units of the quantity (signed): the
+    /// small step (`candidate_step` of the range) or the secant to the far end of the range,
+    /// whichever scored higher; 0 for a signature.
+    #[serde(default)]
+    pub step: f64,
     /// The interval meets the admissible range.
     pub admissible: bool,
     /// What the loop makes of it: `best`, `eligible`, `not identifiable`, `inadmissible
@@ -265,10 +285,12 @@ fn ranked(mut scores: Vec<Score>) -> Vec<Score> {
     scores
 }
 
-/// The directions to score, whitened: one run per candidate in `cands` (journal stage
-/// `<prefix>-candidates`, each moved from its held value by `step` of its range, inwards)
-/// under the fitted nuisance terms, then the signatures: the time scaling about the impact
-/// (`onset`, shifted by the trigger offset) and a drift per channel.
+/// The directions to score, whitened: two runs per candidate in `cands` (journal stage
+/// `<prefix>-candidates`: each moved from its held value by `step` of its range, inwards,
+/// then each at the far end of its range, see the module docs), each candidate's better
+/// direction kept ([`probe`]), then the signatures: the time scaling about the impact
+/// (`onset`, shifted by the trigger offset) and a drift per channel. Returns the directions
+/// and the number of candidate directions that were made (for the Bonferroni count).
 ///
 /// # Errors
 /// Run and journal errors; the model's `enrich` errors.
@@ -280,42 +302,61 @@ fn directions<M: Enrichable>(
     prefix: &str,
     step: f64,
     onset: usize,
-) -> Result<Vec<Direction>> {
+) -> Result<(Vec<Direction>, usize)> {
     let frame = &ctx.frame;
     let t = frame.samples;
     let base = nuisance::apply(&fit.y, frame, &fit.terms);
     let mut dirs: Vec<Direction> = Vec::new();
+    let mut made = 0;
     if !cands.is_empty() {
         let params: Vec<_> = cands.iter().map(|c| c.parameter.clone()).collect();
         let full = model.enrich(&params)?;
         let mut centre = fit.point.clone();
         centre.extend(params.iter().map(|p| p.nominal));
         let d = fit.point.len();
-        let mut steps = Vec::new();
-        let points: Vec<Vec<f64>> = params
-            .iter()
-            .enumerate()
-            .map(|(k, p)| {
-                let h = step * p.width();
-                let h = if p.nominal + h > p.upper { -h } else { h };
-                steps.push(h);
+        let steps: Vec<(f64, Option<f64>)> = params.iter().map(|p| steps_of(p, step)).collect();
+        let mut points = Vec::new();
+        for (k, (h, _)) in steps.iter().enumerate() {
+            let mut x = centre.clone();
+            x[d + k] += h;
+            points.push(x);
+        }
+        let mut far_index = Vec::new();
+        for (k, (_, far)) in steps.iter().enumerate() {
+            if let Some(h) = far {
+                far_index.push(Some(points.len()));
                 let mut x = centre.clone();
                 x[d + k] += h;
-                x
-            })
-            .collect();
+                points.push(x);
+            } else {
+                far_index.push(None);
+            }
+        }
         let outs = ctx
             .runner
             .stage(&full, &format!("{prefix}-candidates"), &points)?;
+        let direction = |i: usize, h: f64, what: &str| -> Result<Vec<f64>> {
+            let yk = ctx.y_of(&outs.histories(i, what)?)?;
+            Ok(nuisance::direction(&yk, &base, frame, &fit.terms, h))
+        };
         for (k, p) in params.iter().enumerate() {
-            let yk = ctx.y_of(&outs.histories(k, &format!("candidate `{}`", p.name))?)?;
-            let g = nuisance::direction(&yk, &base, frame, &fit.terms, steps[k]);
+            let (h, far) = steps[k];
+            let g = direction(k, h, &format!("candidate `{}`", p.name))?;
+            made += 1;
+            let (g, h) = match (far, far_index[k]) {
+                (Some(hf), Some(i)) => {
+                    let gf = direction(i, hf, &format!("candidate `{}` at its far end", p.name))?;
+                    made += 1;
+                    probe((g, h), (gf, hf), &fit.jac, &fit.residual)
+                }
+                _ => (g, h),
+            };
             dirs.push((
                 p.name.clone(),
                 "candidate".into(),
                 cands[k].group.clone(),
                 Shape::Dense(g),
-                Some((p.nominal, p.lower, p.upper, steps[k])),
+                Some((p.nominal, p.lower, p.upper, h)),
             ));
         }
     }
@@ -352,11 +393,61 @@ fn directions<M: Enrichable>(
             None,
         ));
     }
-    Ok(dirs)
+    Ok((dirs, made))
+}
+
+/// The two finite steps of candidate `p` from its held value: `fraction` of its range,
+/// inwards, and the secant to the end of its range farther from the held value (none when
+/// that is no longer than the small step).
+fn steps_of(p: &impactcal_core::Parameter, fraction: f64) -> (f64, Option<f64>) {
+    let h = fraction * p.width();
+    let h = if p.nominal + h > p.upper { -h } else { h };
+    let far = if p.upper - p.nominal >= p.nominal - p.lower {
+        p.upper - p.nominal
+    } else {
+        p.lower - p.nominal
+    };
+    (h, (far.abs() > h.abs() * (1.0 + 1e-9)).then_some(far))
+}
+
+/// Of a candidate's small-step direction `(g, h)` and its secant over the range
+/// `(g_far, h_far)`, the one with the larger score statistic `<g~, r>^2 / <g~, g~>` against
+/// the residual `r` among those with confounding ratio at most [`KAPPA_MAX`]; the small
+/// step when it is not identifiable itself, when neither is, or on a tie.
+///
+/// The confounding ratio is a linear test: the fitted span is the Jacobian's, the tangent
+/// of the fitted quantities at the calibrated point. A candidate the fitted quantities
+/// imitate locally (a stiffness scale beside the modulus: the same model) has a secant
+/// whose part outside that span is the curvature of their own response over a large
+/// change, which re-tuning them would follow; it is no evidence of the effect, so the
+/// secant is scored only for a candidate identifiable at its small step.
+fn probe(
+    near: (Vec<f64>, f64),
+    far: (Vec<f64>, f64),
+    jac: &Jacobian,
+    r: &[f64],
+) -> (Vec<f64>, f64) {
+    let lm = |g: &[f64]| -> Option<f64> {
+        let pg = jac.project(g);
+        let gg = dot(g, g);
+        let gt: Vec<f64> = g.iter().zip(&pg).map(|(a, b)| a - b).collect();
+        let gtt = dot(&gt, &gt);
+        let kappa = if gg > 0.0 {
+            (dot(&pg, &pg) / gg).sqrt()
+        } else {
+            1.0
+        };
+        (kappa <= KAPPA_MAX && gtt > 0.0).then(|| dot(&gt, r).powi(2) / gtt)
+    };
+    match (lm(&near.0), lm(&far.0)) {
+        (Some(n), Some(f)) if f > n => far,
+        _ => near,
+    }
 }
 
 /// Scores the candidates of `model` (and the signature directions) against the residual of
-/// `fit` (see the module docs). `step` is the finite step as a fraction of each range.
+/// `fit` (see the module docs). `step` is the small finite step as a fraction of each
+/// range; each candidate is also probed at the far end of its range.
 ///
 /// # Errors
 /// Run and journal errors; the model's `enrich` errors.
@@ -382,7 +473,8 @@ pub(crate) fn attribute<M: Enrichable>(
     }
     let frame = &ctx.frame;
     let t = frame.samples;
-    let dirs = directions(ctx, model, fit, &cands, prefix, step, onset)?;
+    let (dirs, made) = directions(ctx, model, fit, &cands, prefix, step, onset)?;
+    let tests = dirs.len() - cands.len() + made;
     let parts = Parts::of(dirs, &fit.jac, t);
 
     // One pass over the model's noise draws: each direction's inner products with them.
@@ -397,7 +489,7 @@ pub(crate) fn attribute<M: Enrichable>(
         residual: r,
         utr: fit.jac.coefficients(r),
         rr: dot(r, r),
-        crit: chi2_quantile(1.0, alpha / parts.described.len() as f64)?,
+        crit: chi2_quantile(1.0, alpha / tests as f64)?,
         min_explained,
         draws: &draws,
         draws_energy: draws.unfitted_energy(),
@@ -568,6 +660,7 @@ impl Scoring<'_> {
                 }
                 _ => 0.0,
             },
+            step: range.map_or(0.0, |r| r.3),
             admissible,
             status: status.into(),
             sensor_pattern: self.sensor_pattern(u, gr),

@@ -19,7 +19,8 @@
 //! 4. **Detection** ([`detection`]): reduced chi-square, whiteness, the residual SVD
 //!    against the noise edge; model-form error when chi-square exceeds its quantile and the
 //!    residual is coherent.
-//! 5. **Attribution** ([`attribution`]): one run per candidate for its direction; the
+//! 5. **Attribution** ([`attribution`]): two runs per candidate for its direction (a small
+//!    step and the far end of its range, the better kept); the
 //!    confounding ratio `kappa` against what is already fitted; amplitude with interval,
 //!    explained fraction, score statistic, admissibility, mutual coherence; a ranking.
 //! 6. **Forward selection** ([`selection`]): the best eligible candidate is added and the

@@ -5,7 +5,7 @@
 //! residual shows model-form error, the best eligible candidate of its attribution is added
 //! (its range the candidate's admissible range, its nominal the held value) and the model
 //! is recalibrated: CORS warm-started from the previous optimum (with the candidate at its
-//! held value and at its linear estimate), its own budget, then the Gauss-Newton polish. The
+//! held value, at its linear estimate and at the far end of its range), its own budget, then the Gauss-Newton polish. The
 //! addition is kept when the Bayesian information criterion falls by more than 2.
 //!
 //! With known noise (the weights and each channel's AR whitening, `closeloop::prewhiten`:
@@ -528,23 +528,37 @@ impl<M: Enrichable> State<M> {
 }
 
 /// The starting points of a recalibration with `p` added to the optimum `point`: `p` at
-/// its held value, and at the attribution's estimate (clamped to its range) when that
-/// differs from the held value by more than `1e-12` of the range.
+/// its held value, at the attribution's estimate (clamped to its range) and at the end of
+/// its range farther from the held value, each when it differs from those before it by
+/// more than `1e-12` of the range. The local search cannot leave the basin it starts in; an
+/// effect whose response is far from linear in its amplitude (a phase growing with
+/// frequency) may have its optimum in another basin than the held value's and the linear
+/// estimate's, and the far end of the admissible range starts a search there (the same
+/// misfit keeps the best, `closeloop::fit::calibrate`).
 fn starts(point: &[f64], p: &Parameter, best: &Score) -> Vec<Vec<f64>> {
     let estimate = best
         .amplitude
         .as_ref()
         .map_or(p.nominal, |a| a.value.clamp(p.lower, p.upper));
-    let with = |v: f64| {
-        let mut x = point.to_vec();
-        x.push(v);
-        x
+    let far = if p.upper - p.nominal >= p.nominal - p.lower {
+        p.upper
+    } else {
+        p.lower
     };
-    let mut start = vec![with(p.nominal)];
-    if (estimate - p.nominal).abs() > 1e-12 * p.width() {
-        start.push(with(estimate));
+    let mut values: Vec<f64> = Vec::new();
+    for v in [p.nominal, estimate, far] {
+        if values.iter().all(|u| (u - v).abs() > 1e-12 * p.width()) {
+            values.push(v);
+        }
     }
-    start
+    values
+        .into_iter()
+        .map(|v| {
+            let mut x = point.to_vec();
+            x.push(v);
+            x
+        })
+        .collect()
 }
 
 /// The fit an addition is judged against, as `(rss, bic)`: the control (residual sum of
@@ -591,31 +605,47 @@ mod tests {
             }),
             model_noise_sd: 0.0,
             response_per_unit: 1.0,
+            step: 0.1,
             admissible: true,
             status: "best".into(),
             sensor_pattern: Default::default(),
         }
     }
 
-    /// A recalibration starts from the candidate at its held value and, when the
-    /// attribution estimated another value, there too, clamped to the admissible range.
+    /// A recalibration starts from the candidate at its held value, at the attribution's
+    /// estimate clamped to the admissible range when it differs, and at the far end of the
+    /// range when that differs from both.
     #[test]
-    fn a_recalibration_starts_at_the_held_value_and_the_clamped_estimate() {
+    fn a_recalibration_starts_at_the_held_value_the_clamped_estimate_and_the_far_end() {
         let p = Parameter::new("c", 0.0, 2.0, 0.5).unwrap();
         let point = [1.0, 3.0];
         assert_eq!(
             starts(&point, &p, &scored(Some(1.25))),
-            vec![vec![1.0, 3.0, 0.5], vec![1.0, 3.0, 1.25]]
+            vec![
+                vec![1.0, 3.0, 0.5],
+                vec![1.0, 3.0, 1.25],
+                vec![1.0, 3.0, 2.0]
+            ]
         );
+        // An estimate beyond the range is clamped to its end, which is the far end too.
         assert_eq!(
             starts(&point, &p, &scored(Some(7.0))),
             vec![vec![1.0, 3.0, 0.5], vec![1.0, 3.0, 2.0]]
         );
-        // No estimate, or one at the held value: one start.
-        assert_eq!(starts(&point, &p, &scored(None)), vec![vec![1.0, 3.0, 0.5]]);
+        // No estimate, or one at the held value: the held value and the far end.
+        assert_eq!(
+            starts(&point, &p, &scored(None)),
+            vec![vec![1.0, 3.0, 0.5], vec![1.0, 3.0, 2.0]]
+        );
         assert_eq!(
             starts(&point, &p, &scored(Some(0.5))),
-            vec![vec![1.0, 3.0, 0.5]]
+            vec![vec![1.0, 3.0, 0.5], vec![1.0, 3.0, 2.0]]
+        );
+        // Held near the upper end: the far end is the lower one.
+        let q = Parameter::new("g", 0.3, 3.0, 2.5).unwrap();
+        assert_eq!(
+            starts(&point, &q, &scored(None)),
+            vec![vec![1.0, 3.0, 2.5], vec![1.0, 3.0, 0.3]]
         );
     }
 
