@@ -111,10 +111,6 @@ fn options() -> LoopOptions {
     }
 }
 
-fn close(test: &Histories, holdout: &Histories, dir: &Path) -> LoopResult {
-    close_with(test, holdout, dir, &options())
-}
-
 fn close_with(
     test: &Histories,
     holdout: &Histories,
@@ -154,7 +150,20 @@ fn fresh(name: &str) -> PathBuf {
 fn hidden_damping_on_the_airframe_is_found_and_the_error_falls() {
     let (test, holdout) = tests(&[("damping".into(), 10.0)], 1);
     let dir = fresh("hidden-damping");
-    let r = close(&test, &holdout, &dir);
+    // The polish crawls on the airframe's rough response (each full Gauss-Newton step too
+    // short): from the path the CORS search takes here it needs 12 iterations to reach the
+    // optimum (docs/closed-loop.md, "the samples at each end").
+    let options = LoopOptions {
+        polish: 14,
+        ..options()
+    };
+    let r = close_with(&test, &holdout, &dir, &options);
+    // The result beside the journal, for a look at a failure.
+    std::fs::write(
+        dir.join("loop.json"),
+        serde_json::to_string_pretty(&r).unwrap(),
+    )
+    .unwrap();
     let summary = format!(
         "{:?}\n{:?}\n{:?}\n{:?}\n{:?}",
         ranking(&r),
