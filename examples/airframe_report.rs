@@ -3,8 +3,9 @@
 //! placed (`impactcal demo`, Table 2; mirror pairs such as 237.y/253.y coincide in the
 //! side view), a signed pattern over the 24 channels of the closed-loop demo (as its
 //! residual's sensor pattern is drawn), an impact shape's vertical entries at every node,
-//! and the reveal's hidden change. The headless-browser check
-//! (`tests/browser/check_report.sh`) renders it and requires that no two labels overlap.
+//! and the reveal's hidden change. It names on stderr each sensor that has a label in
+//! neither view of its figure. The headless-browser check (`tests/browser/check_report.sh`) renders it and
+//! requires that no two labels overlap.
 //!
 //! ```text
 //! cargo run --example airframe_report -- OUT_DIR
@@ -149,6 +150,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ],
     };
     let files = report::write(&doc, &out)?;
+    // Every sensor keeps its label in at least one of the two views (a label with no free
+    // place is thinned from a view, never from both, at the demo's density).
+    for (figure, labels) in [
+        ("fig-sensors", &SENSORS[..]),
+        ("fig-residual-structure", &LOOP_CHANNELS[..]),
+    ] {
+        let svg = std::fs::read_to_string(out.join(format!("{figure}.svg")))?;
+        // The text of each <text> element: what follows its opening tag.
+        let shown: Vec<&str> = svg
+            .split("</text>")
+            .filter_map(|part| part.rsplit_once('>').map(|(_, text)| text.trim()))
+            .collect();
+        let missing: Vec<&str> = labels
+            .iter()
+            .copied()
+            .filter(|l| !shown.contains(l))
+            .collect();
+        if !missing.is_empty() {
+            // Reported, not yet refused: at the demo's density the placement leaves 318.y
+            // without a place in either view (docs/report.md).
+            eprintln!(
+                "{figure}: {} of {} sensors have a label in neither view: {}",
+                missing.len(),
+                labels.len(),
+                missing.join(", ")
+            );
+        }
+    }
     println!("{}", files.html.display());
     Ok(())
 }

@@ -111,10 +111,6 @@ fn options() -> LoopOptions {
     }
 }
 
-fn close(test: &Histories, holdout: &Histories, dir: &Path) -> LoopResult {
-    close_with(test, holdout, dir, &options())
-}
-
 fn close_with(
     test: &Histories,
     holdout: &Histories,
@@ -154,7 +150,20 @@ fn fresh(name: &str) -> PathBuf {
 fn hidden_damping_on_the_airframe_is_found_and_the_error_falls() {
     let (test, holdout) = tests(&[("damping".into(), 10.0)], 1);
     let dir = fresh("hidden-damping");
-    let r = close(&test, &holdout, &dir);
+    // The polish crawls on the airframe's rough response (each full Gauss-Newton step too
+    // short): from the path the CORS search takes here it needs 12 iterations to reach the
+    // optimum (docs/closed-loop.md, "the samples at each end").
+    let options = LoopOptions {
+        polish: 14,
+        ..options()
+    };
+    let r = close_with(&test, &holdout, &dir, &options);
+    // The result beside the journal, for a look at a failure.
+    std::fs::write(
+        dir.join("loop.json"),
+        serde_json::to_string_pretty(&r).unwrap(),
+    )
+    .unwrap();
     let summary = format!(
         "{:?}\n{:?}\n{:?}\n{:?}\n{:?}",
         ranking(&r),
@@ -170,9 +179,10 @@ fn hidden_damping_on_the_airframe_is_found_and_the_error_falls() {
     assert_eq!(r.verdict, Verdict::Attributed, "{}\n{summary}", r.stopped);
     let a = &r.added[0];
     assert_eq!(a.name, "damping");
-    // Its value within 5 % of the truth. (Its 95 % interval is not asserted: 9.909
-    // [9.801, 10.016] holds the truth only through the Gauss-Newton step still pending,
-    // 0.051; the model-noise part of a 1e-4 jitter is 0.0018.)
+    // Its value within 5 % of the truth. (Its 95 % interval is not asserted: 10.001
+    // [9.944, 10.058] with a pending Gauss-Newton step of 0.0018 after 14 polish
+    // iterations; after 6 the same path stood at 9.68 [9.42, 9.94], a step of 0.11 still
+    // pending.)
     assert!((a.value - 10.0).abs() < 0.5, "{a:?}");
     // The declared thicknesses recovered within 2 %, and the nuisance terms.
     let x = true_point(&model());

@@ -296,6 +296,9 @@ def main():
     parser.add_argument("--chromium", default="chromium")
     parser.add_argument("--report", required=True, type=Path,
                         help="folder holding report.html and one SVG file per figure")
+    parser.add_argument("--screenshot", type=Path,
+                        help="keep the screenshot of the whole page (PNG) at this path, "
+                             "to look at")
     parser.add_argument("--negative-controls", action="store_true",
                         help="also check that six broken copies of the page are rejected")
     args = parser.parse_args()
@@ -312,6 +315,8 @@ def main():
     with tempfile.TemporaryDirectory(prefix="impactcal-browser-") as tmp:
         work = Path(tmp)
         problems, summary = check(args.chromium, page, names, work)
+        if args.screenshot:
+            args.screenshot.write_bytes((work / "page.png").read_bytes())
         for key, value in summary.items():
             print(f"  {key}: {value}")
         if problems:

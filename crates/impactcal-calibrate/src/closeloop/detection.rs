@@ -1,5 +1,6 @@
 //! Detection of model-form error in the whitened residual `e = L^-1 w (test - model)` of a
-//! calibrated model (`S` channels, `T` samples, `n = S T`, `p` fitted quantities: the
+//! calibrated model (`S` channels, `T` samples, `n = S T` less the masked samples, which
+//! leave every statistic below, `p` fitted quantities: the
 //! calibrated parameters and the nuisance terms): `w` the weights of the noise floor and
 //! `L^-1` each channel's AR filter of the measurement noise (`closeloop::prewhiten`), so
 //! that under the noise model `e` is unit white noise plus what the model lacks.
@@ -43,7 +44,8 @@ pub const WHITENESS_LAGS: usize = 10;
 pub struct Detection {
     /// Reduced chi-square.
     pub chi2_red: f64,
-    /// Samples compared, `S T` (independent once prewhitened).
+    /// Samples in the likelihood, `S T` less the masked ones (independent once
+    /// prewhitened).
     pub n: usize,
     /// Fitted quantities (parameters and nuisance terms).
     pub p: usize,
@@ -133,68 +135,107 @@ fn upper_quantile(d: &impl ContinuousCDF<f64, f64>, alpha: f64, what: &str) -> R
     Ok(d.inverse_cdf(1.0 - alpha))
 }
 
-/// Pooled lag-`k` autocorrelation of the channels of `e` (`S x T`, channel-major).
-fn autocorrelation(e: &[f64], samples: usize, k: usize) -> f64 {
+/// Pooled lag-`k` autocorrelation of the channels of `e` (`S x T`, channel-major) over the
+/// samples in the likelihood (`inside`, `S x T`): each channel's mean and sums of squares
+/// over its samples inside, products over the pairs `(i, i - k)` both inside.
+fn autocorrelation(e: &[f64], inside: &[bool], samples: usize, k: usize) -> f64 {
     let (mut num, mut den) = (0.0, 0.0);
-    for ch in e.chunks(samples) {
-        let m = ch.iter().sum::<f64>() / samples as f64;
-        den += ch.iter().map(|v| (v - m).powi(2)).sum::<f64>();
+    for (ch, ins) in e.chunks(samples).zip(inside.chunks(samples)) {
+        let count = ins.iter().filter(|&&i| i).count();
+        if count == 0 {
+            continue;
+        }
+        let m = ch
+            .iter()
+            .zip(ins)
+            .filter(|(_, i)| **i)
+            .map(|(v, _)| v)
+            .sum::<f64>()
+            / count as f64;
+        den += ch
+            .iter()
+            .zip(ins)
+            .filter(|(_, i)| **i)
+            .map(|(v, _)| (v - m).powi(2))
+            .sum::<f64>();
         num += (k..samples)
+            .filter(|&i| ins[i] && ins[i - k])
             .map(|i| (ch[i] - m) * (ch[i - k] - m))
             .sum::<f64>();
     }
     if den > 0.0 { num / den } else { 0.0 }
 }
 
-/// The reduced chi-square of the whitened residual `e` (`S x T`) with `p` fitted
-/// quantities (see the module docs), with the degrees of freedom `nu` it used:
-/// `(chi2_red, nu)`.
-pub(crate) fn chi2_red(e: &[f64], p: usize) -> (f64, f64) {
+/// The reduced chi-square of the whitened residual `e` (`S x T`) over its `n` samples in the
+/// likelihood (a masked sample is 0 in `e` and not counted in `n`) with `p` fitted
+/// quantities (see the module docs), with the degrees of freedom `nu = max(n - p, 1)` it
+/// used: `(chi2_red, nu)`.
+pub(crate) fn chi2_red(e: &[f64], n: usize, p: usize) -> (f64, f64) {
     let rss: f64 = e.iter().map(|v| v * v).sum();
-    let nu = (e.len() as f64 - p as f64).max(1.0);
+    let nu = (n as f64 - p as f64).max(1.0);
     (rss / nu, nu)
 }
 
 /// The detection statistics (see the module docs) of the whitened residual `e` (`S x T`),
 /// with `p` fitted quantities, level `alpha` and `noise_dof` the degrees of freedom of the
-/// noise level's estimate (`None`: known).
+/// noise level's estimate (`None`: known). `masked` (`S x T`, `true`: out of the
+/// likelihood, the residual 0 there; `None`: every sample in) takes samples out of every
+/// statistic: `n` counts the samples in, the whiteness test's means, sums and record
+/// lengths are each channel's samples in, and the noise edge is that of `S` channels of
+/// `n / S` samples. The statistics of a residual with masked samples are those of the
+/// record without them.
 ///
 /// # Errors
-/// [`CalibrateError::Study`] when the SVD fails or the residual is empty.
+/// [`CalibrateError::Study`] when the SVD fails, the residual is empty or mis-shaped, or
+/// every sample is masked.
 pub fn detect(
     labels: &[String],
     e: &[f64],
+    masked: Option<&[bool]>,
     samples: usize,
     p: usize,
     alpha: f64,
     noise_dof: Option<f64>,
 ) -> Result<Detection> {
     let s = labels.len();
-    let n = e.len();
-    if n == 0 || s * samples != n {
+    if e.is_empty() || s * samples != e.len() || masked.is_some_and(|m| m.len() != e.len()) {
         return Err(CalibrateError::study(
             "detection",
             "empty or mis-shaped residual",
         ));
     }
-    let (chi2_red, nu) = chi2_red(e, p);
-    let lag1 = autocorrelation(e, samples, 1);
+    let inside: Vec<bool> = match masked {
+        Some(m) => m.iter().map(|out| !out).collect(),
+        None => vec![true; e.len()],
+    };
+    let n = inside.iter().filter(|&&i| i).count();
+    if n == 0 {
+        return Err(CalibrateError::study(
+            "detection",
+            "every sample of the residual is masked",
+        ));
+    }
+    let (chi2_red, nu) = chi2_red(e, n, p);
+    let lag1 = autocorrelation(e, &inside, samples, 1);
     let threshold = match noise_dof {
         Some(m) => f_quantile(nu, m, alpha)?,
         None => chi2_quantile(nu, alpha)? / nu,
     };
     let mut q = 0.0;
     let h = WHITENESS_LAGS.min(samples.saturating_sub(2)).max(1);
-    for ch in e.chunks(samples) {
-        let tt = samples as f64;
+    for (ch, ins) in e.chunks(samples).zip(inside.chunks(samples)) {
+        let tt = ins.iter().filter(|&&i| i).count() as f64;
+        if tt <= h as f64 {
+            continue;
+        }
         for k in 1..=h {
-            let r = autocorrelation(ch, samples, k);
+            let r = autocorrelation(ch, ins, samples, k);
             q += tt * (tt + 2.0) * r * r / (tt - k as f64);
         }
     }
     let ljung_box_threshold = chi2_quantile((s * h) as f64, alpha)?;
     let (sv, u, v) = svd_rows(e, s, samples)?;
-    let noise_edge = 1.2 * ((samples as f64).sqrt() + (s as f64).sqrt());
+    let noise_edge = 1.2 * ((n as f64 / s as f64).sqrt() + (s as f64).sqrt());
     let sigma1 = sv.first().copied().unwrap_or(0.0);
     let coherent_rank = sv.iter().filter(|&&x| x > noise_edge).count();
     let coherent = sigma1 > noise_edge;
@@ -260,7 +301,7 @@ mod tests {
         let t = 400;
         let mut alarms = 0;
         for seed in 0..20 {
-            let d = detect(&labels, &white(3 * t, seed), t, 5, 0.01, None).unwrap();
+            let d = detect(&labels, &white(3 * t, seed), None, t, 5, 0.01, None).unwrap();
             assert!(d.lag1.abs() < 0.1);
             alarms += usize::from(d.model_form_error);
         }
@@ -270,12 +311,58 @@ mod tests {
         for k in 0..t {
             e[t + k] += 3.0 * (-((k as f64 - 200.0) / 50.0).powi(2)).exp();
         }
-        let d = detect(&labels, &e, t, 5, 0.01, None).unwrap();
+        let d = detect(&labels, &e, None, t, 5, 0.01, None).unwrap();
         assert!(d.model_form_error, "{d:?}");
         assert!(d.u1["b"].abs() > 0.9);
         let peak = (0..t)
             .max_by(|&i, &j| d.v1[i].abs().total_cmp(&d.v1[j].abs()))
             .unwrap();
         assert!((peak as i64 - 200).abs() < 40, "{peak}");
+    }
+
+    /// Masked samples leave every statistic: a residual of white noise with a pulse on one
+    /// channel, its first two and last two samples of each channel masked (0 there, as the
+    /// noise model leaves them), has the detection of the same record without those
+    /// samples: the same count, chi-square, threshold, whiteness, singular values, noise
+    /// edge and verdict.
+    #[test]
+    fn masked_samples_leave_every_statistic() {
+        let labels: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
+        let (t, head, tail) = (150, 2, 2);
+        let inner = t - head - tail;
+        for pulse in [0.0, 3.0] {
+            let mut e = white(3 * inner, 11);
+            for k in 0..inner {
+                e[inner + k] += pulse * (-((k as f64 - 70.0) / 30.0).powi(2)).exp();
+            }
+            let mut padded = vec![0.0; 3 * t];
+            let mut masked = vec![true; 3 * t];
+            for s in 0..3 {
+                for k in head..t - tail {
+                    padded[s * t + k] = e[s * inner + k - head];
+                    masked[s * t + k] = false;
+                }
+            }
+            let a = detect(&labels, &padded, Some(&masked), t, 5, 0.01, None).unwrap();
+            let b = detect(&labels, &e, None, inner, 5, 0.01, None).unwrap();
+            assert_eq!((a.n, b.n), (3 * inner, 3 * inner));
+            let pairs = [
+                (a.chi2_red, b.chi2_red),
+                (a.threshold, b.threshold),
+                (a.lag1, b.lag1),
+                (a.ljung_box, b.ljung_box),
+                (a.sigma1, b.sigma1),
+                (a.noise_edge, b.noise_edge),
+            ];
+            for (x, y) in pairs {
+                assert!((x - y).abs() <= 1e-9 * y.abs().max(1.0), "{a:?}\n{b:?}");
+            }
+            assert_eq!(a.coherent_rank, b.coherent_rank);
+            assert_eq!(a.model_form_error, b.model_form_error);
+            assert_eq!(a.model_form_error, pulse > 0.0, "{a:?}");
+        }
+        // A residual masked throughout is refused, not judged.
+        let all = vec![true; 3 * t];
+        assert!(detect(&labels, &vec![0.0; 3 * t], Some(&all), t, 5, 0.01, None).is_err());
     }
 }

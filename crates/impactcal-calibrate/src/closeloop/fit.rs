@@ -243,7 +243,7 @@ pub(crate) fn calibrate<M: Model>(
         }
     }
     if budget > 0 {
-        let n = ctx.frame.test.len() as f64;
+        let n = ctx.frame.compared() as f64;
         let error = |h: &Histories| -> Result<f64> { Ok(ctx.profile(&ctx.y_of(h)?).1 / n) };
         let stage = format!("{prefix}-cors");
         ctx.runner.observer.stage(&stage, budget, 0);

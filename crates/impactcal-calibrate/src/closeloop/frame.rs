@@ -82,7 +82,7 @@ pub(super) fn nuisance<'a, M: Model>(
         },
         options,
     )?;
-    noise_model(&mut frame, &nominal.masks, &floor)?;
+    noise_model(&mut frame, &nominal.masks, &floor, cfc)?;
     let onset = noise_floor::onset(&y_nominal, samples);
     let n_nuisance = 1 + if options.fit_gains { 2 } else { 1 } * labels.len();
     Ok(Setting {
@@ -257,22 +257,43 @@ pub(super) fn frame_of(
     Ok((frame, floor))
 }
 
+/// How far (relative) a filtered sample's noise level may depart from the stationary level
+/// the noise model holds before the sample leaves the likelihood: 10 % in standard
+/// deviation is 21 % in a whitened square, beyond the spread of the noise floor's own
+/// estimate.
+const FILTER_END_TOLERANCE: f64 = 0.1;
+
 /// The frame's noise model: zero weight for the masked samples of `core::quality` (clipped
-/// runs and spikes, per channel in frame order: they leave every residual), and each
-/// channel's AR whitening of the noise `floor` measured, started afresh after each mask.
+/// runs and spikes, per channel in frame order: they leave every residual) and for the
+/// samples at the record's ends where the CFC filter `cfc` does not pass noise as it does
+/// inside ([`Cfc::end_samples`]: the reflection through the end value leaves the end
+/// sample's own noise unfiltered, which the stationary noise model would read as a spike
+/// in the residual's last sample), and each channel's AR whitening of the noise `floor`
+/// measured, started afresh after each mask. The ends are kept when masking them would
+/// leave no sample.
 ///
 /// # Errors
-/// [`CalibrateError::Study`] for a noise model that is not stationary.
+/// [`CalibrateError::Study`] for a noise model that is not stationary; filter errors.
 pub(super) fn noise_model(
     frame: &mut Frame,
     masks: &[Vec<bool>],
     floor: &NoiseFloor,
+    cfc: Option<Cfc>,
 ) -> Result<()> {
     let t = frame.samples;
     for (s, m) in masks.iter().enumerate() {
         for (k, &out) in m.iter().enumerate().take(t) {
             if out {
                 frame.weights[s * t + k] = 0.0;
+            }
+        }
+    }
+    if let Some(c) = cfc {
+        let (head, tail) = c.end_samples(t, frame.dt, FILTER_END_TOLERANCE)?;
+        if head + tail < t {
+            for ch in frame.weights.chunks_mut(t) {
+                ch[..head].iter_mut().for_each(|w| *w = 0.0);
+                ch[t - tail..].iter_mut().for_each(|w| *w = 0.0);
             }
         }
     }
@@ -290,6 +311,48 @@ pub(super) fn noise_model(
 mod tests {
     use crate::closeloop::toy::{self, Toy};
     use impactcal_core::Histories;
+
+    /// A filtered comparison leaves out the samples at each end where the CFC filter's end
+    /// treatment passes the noise unfiltered (`Cfc::end_samples`), on every channel, and
+    /// keeps the rest.
+    #[test]
+    fn the_filters_end_samples_leave_the_likelihood() {
+        let model = Toy::new(0.0, 0.0, 1.0);
+        let (a, b) = model.channels(&[1.0]);
+        let test =
+            Histories::from_channels(vec!["a".into(), "b".into()], vec![a, b], toy::DT, 0.0, "")
+                .unwrap();
+        let cfc = impactcal_core::Cfc::from_class(60).unwrap();
+        let (head, tail) = cfc.end_samples(toy::T, toy::DT, 0.1).unwrap();
+        assert!(
+            head >= 1 && tail >= 1 && head + tail < toy::T,
+            "{head}, {tail}"
+        );
+        toy::with_filtered_setting(
+            &model,
+            &test,
+            &toy::options(0.01),
+            Some(cfc),
+            |setting, _| {
+                for ch in setting.ctx.frame.weights.chunks(toy::T) {
+                    assert!(ch[..head].iter().all(|w| *w == 0.0), "head kept: {ch:?}");
+                    assert!(ch[toy::T - tail..].iter().all(|w| *w == 0.0), "tail kept");
+                    assert!(
+                        ch[head..toy::T - tail].iter().all(|w| *w > 0.0),
+                        "inside masked"
+                    );
+                }
+                let frame = &setting.ctx.frame;
+                assert_eq!(frame.compared(), 2 * (toy::T - head - tail));
+                assert_eq!(
+                    frame.masked().iter().filter(|m| **m).count(),
+                    2 * (head + tail)
+                );
+                Ok(())
+            },
+        )
+        .unwrap();
+    }
 
     /// A test that is the nominal run with a gain and a bias per channel and no noise: the
     /// nuisance stage profiles them back exactly, with the weights `1 / sigma` of the known

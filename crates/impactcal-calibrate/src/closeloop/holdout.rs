@@ -99,7 +99,7 @@ pub(super) fn holdout_errors<M: Enrichable>(
         },
         options,
     )?;
-    noise_model(&mut frame_h, &masks_h, &floor_h)?;
+    noise_model(&mut frame_h, &masks_h, &floor_h, test.cfc)?;
     let ys = [
         y_nom_h,
         compared(&calibrated_h, test.cfc, labels)?,

@@ -95,6 +95,7 @@ impl Judge<'_> {
         let det = detection::detect(
             &frame.labels,
             &residual,
+            Some(&frame.masked()),
             frame.samples,
             p,
             self.options.alpha,

@@ -120,6 +120,7 @@ impl ModelNoise {
             shifts: self.shifts.clone(),
             ..DrawStats::default()
         };
+        let compared = frame.compared();
         for j in 0..self.len() {
             let d = self.deviation(j)?;
             let y: Vec<f64> = fit.y.iter().zip(&d).map(|(a, b)| a + b).collect();
@@ -131,7 +132,7 @@ impl ModelNoise {
             out.unfitted.push(uu);
             out.solved.push(fit.jac.solve(&dw));
             if let Some(p) = chi2 {
-                out.chi2.push(chi2_red(&u, p).0);
+                out.chi2.push(chi2_red(&u, compared, p).0);
             }
             if let Some(f) = products {
                 out.products.push(f(&dw, &fit.jac.coefficients(&dw)));

@@ -42,6 +42,19 @@ pub(crate) struct Frame {
     pub whitener: Prewhitener,
 }
 
+impl Frame {
+    /// Whether each sample (`S x T`) is out of the likelihood: weight 0, a sample masked by
+    /// the noise model (`closeloop::frame::noise_model`).
+    pub fn masked(&self) -> Vec<bool> {
+        self.weights.iter().map(|w| *w == 0.0).collect()
+    }
+
+    /// The number of samples in the likelihood (weight above 0).
+    pub fn compared(&self) -> usize {
+        self.weights.iter().filter(|w| **w > 0.0).count()
+    }
+}
+
 /// The estimated nuisance terms.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Nuisance {

@@ -74,9 +74,10 @@ pub fn akaike_weights(aic: &[f64]) -> Vec<f64> {
     w.iter().map(|x| x / s).collect()
 }
 
-fn score(fit: &Fit, added: &[Parameter], n_nuisance: usize, kept: bool) -> ModelScore {
+/// The criteria of `fit` (with `added` quantities) over the `n` samples in the likelihood.
+fn score(fit: &Fit, added: &[Parameter], n_nuisance: usize, n: usize, kept: bool) -> ModelScore {
     let k = fit.point.len() + n_nuisance;
-    let (aic, bic) = criteria(fit.rss, fit.residual.len(), k);
+    let (aic, bic) = criteria(fit.rss, n, k);
     ModelScore {
         added: added.iter().map(|p| p.name.clone()).collect(),
         k,
@@ -207,7 +208,7 @@ pub(crate) fn forward<M: Enrichable>(
     };
     let det = selection.detect(&fit0)?;
     let cur = model.enrich(&[])?;
-    let models = vec![score(&fit0, &[], n_nuisance, true)];
+    let models = vec![score(&fit0, &[], n_nuisance, ctx.frame.compared(), true)];
     let mut state = State {
         fit: fit0,
         det,
@@ -283,6 +284,7 @@ impl<M: Enrichable> Selection<'_, '_, M> {
         let d = detect(
             &frame.labels,
             &fit.residual,
+            Some(&frame.masked()),
             frame.samples,
             p,
             self.options.alpha,
@@ -402,8 +404,9 @@ impl<M: Enrichable> Selection<'_, '_, M> {
         trial: bool,
     ) -> Result<Option<String>> {
         let n_nuisance = self.n_nuisance;
-        let s = score(&tried.fit, &tried.added, n_nuisance, true);
-        let control_score = score(&tried.control, &state.added, n_nuisance, true);
+        let n = self.ctx.frame.compared();
+        let s = score(&tried.fit, &tried.added, n_nuisance, n, true);
+        let control_score = score(&tried.control, &state.added, n_nuisance, n, true);
         let prev_bic = state.models.last().map_or(f64::INFINITY, |m| m.bic);
         let (base_rss, base_bic) = comparison_base(
             state.fit.rss,

@@ -181,13 +181,24 @@ pub fn with_setting<M: Enrichable, R>(
     options: &LoopOptions,
     body: impl FnOnce(&Setting<'_>, &Nominal) -> Result<R>,
 ) -> Result<R> {
+    with_filtered_setting(model, test, options, None, body)
+}
+
+/// [`with_setting`] with test and runs filtered with `cfc`.
+pub fn with_filtered_setting<M: Enrichable, R>(
+    model: &M,
+    test: &Histories,
+    options: &LoopOptions,
+    cfc: Option<impactcal_core::Cfc>,
+    body: impl FnOnce(&Setting<'_>, &Nominal) -> Result<R>,
+) -> Result<R> {
     let dir = tempfile::tempdir().unwrap();
     let used = Cell::new(0usize);
     let runner = journaled(dir.path(), &used);
     let data = TestData {
         histories: test,
         map: None,
-        cfc: None,
+        cfc,
     };
     let nominal = setup::nominal(&runner, model, data)?;
     let plan = setup::plan(model, &nominal, options, 1)?;
@@ -195,7 +206,7 @@ pub fn with_setting<M: Enrichable, R>(
         plan: Some(&plan),
         ..runner
     };
-    let setting = frame::nuisance(runner, model, &nominal, None, options)?;
+    let setting = frame::nuisance(runner, model, &nominal, cfc, options)?;
     body(&setting, &nominal)
 }
 
