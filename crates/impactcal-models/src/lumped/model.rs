@@ -12,9 +12,16 @@
 //!
 //! **Held quantities** ([`Enrichable::candidates`]): each with its admissible range and the
 //! held value that switches it off. Scales: `a_pk` is the record's peak base acceleration
-//! (m/s^2), `M` the total mass, and `d_s = a_pk M / k_s` the stretch of spring `s` (at its
-//! nominal stiffness) if it carried the whole system at the peak input; a pulse of that
-//! peak moves a linear oscillator by at most `2 d_s`.
+//! (m/s^2) and `d_s` the quasi-static stretch of spring `s`: the stretch `|z_a - z_b|` of
+//! its ends in the static solution `K z = M 1 a_pk` at the nominal stiffnesses (the system
+//! held at the peak input as a constant acceleration). A spring carries the masses on its
+//! far side from the base and nothing else, so a board on its own mount has
+//! `d_s = a_pk m / k_s`, and a spring in a chain carries the masses beyond it. A pulse of
+//! that peak moves a linear oscillator by at most `2 d_s`. `u_s(p)` is the travel of spring
+//! `s`: the largest `|z_a - z_b|` over the run of the model at point `p` without its
+//! rattles, under the reference input (the test's own base acceleration; for repeated tests
+//! the strongest one's, [`crate::lumped::LumpedRepeats`], so that one clearance means one
+//! length on every test).
 //!
 //! | name | range | held | effect |
 //! |---|---|---|---|
@@ -23,7 +30,16 @@
 //! | `cubic_<s>` | -1/12..1 | 0 | spring `s` becomes `k d (1 + gamma (d/d_s)^2)`: tangent stiffness positive up to `2 d_s` at the softest, four times `k` at `d_s` at the hardest |
 //! | `stiffness_change` | -0.5..0.5 | 0 | every spring's stiffness times `1 + change` (the damping ratios kept): a test's stiffness change |
 //! | `rattle_<s>_stiffness` | 0..`100 k_s` | 0 | a two-sided gap contact between the ends of spring `s` (a rattle), of this penalty stiffness |
-//! | `rattle_<s>_gap` | 0..`2 d_s` | `d_s / 2` | its clearance (m) |
+//! | `rattle_<s>_gap` | 0..1 | 1/2 | its clearance as a fraction of the travel `u_s(p)`: the clearance is `value u_s(p)` (m) |
+//!
+//! **Why the rattle's clearance is a fraction of the travel.** A contact whose clearance
+//! the ends never reach does nothing, so a rattle can only be seen, and its stiffness only
+//! probed by a finite step, at a clearance below the travel the test itself produces; and
+//! that travel moves with the calibrated stiffness (a stiffer mount travels less). So the
+//! clearance follows the model's own response at the point run: 1 is the travel (a clearance
+//! there never closes), 1/2 the middle of the clearances that close, the held value at
+//! which the rattle's stiffness is probed. [`LumpedModel::travel`] gives `u_s(p)`, so a
+//! fraction converts to metres at any point.
 //! | `delay` | `-50 dt`..`50 dt` | 0 | outputs later by this time (s): `y(t - delay)`, linear between samples |
 //! | `saturation_<c>` | 0..`4 / a_pk` | 0 | channel `c` clipped at the rail `+-1 / value` (value in 1 per record unit; 0 is no rail) |
 //!
@@ -78,6 +94,9 @@ pub struct LumpedModel {
     held: Vec<Held>,
     /// `d_s` of each spring (m).
     reach: Vec<f64>,
+    /// The base acceleration (m/s^2) whose run sets the rattles' travel: the record's own,
+    /// or the strongest of a set of repeated tests.
+    reference: Vec<f64>,
 }
 
 /// A channel label as a parameter-name fragment.
@@ -148,12 +167,7 @@ impl LumpedModel {
         let peak = scale.unwrap_or(peak);
         let dt = record.dt();
         let duration = dt * (raw.len() - 1) as f64;
-        let total: f64 = system.masses.iter().map(|m| m.1).sum();
-        let reach: Vec<f64> = system
-            .springs
-            .iter()
-            .map(|s| peak * total / s.stiffness)
-            .collect();
+        let reach = static_stretch(&system, peak)?;
 
         let mut params = Vec::with_capacity(2 * system.springs.len());
         for s in &system.springs {
@@ -258,11 +272,15 @@ impl LumpedModel {
             add(
                 format!("rattle_{}_gap", s.name),
                 0.0,
-                2.0 * reach[i],
-                0.5 * reach[i],
-                "m",
+                1.0,
+                0.5,
+                "1",
                 "contact",
-                format!("clearance of the rattle between {pair}"),
+                format!(
+                    "clearance of the rattle between {pair}, as a fraction of the travel \
+                     of `{}` in the model's run",
+                    s.name
+                ),
                 Effect::RattleGap(i),
             )?;
         }
@@ -306,13 +324,79 @@ impl LumpedModel {
         Ok(LumpedModel {
             space: ParameterSpace::new(params)?,
             system,
-            input,
             dt,
             start: record.start(),
             unit_label: record.unit().to_string(),
             held,
             reach,
+            reference: input.clone(),
+            input,
         })
+    }
+
+    /// The same model with the rattles' travel taken from the run under `reference` (m/s^2,
+    /// one value per sample of this model's record) in place of its own input: what
+    /// repeated tests share ([`crate::lumped::LumpedRepeats`]).
+    ///
+    /// # Errors
+    /// [`ModelsError::Invalid`] for a reference of another length than the input, or with a
+    /// sample that is not finite.
+    pub fn with_reference(mut self, reference: &[f64]) -> Result<LumpedModel> {
+        if reference.len() != self.input.len() {
+            return Err(ModelsError::invalid(
+                "reference input",
+                format!("{} samples", reference.len()),
+                format!("the model's input has {}", self.input.len()),
+            ));
+        }
+        if let Some(k) = reference.iter().position(|x| !x.is_finite()) {
+            return Err(ModelsError::invalid(
+                "reference input",
+                format!("sample {k} = {}", reference[k]),
+                "must be finite",
+            ));
+        }
+        self.reference = reference.to_vec();
+        Ok(self)
+    }
+
+    /// The quasi-static stretch `d_s` of each spring (m), in name order (see the module
+    /// docs): what the held quantities' ranges are scaled by.
+    pub fn reach(&self) -> &[f64] {
+        &self.reach
+    }
+
+    /// The travel `u_s(p)` of each spring (m), in name order: the largest stretch of its ends
+    /// over the model's run at point `p` without its rattles (every other held quantity as
+    /// at `p`), under the reference input. A rattle of clearance fraction `g` between the
+    /// spring's ends has the clearance `g u_s(p)`.
+    ///
+    /// # Errors
+    /// As [`LumpedModel::dynamics`] and the integrator.
+    pub fn travel(&self, p: &[f64]) -> Result<Vec<f64>> {
+        let (dynamics, _, _) = self.assemble(p, false)?;
+        self.travel_of(&dynamics)
+    }
+
+    /// The largest stretch of each declared spring's ends in the run of `dynamics` under
+    /// the reference input.
+    fn travel_of(&self, dynamics: &Dynamics) -> Result<Vec<f64>> {
+        let reach = 2.0 * self.reach.iter().fold(0.0_f64, |m, r| m.max(*r));
+        let traj = dynamics.run(&self.reference, self.dt, reach)?;
+        let at = |node: Node, k: usize| match node {
+            Node::Base => 0.0,
+            Node::Mass(i) => traj.z[i][k],
+        };
+        Ok(self
+            .system
+            .springs
+            .iter()
+            .map(|s| {
+                (0..self.reference.len()).fold(0.0_f64, |m, k| {
+                    m.max((at(s.between[1], k) - at(s.between[0], k)).abs())
+                })
+            })
+            .collect())
     }
 
     /// The system the model runs.
@@ -343,6 +427,11 @@ impl LumpedModel {
     /// [`ModelsError::Invalid`] for a point of the wrong length or a value outside what the
     /// physics admits (a stiffness that is not positive, a negative damping ratio).
     pub fn dynamics(&self, p: &[f64]) -> Result<(Dynamics, f64, Vec<f64>)> {
+        self.assemble(p, true)
+    }
+
+    /// [`LumpedModel::dynamics`], with the rattles or without them.
+    fn assemble(&self, p: &[f64], rattles: bool) -> Result<(Dynamics, f64, Vec<f64>)> {
         if p.len() != self.space.dim() {
             return Err(ModelsError::invalid(
                 "point",
@@ -422,7 +511,7 @@ impl LumpedModel {
                 masses.push(mx);
             }
         }
-        let mut gaps: Vec<GapLink> = sys
+        let gaps: Vec<GapLink> = sys
             .gaps
             .iter()
             .map(|g| GapLink {
@@ -432,17 +521,7 @@ impl LumpedModel {
                 sides: g.sides,
             })
             .collect();
-        for (i, &(k, gap)) in rattle.iter().enumerate() {
-            if k > 0.0 {
-                gaps.push(GapLink {
-                    ends: sys.springs[i].between,
-                    gap: gap.max(0.0),
-                    k,
-                    sides: GapSides::Both,
-                });
-            }
-        }
-        let dynamics = Dynamics {
+        let mut dynamics = Dynamics {
             masses,
             springs,
             dashpots: sys
@@ -452,6 +531,19 @@ impl LumpedModel {
                 .collect(),
             gaps,
         };
+        if rattles && rattle.iter().any(|r| r.0 > 0.0) {
+            let travel = self.travel_of(&dynamics)?;
+            for (i, &(k, fraction)) in rattle.iter().enumerate() {
+                if k > 0.0 {
+                    dynamics.gaps.push(GapLink {
+                        ends: sys.springs[i].between,
+                        gap: fraction.max(0.0) * travel[i],
+                        k,
+                        sides: GapSides::Both,
+                    });
+                }
+            }
+        }
         Ok((dynamics, delay, rails))
     }
 
@@ -486,6 +578,63 @@ impl LumpedModel {
             self.unit_label.clone(),
         )?)
     }
+}
+
+/// The quasi-static stretch of each spring of `system` (m): `|z_a - z_b|` at its ends in
+/// the solution of `K z = M 1 peak` at the nominal stiffnesses (Gaussian elimination with
+/// partial pivoting; `K` is positive definite since every mass is tied to the base by
+/// springs, which the file reader checks).
+///
+/// # Errors
+/// [`ModelsError::Invalid`] if `K` is singular to working precision.
+fn static_stretch(system: &LumpedSystem, peak: f64) -> Result<Vec<f64>> {
+    let n = system.masses.len();
+    let mut k = vec![0.0; n * n];
+    for s in &system.springs {
+        let [a, b] = s.between;
+        for (x, y, w) in [(a, a, 1.0), (b, b, 1.0), (a, b, -1.0), (b, a, -1.0)] {
+            if let (Node::Mass(i), Node::Mass(j)) = (x, y) {
+                k[i * n + j] += w * s.stiffness;
+            }
+        }
+    }
+    let mut z: Vec<f64> = system.masses.iter().map(|m| m.1 * peak).collect();
+    for c in 0..n {
+        let pivot = (c..n)
+            .max_by(|&i, &j| k[i * n + c].abs().total_cmp(&k[j * n + c].abs()))
+            .unwrap_or(c);
+        if k[pivot * n + c] == 0.0 {
+            return Err(ModelsError::invalid(
+                "stiffness matrix",
+                format!("column {c}"),
+                "is singular: a mass is not held by springs",
+            ));
+        }
+        for j in 0..n {
+            k.swap(c * n + j, pivot * n + j);
+        }
+        z.swap(c, pivot);
+        for i in c + 1..n {
+            let f = k[i * n + c] / k[c * n + c];
+            for j in c..n {
+                k[i * n + j] -= f * k[c * n + j];
+            }
+            z[i] -= f * z[c];
+        }
+    }
+    for c in (0..n).rev() {
+        let tail: f64 = (c + 1..n).map(|j| k[c * n + j] * z[j]).sum();
+        z[c] = (z[c] - tail) / k[c * n + c];
+    }
+    let at = |node: Node| match node {
+        Node::Base => 0.0,
+        Node::Mass(i) => z[i],
+    };
+    Ok(system
+        .springs
+        .iter()
+        .map(|s| (at(s.between[1]) - at(s.between[0])).abs())
+        .collect())
 }
 
 /// `y(k - shift)` for each sample `k`, linear between samples, the first value before the

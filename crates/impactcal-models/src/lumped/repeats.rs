@@ -12,7 +12,10 @@
 //! **Scales.** The held quantities' ranges and held values (a rattle's gap, a rail, the
 //! cubic term's reach) are scaled by the largest peak base acceleration over every test of
 //! both sets, so that a freed quantity means the same physical thing on each test and its
-//! range covers the largest drive ([`LumpedModel::with_scale`]).
+//! range covers the largest drive ([`LumpedModel::with_scale`]); and a rattle's clearance,
+//! a fraction of the travel its spring reaches in the model's run, takes that travel from
+//! the run under the strongest test's input on every test
+//! ([`LumpedModel::with_reference`]), so that one freed clearance is one length on each.
 //!
 //! **Which set runs** is a condition: [`REPEAT_SET`] `= 0` the calibration tests (the
 //! default), `= 1` the holdout tests; the loop's holdout runs at `repeat_set = 1`.
@@ -85,14 +88,20 @@ impl LumpedRepeats {
         let all = || calibration.iter().chain(holdout);
         same_window(&all().copied().collect::<Vec<_>>())?;
         let mut peak = 0.0_f64;
+        let mut reference = Vec::new();
         for (name, record) in all() {
             let m = LumpedModel::new(system.clone(), record).map_err(|e| in_test(name, e))?;
-            peak = m.input().iter().fold(peak, |p, a| p.max(a.abs()));
+            let own = m.input().iter().fold(0.0_f64, |p, a| p.max(a.abs()));
+            if own > peak {
+                peak = own;
+                reference = m.input().to_vec();
+            }
         }
         let build = |set: &[(&str, &Histories)]| -> Result<Vec<(String, LumpedModel)>> {
             set.iter()
                 .map(|(name, record)| {
                     LumpedModel::with_scale(system.clone(), record, peak)
+                        .and_then(|m| m.with_reference(&reference))
                         .map(|m| (name.to_string(), m))
                         .map_err(|e| in_test(name, e))
                 })
