@@ -120,7 +120,7 @@ fn a_lumped_file_builds_the_system_driven_by_its_test() {
         model
             .candidates()
             .iter()
-            .any(|c| c.name() == "rattle_mount_gap")
+            .any(|c| c.name() == "rattle_mount_c1_gap")
     );
     let m = e.measured().unwrap();
     assert_eq!(m.test.labels(), ["accel_1"]);

@@ -17,11 +17,11 @@
 //! held at the peak input as a constant acceleration). A spring carries the masses on its
 //! far side from the base and nothing else, so a board on its own mount has
 //! `d_s = a_pk m / k_s`, and a spring in a chain carries the masses beyond it. A pulse of
-//! that peak moves a linear oscillator by at most `2 d_s`. `u_s(p)` is the travel of spring
-//! `s`: the largest `|z_a - z_b|` over the run of the model at point `p` without its
-//! rattles, under the reference input (the test's own base acceleration; for repeated tests
-//! the strongest one's, [`crate::lumped::LumpedRepeats`], so that one clearance means one
-//! length on every test).
+//! that peak moves a linear oscillator by at most `2 d_s`. `u_s` is the nominal travel of
+//! spring `s`: the largest `|z_a - z_b|` over the run of the model at its nominal point,
+//! under the reference input (the test's own base acceleration; for repeated tests the
+//! strongest one's, [`crate::lumped::LumpedRepeats`], so that the rattles are probed at the
+//! same lengths on every test).
 //!
 //! | name | range | held | effect |
 //! |---|---|---|---|
@@ -29,17 +29,23 @@
 //! | `mode_<m>_frequency` | `10/T`..`0.2/dt` Hz | their geometric mean | that mode's frequency on a fixed base, `sqrt(k/m_x) / 2 pi` (damping ratio 0.02) |
 //! | `cubic_<s>` | -1/12..1 | 0 | spring `s` becomes `k d (1 + gamma (d/d_s)^2)`: tangent stiffness positive up to `2 d_s` at the softest, four times `k` at `d_s` at the hardest |
 //! | `stiffness_change` | -0.5..0.5 | 0 | every spring's stiffness times `1 + change` (the damping ratios kept): a test's stiffness change |
-//! | `rattle_<s>_stiffness` | 0..`100 k_s` | 0 | a two-sided gap contact between the ends of spring `s` (a rattle), of this penalty stiffness |
-//! | `rattle_<s>_gap` | 0..1 | 1/2 | its clearance as a fraction of the travel `u_s(p)`: the clearance is `value u_s(p)` (m) |
+//! | `rattle_<s>_c<j>_stiffness` | 0..`100 k_s` | 0 | a two-sided gap contact between the ends of spring `s` (a rattle), of this penalty stiffness; `j = 1, 2, 3` |
+//! | `rattle_<s>_c<j>_gap` | 0..`2 d_s` | `u_s / 2^j` | its clearance (m) |
 //!
-//! **Why the rattle's clearance is a fraction of the travel.** A contact whose clearance
-//! the ends never reach does nothing, so a rattle can only be seen, and its stiffness only
-//! probed by a finite step, at a clearance below the travel the test itself produces; and
-//! that travel moves with the calibrated stiffness (a stiffer mount travels less). So the
-//! clearance follows the model's own response at the point run: 1 is the travel (a clearance
-//! there never closes), 1/2 the middle of the clearances that close, the held value at
-//! which the rattle's stiffness is probed. [`LumpedModel::travel`] gives `u_s(p)`, so a
-//! fraction converts to metres at any point.
+//! **Why three rattles per spring, at halving clearances.** A contact whose clearance the
+//! ends never reach does nothing, so a rattle's stiffness can only be probed by a finite
+//! step at a clearance the test's own travel closes; and a contact is a threshold effect,
+//! so its stiffness at one clearance does not stand in for another (the recalibration with
+//! the stiffness alone, at a clearance far from the true one, realises little of what the
+//! contact explains). The clearance is unknown and may lie anywhere below the travel, and
+//! the travel at the calibrated point may be well below the nominal one (a linear model
+//! fitted to a rattling article stiffens its mount). So each spring carries three rattles,
+//! probed at a half, a quarter and an eighth of its nominal travel (`c1`, `c2`, `c3`): a
+//! geometric grid, each clearance within a factor of `sqrt 2` of any clearance between
+//! `u_s / 8 sqrt 2` and `u_s / sqrt 2`, which closes at the calibrated point as long as its
+//! travel stays above an eighth of the nominal one. The attribution scores each; once one's
+//! stiffness is added, its clearance is the candidate that refines it. Only the lengths
+//! come from the model's response (its nominal run); nothing of a test's residual enters.
 //! | `delay` | `-50 dt`..`50 dt` | 0 | outputs later by this time (s): `y(t - delay)`, linear between samples |
 //! | `saturation_<c>` | 0..`4 / a_pk` | 0 | channel `c` clipped at the rail `+-1 / value` (value in 1 per record unit; 0 is no rail) |
 //!
@@ -66,8 +72,8 @@ enum Effect {
     ModeFrequency(usize),
     Cubic(usize),
     StiffnessChange,
-    RattleStiffness(usize),
-    RattleGap(usize),
+    RattleStiffness(usize, usize),
+    RattleGap(usize, usize),
     Delay,
     Saturation(usize),
 }
@@ -94,10 +100,10 @@ pub struct LumpedModel {
     held: Vec<Held>,
     /// `d_s` of each spring (m).
     reach: Vec<f64>,
-    /// The base acceleration (m/s^2) whose run sets the rattles' travel: the record's own,
-    /// or the strongest of a set of repeated tests.
-    reference: Vec<f64>,
 }
+
+/// The rattles' held clearances, as fractions of the nominal travel: `c1`, `c2`, `c3`.
+const CLEARANCES: [f64; 3] = [0.5, 0.25, 0.125];
 
 /// A channel label as a parameter-name fragment.
 fn fragment(label: &str) -> String {
@@ -122,7 +128,7 @@ impl LumpedModel {
     /// channel with a non-finite sample (naming it) or that never moves; [`ModelsError::Invalid`]
     /// when two output labels give the same saturation parameter name.
     pub fn new(system: LumpedSystem, record: &Histories) -> Result<LumpedModel> {
-        LumpedModel::scaled(system, record, None)
+        LumpedModel::scaled(system, record, None, None)
     }
 
     /// The model of `system` driven by the base channel of `record`, its held quantities
@@ -141,10 +147,15 @@ impl LumpedModel {
                 "must be positive and finite",
             ));
         }
-        LumpedModel::scaled(system, record, Some(peak))
+        LumpedModel::scaled(system, record, Some(peak), None)
     }
 
-    fn scaled(system: LumpedSystem, record: &Histories, scale: Option<f64>) -> Result<LumpedModel> {
+    fn scaled(
+        system: LumpedSystem,
+        record: &Histories,
+        scale: Option<f64>,
+        reference: Option<&[f64]>,
+    ) -> Result<LumpedModel> {
         let raw = record.channel_by_label(&system.base_channel)?;
         let what = format!("base channel `{}`", system.base_channel);
         if raw.len() < 2 {
@@ -168,6 +179,27 @@ impl LumpedModel {
         let dt = record.dt();
         let duration = dt * (raw.len() - 1) as f64;
         let reach = static_stretch(&system, peak)?;
+        let reference = reference.unwrap_or(&input);
+        if reference.len() != input.len() {
+            return Err(ModelsError::invalid(
+                "reference input",
+                format!("{} samples", reference.len()),
+                format!("the record has {}", input.len()),
+            ));
+        }
+        if let Some(k) = reference.iter().position(|x| !x.is_finite()) {
+            return Err(ModelsError::invalid(
+                "reference input",
+                format!("sample {k} = {}", reference[k]),
+                "must be finite",
+            ));
+        }
+        let nominal: Vec<f64> = system
+            .springs
+            .iter()
+            .flat_map(|s| [s.stiffness, s.damping_ratio])
+            .collect();
+        let travel = travel_of(&linear(&system, &nominal)?, reference, dt, &reach, &system)?;
 
         let mut params = Vec::with_capacity(2 * system.springs.len());
         for s in &system.springs {
@@ -259,30 +291,33 @@ impl LumpedModel {
         for (i, s) in system.springs.iter().enumerate() {
             let [a, b] = s.between;
             let pair = format!("`{}` and `{}`", system.node_name(a), system.node_name(b));
-            add(
-                format!("rattle_{}_stiffness", s.name),
-                0.0,
-                100.0 * s.stiffness,
-                0.0,
-                "N/m",
-                "contact",
-                format!("penalty stiffness of a rattle (two-sided gap contact) between {pair}"),
-                Effect::RattleStiffness(i),
-            )?;
-            add(
-                format!("rattle_{}_gap", s.name),
-                0.0,
-                1.0,
-                0.5,
-                "1",
-                "contact",
-                format!(
-                    "clearance of the rattle between {pair}, as a fraction of the travel \
-                     of `{}` in the model's run",
-                    s.name
-                ),
-                Effect::RattleGap(i),
-            )?;
+            for (j, fraction) in CLEARANCES.iter().enumerate() {
+                let c = j + 1;
+                let gap = (fraction * travel[i]).min(2.0 * reach[i]);
+                add(
+                    format!("rattle_{}_c{c}_stiffness", s.name),
+                    0.0,
+                    100.0 * s.stiffness,
+                    0.0,
+                    "N/m",
+                    "contact",
+                    format!(
+                        "penalty stiffness of a rattle (two-sided gap contact) between {pair}, \
+                         probed at {fraction} of the nominal travel ({gap:.3e} m)"
+                    ),
+                    Effect::RattleStiffness(i, j),
+                )?;
+                add(
+                    format!("rattle_{}_c{c}_gap", s.name),
+                    0.0,
+                    2.0 * reach[i],
+                    gap,
+                    "m",
+                    "contact",
+                    format!("clearance of rattle c{c} between {pair}"),
+                    Effect::RattleGap(i, j),
+                )?;
+            }
         }
         add(
             "delay".into(),
@@ -329,35 +364,33 @@ impl LumpedModel {
             unit_label: record.unit().to_string(),
             held,
             reach,
-            reference: input.clone(),
             input,
         })
     }
 
-    /// The same model with the rattles' travel taken from the run under `reference` (m/s^2,
-    /// one value per sample of this model's record) in place of its own input: what
-    /// repeated tests share ([`crate::lumped::LumpedRepeats`]).
+    /// The model of `system` driven by the base channel of `record`, its held quantities
+    /// scaled by `peak` (m/s^2) as [`LumpedModel::with_scale`], and its rattles probed at
+    /// clearances taken from the nominal run under `reference` (m/s^2, one value per sample
+    /// of `record`) in place of its own input: what repeated tests share
+    /// ([`crate::lumped::LumpedRepeats`]).
     ///
     /// # Errors
-    /// [`ModelsError::Invalid`] for a reference of another length than the input, or with a
-    /// sample that is not finite.
-    pub fn with_reference(mut self, reference: &[f64]) -> Result<LumpedModel> {
-        if reference.len() != self.input.len() {
+    /// As [`LumpedModel::with_scale`]; [`ModelsError::Invalid`] for a reference of another
+    /// length than the record, or with a sample that is not finite.
+    pub fn with_reference(
+        system: LumpedSystem,
+        record: &Histories,
+        peak: f64,
+        reference: &[f64],
+    ) -> Result<LumpedModel> {
+        if !(peak.is_finite() && peak > 0.0) {
             return Err(ModelsError::invalid(
-                "reference input",
-                format!("{} samples", reference.len()),
-                format!("the model's input has {}", self.input.len()),
+                "peak base acceleration",
+                peak,
+                "must be positive and finite",
             ));
         }
-        if let Some(k) = reference.iter().position(|x| !x.is_finite()) {
-            return Err(ModelsError::invalid(
-                "reference input",
-                format!("sample {k} = {}", reference[k]),
-                "must be finite",
-            ));
-        }
-        self.reference = reference.to_vec();
-        Ok(self)
+        LumpedModel::scaled(system, record, Some(peak), Some(reference))
     }
 
     /// The quasi-static stretch `d_s` of each spring (m), in name order (see the module
@@ -366,37 +399,18 @@ impl LumpedModel {
         &self.reach
     }
 
-    /// The travel `u_s(p)` of each spring (m), in name order: the largest stretch of its ends
-    /// over the model's run at point `p` without its rattles (every other held quantity as
-    /// at `p`), under the reference input. A rattle of clearance fraction `g` between the
-    /// spring's ends has the clearance `g u_s(p)`.
+    /// The travel of each spring (m), in name order: the largest stretch of its ends over
+    /// the model's own run at point `p` without its rattles (every other held quantity as at
+    /// `p`). At the nominal point under the reference input it is the `u_s` of the module
+    /// docs.
     ///
     /// # Errors
     /// As [`LumpedModel::dynamics`] and the integrator.
     pub fn travel(&self, p: &[f64]) -> Result<Vec<f64>> {
-        let (dynamics, _, _) = self.assemble(p, false)?;
-        self.travel_of(&dynamics)
-    }
-
-    /// The largest stretch of each declared spring's ends in the run of `dynamics` under
-    /// the reference input.
-    fn travel_of(&self, dynamics: &Dynamics) -> Result<Vec<f64>> {
-        let reach = 2.0 * self.reach.iter().fold(0.0_f64, |m, r| m.max(*r));
-        let traj = dynamics.run(&self.reference, self.dt, reach)?;
-        let at = |node: Node, k: usize| match node {
-            Node::Base => 0.0,
-            Node::Mass(i) => traj.z[i][k],
-        };
-        Ok(self
-            .system
-            .springs
-            .iter()
-            .map(|s| {
-                (0..self.reference.len()).fold(0.0_f64, |m, k| {
-                    m.max((at(s.between[1], k) - at(s.between[0], k)).abs())
-                })
-            })
-            .collect())
+        let (mut dynamics, _, _) = self.dynamics(p)?;
+        let declared = self.system.gaps.len();
+        dynamics.gaps.truncate(declared);
+        travel_of(&dynamics, &self.input, self.dt, &self.reach, &self.system)
     }
 
     /// The system the model runs.
@@ -427,11 +441,6 @@ impl LumpedModel {
     /// [`ModelsError::Invalid`] for a point of the wrong length or a value outside what the
     /// physics admits (a stiffness that is not positive, a negative damping ratio).
     pub fn dynamics(&self, p: &[f64]) -> Result<(Dynamics, f64, Vec<f64>)> {
-        self.assemble(p, true)
-    }
-
-    /// [`LumpedModel::dynamics`], with the rattles or without them.
-    fn assemble(&self, p: &[f64], rattles: bool) -> Result<(Dynamics, f64, Vec<f64>)> {
         if p.len() != self.space.dim() {
             return Err(ModelsError::invalid(
                 "point",
@@ -460,7 +469,7 @@ impl LumpedModel {
         let mut delay = 0.0;
         let mut rails = vec![0.0; sys.outputs.len()];
         let mut cubic = vec![0.0; sys.springs.len()];
-        let mut rattle = vec![(0.0, 0.0); sys.springs.len()];
+        let mut rattle = vec![[(0.0, 0.0); CLEARANCES.len()]; sys.springs.len()];
         let mut modes = vec![(0.0, 0.0); sys.masses.len()];
         for (held, v) in self.held.iter().zip(&h) {
             match held.effect {
@@ -468,8 +477,8 @@ impl LumpedModel {
                 Effect::ModeFrequency(m) => modes[m].1 = *v,
                 Effect::Cubic(s) => cubic[s] = *v,
                 Effect::StiffnessChange => change = *v,
-                Effect::RattleStiffness(s) => rattle[s].0 = *v,
-                Effect::RattleGap(s) => rattle[s].1 = *v,
+                Effect::RattleStiffness(s, j) => rattle[s][j].0 = *v,
+                Effect::RattleGap(s, j) => rattle[s][j].1 = *v,
                 Effect::Delay => delay = *v,
                 Effect::Saturation(o) => rails[o] = *v,
             }
@@ -531,13 +540,12 @@ impl LumpedModel {
                 .collect(),
             gaps,
         };
-        if rattles && rattle.iter().any(|r| r.0 > 0.0) {
-            let travel = self.travel_of(&dynamics)?;
-            for (i, &(k, fraction)) in rattle.iter().enumerate() {
+        for (i, slots) in rattle.iter().enumerate() {
+            for &(k, gap) in slots {
                 if k > 0.0 {
                     dynamics.gaps.push(GapLink {
                         ends: sys.springs[i].between,
-                        gap: fraction.max(0.0) * travel[i],
+                        gap: gap.max(0.0),
                         k,
                         sides: GapSides::Both,
                     });
@@ -578,6 +586,79 @@ impl LumpedModel {
             self.unit_label.clone(),
         )?)
     }
+}
+
+/// The declared system at `point` (each spring's stiffness and damping ratio, in name
+/// order), without held quantities: what the nominal travel is read from.
+fn linear(system: &LumpedSystem, point: &[f64]) -> Result<Dynamics> {
+    let mass_of = |n: Node| match n {
+        Node::Base => None,
+        Node::Mass(i) => Some(system.masses[i].1),
+    };
+    let springs = system
+        .springs
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let (k, zeta) = (point[2 * i], point[2 * i + 1]);
+            let mu = match (mass_of(s.between[0]), mass_of(s.between[1])) {
+                (Some(a), Some(b)) => a * b / (a + b),
+                (Some(a), None) | (None, Some(a)) => a,
+                (None, None) => 0.0,
+            };
+            SpringLink {
+                ends: s.between,
+                k,
+                beta: 0.0,
+                c: 2.0 * zeta * (k * mu).sqrt(),
+            }
+        })
+        .collect();
+    Ok(Dynamics {
+        masses: system.masses.iter().map(|m| m.1).collect(),
+        springs,
+        dashpots: system
+            .dashpots
+            .iter()
+            .map(|d| (d.between, d.coefficient))
+            .collect(),
+        gaps: system
+            .gaps
+            .iter()
+            .map(|g| GapLink {
+                ends: g.between,
+                gap: g.gap,
+                k: g.stiffness,
+                sides: g.sides,
+            })
+            .collect(),
+    })
+}
+
+/// The largest stretch of each declared spring's ends (m) in the run of `dynamics` under
+/// `input` (m/s^2, step `dt`); `reach` the springs' `d_s`.
+fn travel_of(
+    dynamics: &Dynamics,
+    input: &[f64],
+    dt: f64,
+    reach: &[f64],
+    system: &LumpedSystem,
+) -> Result<Vec<f64>> {
+    let far = 2.0 * reach.iter().fold(0.0_f64, |m, r| m.max(*r));
+    let traj = dynamics.run(input, dt, far)?;
+    let at = |node: Node, k: usize| match node {
+        Node::Base => 0.0,
+        Node::Mass(i) => traj.z[i][k],
+    };
+    Ok(system
+        .springs
+        .iter()
+        .map(|s| {
+            (0..input.len()).fold(0.0_f64, |m, k| {
+                m.max((at(s.between[1], k) - at(s.between[0], k)).abs())
+            })
+        })
+        .collect())
 }
 
 /// The quasi-static stretch of each spring of `system` (m): `|z_a - z_b|` at its ends in

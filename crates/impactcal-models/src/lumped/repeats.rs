@@ -12,10 +12,9 @@
 //! **Scales.** The held quantities' ranges and held values (a rattle's gap, a rail, the
 //! cubic term's reach) are scaled by the largest peak base acceleration over every test of
 //! both sets, so that a freed quantity means the same physical thing on each test and its
-//! range covers the largest drive ([`LumpedModel::with_scale`]); and a rattle's clearance,
-//! a fraction of the travel its spring reaches in the model's run, takes that travel from
-//! the run under the strongest test's input on every test
-//! ([`LumpedModel::with_reference`]), so that one freed clearance is one length on each.
+//! range covers the largest drive; and the rattles' probe clearances, fractions of the
+//! travel each spring reaches in the nominal run, take that travel from the run under the
+//! strongest test's input on every test ([`LumpedModel::with_reference`]).
 //!
 //! **Which set runs** is a condition: [`REPEAT_SET`] `= 0` the calibration tests (the
 //! default), `= 1` the holdout tests; the loop's holdout runs at `repeat_set = 1`.
@@ -100,8 +99,7 @@ impl LumpedRepeats {
         let build = |set: &[(&str, &Histories)]| -> Result<Vec<(String, LumpedModel)>> {
             set.iter()
                 .map(|(name, record)| {
-                    LumpedModel::with_scale(system.clone(), record, peak)
-                        .and_then(|m| m.with_reference(&reference))
+                    LumpedModel::with_reference(system.clone(), record, peak, &reference)
                         .map(|m| (name.to_string(), m))
                         .map_err(|e| in_test(name, e))
                 })
