@@ -230,7 +230,7 @@ impl Experiment {
             .map_err(|e| in_test(e.into()))?;
         if let ModelSpec::Lumped(spec) = &self.spec {
             let m = lumped::measured(spec, base, &mut notes).map_err(in_test)?;
-            notes.extend(lumped::scatter_notes(&m.scatter));
+            notes.extend(lumped::scatter_notes(&m.scatter, &m.shifts));
             return Ok(Measured {
                 test: m.test,
                 map: None,

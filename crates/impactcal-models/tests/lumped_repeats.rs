@@ -116,7 +116,11 @@ fn held_quantities_share_the_largest_drives_scale() {
     for set in [0.0, 1.0] {
         let run = reps.at_condition(&[(REPEAT_SET.into(), set)]).unwrap();
         for m in run.models() {
-            assert!((m.reach()[0] / reach - 1.0).abs() <= 1e-12, "{:?}", m.reach());
+            assert!(
+                (m.reach()[0] / reach - 1.0).abs() <= 1e-12,
+                "{:?}",
+                m.reach()
+            );
             let gap = m
                 .candidates()
                 .into_iter()

@@ -59,6 +59,7 @@ use impactcal_core::{
 };
 
 use crate::error::{ModelsError, Result};
+use crate::lumped::align::shift_by;
 use crate::lumped::integrate::{Dynamics, GapLink, SpringLink};
 use crate::lumped::system::{GapSides, LumpedSystem, Node};
 
@@ -566,7 +567,7 @@ impl LumpedModel {
             let mut a = if delay == 0.0 {
                 a
             } else {
-                shifted(&a, delay / self.dt)
+                shift_by(&a, delay / self.dt)
             };
             if rails[o] > 0.0 {
                 let rail = 1.0 / rails[o];
@@ -716,30 +717,6 @@ fn static_stretch(system: &LumpedSystem, peak: f64) -> Result<Vec<f64>> {
         .iter()
         .map(|s| (at(s.between[1]) - at(s.between[0])).abs())
         .collect())
-}
-
-/// `y(k - shift)` for each sample `k`, linear between samples, the first value before the
-/// record and the last after it.
-fn shifted(y: &[f64], shift: f64) -> Vec<f64> {
-    let n = y.len();
-    (0..n)
-        .map(|k| {
-            let x = k as f64 - shift;
-            if x <= 0.0 {
-                y[0]
-            } else if x >= (n - 1) as f64 {
-                y[n - 1]
-            } else {
-                let i = x.floor() as usize;
-                let f = x - i as f64;
-                if f == 0.0 {
-                    y[i]
-                } else {
-                    y[i] + f * (y[i + 1] - y[i])
-                }
-            }
-        })
-        .collect()
 }
 
 impl Model for LumpedModel {
