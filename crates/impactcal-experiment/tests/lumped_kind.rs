@@ -181,7 +181,7 @@ fn repeated_tests_calibrate_and_hold_out_side_by_side() {
     let dt = Histories::read_csv(d.join("drop1.csv")).unwrap().dt();
     let (y1, y3) = (
         y("drop1.csv"),
-        impactcal_models::lumped::shift_by(&y("drop3.csv"), -m.shifts[1] / dt),
+        impactcal_models::lumped::delay_exact(&y("drop3.csv"), -m.shifts[1] / dt),
     );
     let by_hand = (y1
         .iter()

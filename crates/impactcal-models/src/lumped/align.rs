@@ -17,8 +17,14 @@
 //! sampled at 1 MHz: about `1e-4` of a sample, well below what the noise allows). `y(t + s)`
 //! then matches `x(t)`: `y` triggered `s dt` later.
 //!
-//! **Aligned repeat.** `y(t + s dt)` is read from the samples of `y` by linear
-//! interpolation, the first or last sample held beyond the record ([`shift_by`]).
+//! **Aligned repeat.** `y(t + s dt)` is read from the samples of `y` by a fractional delay
+//! in the frequency domain ([`delay_exact`]): the record, padded with zeros to a power of two
+//! at least twice its length, is transformed, each bin `m` multiplied by
+//! `exp(-2 pi i m shift / M)`, and transformed back. This is an all-pass filter: it moves a
+//! band-limited signal exactly and keeps the variance of white noise, where a linear
+//! interpolation between samples would halve it at half a sample (its weights `1 - f` and
+//! `f` give `(1 - f)^2 + f^2`), so the scatter between repeats would under-report their
+//! noise. Only the Nyquist bin, whose delay is not real, is scaled by `cos(pi shift)`.
 
 use crate::error::{ModelsError, Result};
 
@@ -44,6 +50,78 @@ pub fn shift_by(y: &[f64], shift: f64) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// `y(k - shift)` for each sample `k` (`shift` in samples; positive delays `y`), by the
+/// all-pass fractional delay of the module docs. The record's ends meet zeros, not each
+/// other: a shift smaller than the record's length does not wrap.
+pub fn delay_exact(y: &[f64], shift: f64) -> Vec<f64> {
+    let n = y.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let m = (2 * n).next_power_of_two();
+    let mut re = vec![0.0; m];
+    let mut im = vec![0.0; m];
+    re[..n].copy_from_slice(y);
+    fft(&mut re, &mut im, false);
+    for k in 0..m {
+        // Frequency index of bin k, signed: k for the lower half, k - m above.
+        let f = if k <= m / 2 {
+            k as f64
+        } else {
+            k as f64 - m as f64
+        };
+        let (c, s) = if k == m / 2 {
+            ((std::f64::consts::PI * shift).cos(), 0.0)
+        } else {
+            let ph = -2.0 * std::f64::consts::PI * f * shift / m as f64;
+            (ph.cos(), ph.sin())
+        };
+        let (a, b) = (re[k], im[k]);
+        re[k] = a * c - b * s;
+        im[k] = a * s + b * c;
+    }
+    fft(&mut re, &mut im, true);
+    re.truncate(n);
+    re.iter_mut().for_each(|v| *v /= m as f64);
+    re
+}
+
+/// In-place radix-2 FFT of `re + i im` (length a power of two); `inverse` conjugates the
+/// twiddles (unscaled).
+fn fft(re: &mut [f64], im: &mut [f64], inverse: bool) {
+    let n = re.len();
+    let mut j = 0;
+    for i in 1..n {
+        let mut bit = n >> 1;
+        while j & bit != 0 {
+            j ^= bit;
+            bit >>= 1;
+        }
+        j |= bit;
+        if i < j {
+            re.swap(i, j);
+            im.swap(i, j);
+        }
+    }
+    let sign = if inverse { 1.0 } else { -1.0 };
+    let mut len = 2;
+    while len <= n {
+        let ang = sign * 2.0 * std::f64::consts::PI / len as f64;
+        for start in (0..n).step_by(len) {
+            for k in 0..len / 2 {
+                let (wr, wi) = ((ang * k as f64).cos(), (ang * k as f64).sin());
+                let (a, b) = (start + k, start + k + len / 2);
+                let (xr, xi) = (re[b] * wr - im[b] * wi, re[b] * wi + im[b] * wr);
+                re[b] = re[a] - xr;
+                im[b] = im[a] - xi;
+                re[a] += xr;
+                im[a] += xi;
+            }
+        }
+        len <<= 1;
+    }
 }
 
 /// The shift `s` (samples) at which `y(t + s)` best matches `x(t)` (see the module docs):

@@ -49,7 +49,7 @@ pub mod model;
 pub mod repeats;
 pub mod system;
 
-pub use align::{input_shift, shift_by};
+pub use align::{delay_exact, input_shift, shift_by};
 pub use integrate::{Dynamics, GapLink, SpringLink, Trajectory};
 pub use model::LumpedModel;
 pub use repeats::{

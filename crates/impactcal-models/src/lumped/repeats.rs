@@ -24,7 +24,7 @@ use impactcal_core::{
 };
 
 use crate::error::{ModelsError, Result};
-use crate::lumped::align::{input_shift, shift_by};
+use crate::lumped::align::{delay_exact, input_shift};
 use crate::lumped::model::LumpedModel;
 use crate::lumped::system::LumpedSystem;
 
@@ -412,7 +412,7 @@ pub fn scatter(
                     Ok(if *shift == 0.0 {
                         y.to_vec()
                     } else {
-                        shift_by(y, -shift / dt)
+                        delay_exact(y, -shift / dt)
                     })
                 })
                 .collect::<Result<Vec<Vec<f64>>>>()?;
