@@ -110,6 +110,9 @@ pub struct Measured {
     /// The scatter between repeated calibration tests, per channel (a lumped model's;
     /// empty otherwise).
     pub scatter: Vec<impactcal_models::lumped::ChannelScatter>,
+    /// The time (s) by which each repeated calibration test triggered later than the
+    /// first, read from its input, before the scatter (a lumped model's; empty otherwise).
+    pub shifts: Vec<f64>,
 }
 
 impl Experiment {
@@ -239,6 +242,7 @@ impl Experiment {
                 notes,
                 sigma: None,
                 scatter: m.scatter,
+                shifts: m.shifts,
             });
         }
         let test = match (&self.spec, &t.data) {
@@ -287,6 +291,7 @@ impl Experiment {
             notes,
             sigma,
             scatter: Vec::new(),
+            shifts: Vec::new(),
         })
     }
 
