@@ -27,6 +27,7 @@
 //! noise. Only the Nyquist bin, whose delay is not real, is scaled by `cos(pi shift)`.
 
 use crate::error::{ModelsError, Result};
+use crate::kolsky::dispersion::fft;
 
 /// `y(k - shift)` for each sample `k` (`shift` in samples), linear between samples, the first
 /// value before the record and the last after it. A positive shift delays `y`.
@@ -84,44 +85,7 @@ pub fn delay_exact(y: &[f64], shift: f64) -> Vec<f64> {
     }
     fft(&mut re, &mut im, true);
     re.truncate(n);
-    re.iter_mut().for_each(|v| *v /= m as f64);
     re
-}
-
-/// In-place radix-2 FFT of `re + i im` (length a power of two); `inverse` conjugates the
-/// twiddles (unscaled).
-fn fft(re: &mut [f64], im: &mut [f64], inverse: bool) {
-    let n = re.len();
-    let mut j = 0;
-    for i in 1..n {
-        let mut bit = n >> 1;
-        while j & bit != 0 {
-            j ^= bit;
-            bit >>= 1;
-        }
-        j |= bit;
-        if i < j {
-            re.swap(i, j);
-            im.swap(i, j);
-        }
-    }
-    let sign = if inverse { 1.0 } else { -1.0 };
-    let mut len = 2;
-    while len <= n {
-        let ang = sign * 2.0 * std::f64::consts::PI / len as f64;
-        for start in (0..n).step_by(len) {
-            for k in 0..len / 2 {
-                let (wr, wi) = ((ang * k as f64).cos(), (ang * k as f64).sin());
-                let (a, b) = (start + k, start + k + len / 2);
-                let (xr, xi) = (re[b] * wr - im[b] * wi, re[b] * wi + im[b] * wr);
-                re[b] = re[a] - xr;
-                im[b] = im[a] - xi;
-                re[a] += xr;
-                im[a] += xi;
-            }
-        }
-        len <<= 1;
-    }
 }
 
 /// The shift `s` (samples) at which `y(t + s)` best matches `x(t)` (see the module docs):

@@ -521,25 +521,10 @@ impl LumpedModel {
                 masses.push(mx);
             }
         }
-        let gaps: Vec<GapLink> = sys
-            .gaps
-            .iter()
-            .map(|g| GapLink {
-                ends: g.between,
-                gap: g.gap,
-                k: g.stiffness,
-                sides: g.sides,
-            })
-            .collect();
         let mut dynamics = Dynamics {
             masses,
             springs,
-            dashpots: sys
-                .dashpots
-                .iter()
-                .map(|d| (d.between, d.coefficient))
-                .collect(),
-            gaps,
+            ..declared_elements(sys)
         };
         for (i, slots) in rattle.iter().enumerate() {
             for &(k, gap) in slots {
@@ -618,6 +603,16 @@ fn linear(system: &LumpedSystem, point: &[f64]) -> Result<Dynamics> {
     Ok(Dynamics {
         masses: system.masses.iter().map(|m| m.1).collect(),
         springs,
+        ..declared_elements(system)
+    })
+}
+
+/// The file's dashpots and gap contacts of `system`, as the integrator takes them (no mass,
+/// no spring).
+fn declared_elements(system: &LumpedSystem) -> Dynamics {
+    Dynamics {
+        masses: Vec::new(),
+        springs: Vec::new(),
         dashpots: system
             .dashpots
             .iter()
@@ -633,7 +628,7 @@ fn linear(system: &LumpedSystem, point: &[f64]) -> Result<Dynamics> {
                 sides: g.sides,
             })
             .collect(),
-    })
+    }
 }
 
 /// The largest stretch of each declared spring's ends (m) in the run of `dynamics` under
