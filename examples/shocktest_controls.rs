@@ -61,13 +61,14 @@ fn main() {
                 .collect();
             println!(
                 "{what}, seed {seed}: verdict {:?}, added [{}], best candidates {:?}, error \
-                 {:.3} -> {:.3}, {:.1} s",
+                 {:.3} -> {:.3}, {:.1} s\n  stopped: {}",
                 r.verdict,
                 added.join(", "),
                 shock_controls::reasons(&r),
                 r.errors.calibration.calibrated,
                 r.errors.calibration.enriched,
-                start.elapsed().as_secs_f64()
+                start.elapsed().as_secs_f64(),
+                r.stopped
             );
         }
         println!(

@@ -111,6 +111,9 @@ pub struct Measured {
     /// The scatter between repeated calibration tests, per channel (a lumped model's;
     /// empty otherwise).
     pub scatter: Vec<impactcal_models::lumped::ChannelScatter>,
+    /// The time (s) by which each repeated calibration test triggered later than the
+    /// first, read from its input, before the scatter (a lumped model's; empty otherwise).
+    pub shifts: Vec<f64>,
 }
 
 impl Experiment {
@@ -240,7 +243,7 @@ impl Experiment {
             .map_err(|e| in_test(e.into()))?;
         if let ModelSpec::Lumped(spec) = &self.spec {
             let m = lumped::measured(spec, base, &mut notes).map_err(in_test)?;
-            notes.extend(lumped::scatter_notes(&m.scatter));
+            notes.extend(lumped::scatter_notes(&m.scatter, &m.shifts));
             return Ok(Measured {
                 test: m.test,
                 map: None,
@@ -249,6 +252,7 @@ impl Experiment {
                 notes,
                 sigma: None,
                 scatter: m.scatter,
+                shifts: m.shifts,
             });
         }
         let test = match (&self.spec, &t.data) {
@@ -297,6 +301,7 @@ impl Experiment {
             notes,
             sigma,
             scatter: Vec::new(),
+            shifts: Vec::new(),
         })
     }
 

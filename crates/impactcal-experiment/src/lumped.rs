@@ -32,7 +32,9 @@ use std::path::{Path, PathBuf};
 
 use impactcal_core::Histories;
 use impactcal_core::quality::{QualityOptions, check};
-use impactcal_models::lumped::{ChannelScatter, LumpedRepeats, LumpedSystem, REPEAT_SET, scatter};
+use impactcal_models::lumped::{
+    ChannelScatter, LumpedRepeats, LumpedSystem, REPEAT_SET, alignment, scatter,
+};
 use impactcal_runner::fingerprint;
 
 use crate::error::{ExperimentError, Result, io};
@@ -66,8 +68,12 @@ pub struct LumpedMeasured {
     pub test: Histories,
     /// The holdout tests' likewise, with their condition (`repeat_set = 1`).
     pub holdout: Option<(Histories, Vec<(String, f64)>)>,
-    /// The scatter between the calibration tests, per output channel (empty for one test).
+    /// The scatter between the calibration tests, per output channel (empty for one test),
+    /// the tests aligned in time on their base channel.
     pub scatter: Vec<ChannelScatter>,
+    /// The time (s) by which each calibration test triggered later than the first, read
+    /// from the base channel ([`impactcal_models::lumped::alignment`]; empty for one test).
+    pub shifts: Vec<f64>,
 }
 
 fn fault(name: &str, message: impl std::fmt::Display) -> ExperimentError {
@@ -253,23 +259,37 @@ pub fn measured(spec: &LumpedSpec, base: &Path, notes: &mut Vec<String>) -> Resu
     } else {
         Some((side_by_side(&hold)?, vec![(REPEAT_SET.to_string(), 1.0)]))
     };
-    let scatter = if cal.len() >= 2 {
-        scatter(&as_refs(&cal), &outputs)?
+    let (scatter, shifts) = if cal.len() >= 2 {
+        let shifts = alignment(&as_refs(&cal), &system.base_channel)?;
+        (scatter(&as_refs(&cal), &outputs, &shifts)?, shifts)
     } else {
-        Vec::new()
+        (Vec::new(), Vec::new())
     };
     Ok(LumpedMeasured {
         test,
         holdout,
         scatter,
+        shifts,
     })
 }
 
-/// A line per channel of the scatter between repeats, for the notes of a study or loop.
-pub fn scatter_notes(scatter: &[ChannelScatter]) -> Vec<String> {
-    scatter
-        .iter()
-        .map(|s| {
+/// A line with the calibration tests' shifts, then a line per channel of the scatter
+/// between them, for the notes of a study or loop.
+pub fn scatter_notes(scatter: &[ChannelScatter], shifts: &[f64]) -> Vec<String> {
+    let aligned = (shifts.len() >= 2).then(|| {
+        format!(
+            "calibration tests aligned on their input before their scatter: each triggered \
+             later than the first by {} us",
+            shifts
+                .iter()
+                .map(|s| format!("{:.2}", s * 1e6))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    });
+    aligned
+        .into_iter()
+        .chain(scatter.iter().map(|s| {
             format!(
                 "scatter between the {} calibration tests, `{}`: RMS {:.4} ({:.1} % of the \
                  repeats' RMS)",
@@ -278,7 +298,7 @@ pub fn scatter_notes(scatter: &[ChannelScatter]) -> Vec<String> {
                 s.rms,
                 100.0 * s.relative
             )
-        })
+        }))
         .collect()
 }
 

@@ -120,7 +120,7 @@ fn a_lumped_file_builds_the_system_driven_by_its_test() {
         model
             .candidates()
             .iter()
-            .any(|c| c.name() == "rattle_mount_gap")
+            .any(|c| c.name() == "rattle_mount_c1_gap")
     );
     let m = e.measured().unwrap();
     assert_eq!(m.test.labels(), ["accel_1"]);
@@ -167,7 +167,10 @@ fn repeated_tests_calibrate_and_hold_out_side_by_side() {
     let held = model.at_condition(&set).unwrap().simulate(&p).unwrap();
     assert_eq!(held.channel(0), own("drop2.csv").channel(0));
     assert_eq!(held.channel(1), own("drop4.csv").channel(0));
-    // The scatter of drops 1 and 3 by hand: the RMS over samples of |y1 - y3| / sqrt(2).
+    // The scatter of drops 1 and 3 by hand, drop 3 read at its shift on the input: the RMS
+    // over samples of |y1 - y3| / sqrt(2).
+    assert_eq!(m.shifts.len(), 2);
+    assert_eq!(m.shifts[0], 0.0);
     let y = |f: &str| {
         Histories::read_csv(d.join(f))
             .unwrap()
@@ -175,7 +178,11 @@ fn repeated_tests_calibrate_and_hold_out_side_by_side() {
             .unwrap()
             .to_vec()
     };
-    let (y1, y3) = (y("drop1.csv"), y("drop3.csv"));
+    let dt = Histories::read_csv(d.join("drop1.csv")).unwrap().dt();
+    let (y1, y3) = (
+        y("drop1.csv"),
+        impactcal_models::lumped::delay_exact(&y("drop3.csv"), -m.shifts[1] / dt),
+    );
     let by_hand = (y1
         .iter()
         .zip(&y3)
@@ -190,6 +197,7 @@ fn repeated_tests_calibrate_and_hold_out_side_by_side() {
             .iter()
             .any(|n| n.contains("scatter between the 2 calibration tests, `accel_1`"))
     );
+    assert!(m.notes.iter().any(|n| n.contains("aligned on their input")));
 }
 
 #[test]

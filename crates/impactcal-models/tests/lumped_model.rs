@@ -139,8 +139,12 @@ fn declared_parameters_and_candidates_follow_the_file() {
             "mode_board_frequency",
             "cubic_mount",
             "stiffness_change",
-            "rattle_mount_stiffness",
-            "rattle_mount_gap",
+            "rattle_mount_c1_stiffness",
+            "rattle_mount_c1_gap",
+            "rattle_mount_c2_stiffness",
+            "rattle_mount_c2_gap",
+            "rattle_mount_c3_stiffness",
+            "rattle_mount_c3_gap",
             "delay",
             "saturation_accel_1"
         ]
@@ -275,40 +279,74 @@ fn the_added_mode_resonates_where_the_two_mass_system_does() {
 }
 
 /// A rattle at zero clearance is a spring in parallel: stiffness `3 k` doubles the
-/// frequency; at a clearance wider than the motion it never touches.
+/// frequency; at a clearance of the whole travel it never touches, and the travel is the
+/// undamped oscillator's peak stretch `max |a| / w^2`; the three rattles are probed at a
+/// half, a quarter and an eighth of it, each of which closes.
 #[test]
 fn a_rattle_acts_past_its_gap_only() {
     let m = model(0.0, 20_000);
     let (e, p) = freed(
         &m,
         &[
-            ("rattle_mount_stiffness", 3.0 * k0()),
-            ("rattle_mount_gap", 0.0),
+            ("rattle_mount_c1_stiffness", 3.0 * k0()),
+            ("rattle_mount_c1_gap", 0.0),
         ],
     );
     let f = frequency(e.simulate(&p).unwrap().channel(0), 2.0 * WIDTH);
     assert!((f / (2.0 * F0) - 1.0).abs() < 1e-3, "{f}");
-    let d_s = PEAK * G1000 * M / k0();
-    let (e, p) = freed(
-        &m,
-        &[
-            ("rattle_mount_stiffness", 3.0 * k0()),
-            ("rattle_mount_gap", 1.99 * d_s),
-        ],
-    );
-    let z_max = m
-        .simulate(&m.space().nominal())
-        .unwrap()
+    let linear = m.simulate(&m.space().nominal()).unwrap();
+    let z_max = linear
         .channel(0)
         .iter()
         .fold(0.0_f64, |x, v| x.max(v.abs()))
         * G1000
         / (2.0 * PI * F0).powi(2);
-    assert!(z_max < 1.99 * d_s, "{z_max} {d_s}");
-    let a = e.simulate(&p).unwrap();
-    let b = m.simulate(&m.space().nominal()).unwrap();
-    for (x, y) in a.data().iter().zip(b.data()) {
-        assert!((x - y).abs() <= 1e-9 * PEAK, "{x} {y}");
+    let travel = m.travel(&m.space().nominal()).unwrap()[0];
+    assert!((travel / z_max - 1.0).abs() < 1e-9, "{travel} {z_max}");
+    let largest = |h: &Histories| {
+        h.data()
+            .iter()
+            .zip(linear.data())
+            .fold(0.0_f64, |d, (x, y)| d.max((x - y).abs()))
+    };
+    let (e, p) = freed(
+        &m,
+        &[
+            ("rattle_mount_c1_stiffness", 3.0 * k0()),
+            ("rattle_mount_c1_gap", travel),
+        ],
+    );
+    assert!(largest(&e.simulate(&p).unwrap()) <= 1e-9 * PEAK);
+    let cands = m.candidates();
+    for (c, fraction) in [("c1", 0.5), ("c2", 0.25), ("c3", 0.125)] {
+        let gap = cands
+            .iter()
+            .find(|x| x.name() == format!("rattle_mount_{c}_gap"))
+            .unwrap();
+        assert!((gap.parameter.nominal / (fraction * travel) - 1.0).abs() < 1e-12);
+        let (e, p) = freed(&m, &[(&format!("rattle_mount_{c}_stiffness"), 3.0 * k0())]);
+        assert!(largest(&e.simulate(&p).unwrap()) > 1e-2 * PEAK, "{c}");
+    }
+}
+
+/// The quasi-static stretch `d_s` solves `K z = M 1 a_pk`: a board on its own mount
+/// carries its own mass, a spring in a chain the masses beyond it (closed form).
+#[test]
+fn the_stretch_scale_carries_the_masses_beyond_each_spring() {
+    let text = format!(
+        "[base]\nchannel = \"table\"\nunit = {G1000}\n\
+         [masses]\na = 0.2\nb = 0.05\nc = 0.03\n\
+         [springs.s1]\nbetween = [\"base\", \"a\"]\nstiffness = 4.0e7\n\
+         [springs.s2]\nbetween = [\"a\", \"b\"]\nstiffness = 1.0e7\n\
+         [springs.s3]\nbetween = [\"base\", \"c\"]\nstiffness = 3.0e7\n\
+         [outputs]\n\"accel 1\" = \"b\"\n"
+    );
+    let sys = LumpedSystem::parse(&text, "chain.toml").unwrap();
+    let m = LumpedModel::new(sys, &record(100)).unwrap();
+    let a = PEAK * G1000;
+    let want = [a * 0.25 / 4.0e7, a * 0.05 / 1.0e7, a * 0.03 / 3.0e7];
+    for (got, want) in m.reach().iter().zip(want) {
+        assert!((got / want - 1.0).abs() < 1e-12, "{got} {want}");
     }
 }
 

@@ -252,7 +252,7 @@ impl DispersionCurve {
 }
 
 /// In-place radix-2 FFT of `(re, im)` (length a power of two); `inverse` divides by `n`.
-fn fft(re: &mut [f64], im: &mut [f64], inverse: bool) {
+pub(crate) fn fft(re: &mut [f64], im: &mut [f64], inverse: bool) {
     let n = re.len();
     let mut j = 0;
     for i in 1..n {

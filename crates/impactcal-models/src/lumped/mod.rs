@@ -9,7 +9,9 @@
 //!   `Enrichable` with its held quantities ([`LumpedModel`]);
 //! - [`repeats`]: repeated tests of one article as one data set, calibration and holdout
 //!   tests each with its own input ([`LumpedRepeats`]), and the scatter between repeats
-//!   ([`scatter`]).
+//!   ([`scatter`]), after aligning the repeats in time on their input ([`alignment`]);
+//! - [`align`]: the shift between two tests' inputs, to a fraction of a sample
+//!   ([`input_shift`]).
 //!
 //! ```
 //! use impactcal_core::{Enrichable, Histories, Model};
@@ -37,16 +39,20 @@
 //! let h = model.simulate(&model.space().nominal())?;
 //! let peak = h.channel(0).iter().fold(0.0_f64, |m, a| m.max(*a));
 //! assert!((peak - 200.0).abs() < 1e-2);
-//! assert!(model.candidates().iter().any(|c| c.name() == "rattle_mount_gap"));
+//! assert!(model.candidates().iter().any(|c| c.name() == "rattle_mount_c1_gap"));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod align;
 pub mod integrate;
 pub mod model;
 pub mod repeats;
 pub mod system;
 
+pub use align::{delay_exact, input_shift, shift_by};
 pub use integrate::{Dynamics, GapLink, SpringLink, Trajectory};
 pub use model::LumpedModel;
-pub use repeats::{ChannelScatter, LumpedRepeats, REPEAT_SET, repeat_label, scatter, side_by_side};
+pub use repeats::{
+    ChannelScatter, LumpedRepeats, REPEAT_SET, alignment, repeat_label, scatter, side_by_side,
+};
 pub use system::{BASE, Dashpot, Gap, GapSides, LumpedSystem, Node, Output, Spring};

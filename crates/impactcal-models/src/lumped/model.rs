@@ -12,9 +12,16 @@
 //!
 //! **Held quantities** ([`Enrichable::candidates`]): each with its admissible range and the
 //! held value that switches it off. Scales: `a_pk` is the record's peak base acceleration
-//! (m/s^2), `M` the total mass, and `d_s = a_pk M / k_s` the stretch of spring `s` (at its
-//! nominal stiffness) if it carried the whole system at the peak input; a pulse of that
-//! peak moves a linear oscillator by at most `2 d_s`.
+//! (m/s^2) and `d_s` the quasi-static stretch of spring `s`: the stretch `|z_a - z_b|` of
+//! its ends in the static solution `K z = M 1 a_pk` at the nominal stiffnesses (the system
+//! held at the peak input as a constant acceleration). A spring carries the masses on its
+//! far side from the base and nothing else, so a board on its own mount has
+//! `d_s = a_pk m / k_s`, and a spring in a chain carries the masses beyond it. A pulse of
+//! that peak moves a linear oscillator by at most `2 d_s`. `u_s` is the nominal travel of
+//! spring `s`: the largest `|z_a - z_b|` over the run of the model at its nominal point,
+//! under the reference input (the test's own base acceleration; for repeated tests the
+//! strongest one's, [`crate::lumped::LumpedRepeats`], so that the rattles are probed at the
+//! same lengths on every test).
 //!
 //! | name | range | held | effect |
 //! |---|---|---|---|
@@ -22,8 +29,23 @@
 //! | `mode_<m>_frequency` | `10/T`..`0.2/dt` Hz | their geometric mean | that mode's frequency on a fixed base, `sqrt(k/m_x) / 2 pi` (damping ratio 0.02) |
 //! | `cubic_<s>` | -1/12..1 | 0 | spring `s` becomes `k d (1 + gamma (d/d_s)^2)`: tangent stiffness positive up to `2 d_s` at the softest, four times `k` at `d_s` at the hardest |
 //! | `stiffness_change` | -0.5..0.5 | 0 | every spring's stiffness times `1 + change` (the damping ratios kept): a test's stiffness change |
-//! | `rattle_<s>_stiffness` | 0..`100 k_s` | 0 | a two-sided gap contact between the ends of spring `s` (a rattle), of this penalty stiffness |
-//! | `rattle_<s>_gap` | 0..`2 d_s` | `d_s / 2` | its clearance (m) |
+//! | `rattle_<s>_c<j>_stiffness` | 0..`100 k_s` | 0 | a two-sided gap contact between the ends of spring `s` (a rattle), of this penalty stiffness; `j = 1, 2, 3` |
+//! | `rattle_<s>_c<j>_gap` | 0..`2 d_s` | `u_s / 2^j` | its clearance (m) |
+//!
+//! **Why three rattles per spring, at halving clearances.** A contact whose clearance the
+//! ends never reach does nothing, so a rattle's stiffness can only be probed by a finite
+//! step at a clearance the test's own travel closes; and a contact is a threshold effect,
+//! so its stiffness at one clearance does not stand in for another (the recalibration with
+//! the stiffness alone, at a clearance far from the true one, realises little of what the
+//! contact explains). The clearance is unknown and may lie anywhere below the travel, and
+//! the travel at the calibrated point may be well below the nominal one (a linear model
+//! fitted to a rattling article stiffens its mount). So each spring carries three rattles,
+//! probed at a half, a quarter and an eighth of its nominal travel (`c1`, `c2`, `c3`): a
+//! geometric grid, each clearance within a factor of `sqrt 2` of any clearance between
+//! `u_s / 8 sqrt 2` and `u_s / sqrt 2`, which closes at the calibrated point as long as its
+//! travel stays above an eighth of the nominal one. The attribution scores each; once one's
+//! stiffness is added, its clearance is the candidate that refines it. Only the lengths
+//! come from the model's response (its nominal run); nothing of a test's residual enters.
 //! | `delay` | `-50 dt`..`50 dt` | 0 | outputs later by this time (s): `y(t - delay)`, linear between samples |
 //! | `saturation_<c>` | 0..`4 / a_pk` | 0 | channel `c` clipped at the rail `+-1 / value` (value in 1 per record unit; 0 is no rail) |
 //!
@@ -37,6 +59,7 @@ use impactcal_core::{
 };
 
 use crate::error::{ModelsError, Result};
+use crate::lumped::align::shift_by;
 use crate::lumped::integrate::{Dynamics, GapLink, SpringLink};
 use crate::lumped::system::{GapSides, LumpedSystem, Node};
 
@@ -50,8 +73,8 @@ enum Effect {
     ModeFrequency(usize),
     Cubic(usize),
     StiffnessChange,
-    RattleStiffness(usize),
-    RattleGap(usize),
+    RattleStiffness(usize, usize),
+    RattleGap(usize, usize),
     Delay,
     Saturation(usize),
 }
@@ -80,6 +103,9 @@ pub struct LumpedModel {
     reach: Vec<f64>,
 }
 
+/// The rattles' held clearances, as fractions of the nominal travel: `c1`, `c2`, `c3`.
+const CLEARANCES: [f64; 3] = [0.5, 0.25, 0.125];
+
 /// A channel label as a parameter-name fragment.
 fn fragment(label: &str) -> String {
     label
@@ -103,7 +129,7 @@ impl LumpedModel {
     /// channel with a non-finite sample (naming it) or that never moves; [`ModelsError::Invalid`]
     /// when two output labels give the same saturation parameter name.
     pub fn new(system: LumpedSystem, record: &Histories) -> Result<LumpedModel> {
-        LumpedModel::scaled(system, record, None)
+        LumpedModel::scaled(system, record, None, None)
     }
 
     /// The model of `system` driven by the base channel of `record`, its held quantities
@@ -122,10 +148,15 @@ impl LumpedModel {
                 "must be positive and finite",
             ));
         }
-        LumpedModel::scaled(system, record, Some(peak))
+        LumpedModel::scaled(system, record, Some(peak), None)
     }
 
-    fn scaled(system: LumpedSystem, record: &Histories, scale: Option<f64>) -> Result<LumpedModel> {
+    fn scaled(
+        system: LumpedSystem,
+        record: &Histories,
+        scale: Option<f64>,
+        reference: Option<&[f64]>,
+    ) -> Result<LumpedModel> {
         let raw = record.channel_by_label(&system.base_channel)?;
         let what = format!("base channel `{}`", system.base_channel);
         if raw.len() < 2 {
@@ -148,12 +179,28 @@ impl LumpedModel {
         let peak = scale.unwrap_or(peak);
         let dt = record.dt();
         let duration = dt * (raw.len() - 1) as f64;
-        let total: f64 = system.masses.iter().map(|m| m.1).sum();
-        let reach: Vec<f64> = system
+        let reach = static_stretch(&system, peak)?;
+        let reference = reference.unwrap_or(&input);
+        if reference.len() != input.len() {
+            return Err(ModelsError::invalid(
+                "reference input",
+                format!("{} samples", reference.len()),
+                format!("the record has {}", input.len()),
+            ));
+        }
+        if let Some(k) = reference.iter().position(|x| !x.is_finite()) {
+            return Err(ModelsError::invalid(
+                "reference input",
+                format!("sample {k} = {}", reference[k]),
+                "must be finite",
+            ));
+        }
+        let nominal: Vec<f64> = system
             .springs
             .iter()
-            .map(|s| peak * total / s.stiffness)
+            .flat_map(|s| [s.stiffness, s.damping_ratio])
             .collect();
+        let travel = travel_of(&linear(&system, &nominal)?, reference, dt, &reach, &system)?;
 
         let mut params = Vec::with_capacity(2 * system.springs.len());
         for s in &system.springs {
@@ -245,26 +292,33 @@ impl LumpedModel {
         for (i, s) in system.springs.iter().enumerate() {
             let [a, b] = s.between;
             let pair = format!("`{}` and `{}`", system.node_name(a), system.node_name(b));
-            add(
-                format!("rattle_{}_stiffness", s.name),
-                0.0,
-                100.0 * s.stiffness,
-                0.0,
-                "N/m",
-                "contact",
-                format!("penalty stiffness of a rattle (two-sided gap contact) between {pair}"),
-                Effect::RattleStiffness(i),
-            )?;
-            add(
-                format!("rattle_{}_gap", s.name),
-                0.0,
-                2.0 * reach[i],
-                0.5 * reach[i],
-                "m",
-                "contact",
-                format!("clearance of the rattle between {pair}"),
-                Effect::RattleGap(i),
-            )?;
+            for (j, fraction) in CLEARANCES.iter().enumerate() {
+                let c = j + 1;
+                let gap = (fraction * travel[i]).min(2.0 * reach[i]);
+                add(
+                    format!("rattle_{}_c{c}_stiffness", s.name),
+                    0.0,
+                    100.0 * s.stiffness,
+                    0.0,
+                    "N/m",
+                    "contact",
+                    format!(
+                        "penalty stiffness of a rattle (two-sided gap contact) between {pair}, \
+                         probed at {fraction} of the nominal travel ({gap:.3e} m)"
+                    ),
+                    Effect::RattleStiffness(i, j),
+                )?;
+                add(
+                    format!("rattle_{}_c{c}_gap", s.name),
+                    0.0,
+                    2.0 * reach[i],
+                    gap,
+                    "m",
+                    "contact",
+                    format!("clearance of rattle c{c} between {pair}"),
+                    Effect::RattleGap(i, j),
+                )?;
+            }
         }
         add(
             "delay".into(),
@@ -306,13 +360,58 @@ impl LumpedModel {
         Ok(LumpedModel {
             space: ParameterSpace::new(params)?,
             system,
-            input,
             dt,
             start: record.start(),
             unit_label: record.unit().to_string(),
             held,
             reach,
+            input,
         })
+    }
+
+    /// The model of `system` driven by the base channel of `record`, its held quantities
+    /// scaled by `peak` (m/s^2) as [`LumpedModel::with_scale`], and its rattles probed at
+    /// clearances taken from the nominal run under `reference` (m/s^2, one value per sample
+    /// of `record`) in place of its own input: what repeated tests share
+    /// ([`crate::lumped::LumpedRepeats`]).
+    ///
+    /// # Errors
+    /// As [`LumpedModel::with_scale`]; [`ModelsError::Invalid`] for a reference of another
+    /// length than the record, or with a sample that is not finite.
+    pub fn with_reference(
+        system: LumpedSystem,
+        record: &Histories,
+        peak: f64,
+        reference: &[f64],
+    ) -> Result<LumpedModel> {
+        if !(peak.is_finite() && peak > 0.0) {
+            return Err(ModelsError::invalid(
+                "peak base acceleration",
+                peak,
+                "must be positive and finite",
+            ));
+        }
+        LumpedModel::scaled(system, record, Some(peak), Some(reference))
+    }
+
+    /// The quasi-static stretch `d_s` of each spring (m), in name order (see the module
+    /// docs): what the held quantities' ranges are scaled by.
+    pub fn reach(&self) -> &[f64] {
+        &self.reach
+    }
+
+    /// The travel of each spring (m), in name order: the largest stretch of its ends over
+    /// the model's own run at point `p` without its rattles (every other held quantity as at
+    /// `p`). At the nominal point under the reference input it is the `u_s` of the module
+    /// docs.
+    ///
+    /// # Errors
+    /// As [`LumpedModel::dynamics`] and the integrator.
+    pub fn travel(&self, p: &[f64]) -> Result<Vec<f64>> {
+        let (mut dynamics, _, _) = self.dynamics(p)?;
+        let declared = self.system.gaps.len();
+        dynamics.gaps.truncate(declared);
+        travel_of(&dynamics, &self.input, self.dt, &self.reach, &self.system)
     }
 
     /// The system the model runs.
@@ -371,7 +470,7 @@ impl LumpedModel {
         let mut delay = 0.0;
         let mut rails = vec![0.0; sys.outputs.len()];
         let mut cubic = vec![0.0; sys.springs.len()];
-        let mut rattle = vec![(0.0, 0.0); sys.springs.len()];
+        let mut rattle = vec![[(0.0, 0.0); CLEARANCES.len()]; sys.springs.len()];
         let mut modes = vec![(0.0, 0.0); sys.masses.len()];
         for (held, v) in self.held.iter().zip(&h) {
             match held.effect {
@@ -379,8 +478,8 @@ impl LumpedModel {
                 Effect::ModeFrequency(m) => modes[m].1 = *v,
                 Effect::Cubic(s) => cubic[s] = *v,
                 Effect::StiffnessChange => change = *v,
-                Effect::RattleStiffness(s) => rattle[s].0 = *v,
-                Effect::RattleGap(s) => rattle[s].1 = *v,
+                Effect::RattleStiffness(s, j) => rattle[s][j].0 = *v,
+                Effect::RattleGap(s, j) => rattle[s][j].1 = *v,
                 Effect::Delay => delay = *v,
                 Effect::Saturation(o) => rails[o] = *v,
             }
@@ -422,36 +521,23 @@ impl LumpedModel {
                 masses.push(mx);
             }
         }
-        let mut gaps: Vec<GapLink> = sys
-            .gaps
-            .iter()
-            .map(|g| GapLink {
-                ends: g.between,
-                gap: g.gap,
-                k: g.stiffness,
-                sides: g.sides,
-            })
-            .collect();
-        for (i, &(k, gap)) in rattle.iter().enumerate() {
-            if k > 0.0 {
-                gaps.push(GapLink {
-                    ends: sys.springs[i].between,
-                    gap: gap.max(0.0),
-                    k,
-                    sides: GapSides::Both,
-                });
-            }
-        }
-        let dynamics = Dynamics {
+        let mut dynamics = Dynamics {
             masses,
             springs,
-            dashpots: sys
-                .dashpots
-                .iter()
-                .map(|d| (d.between, d.coefficient))
-                .collect(),
-            gaps,
+            ..declared_elements(sys)
         };
+        for (i, slots) in rattle.iter().enumerate() {
+            for &(k, gap) in slots {
+                if k > 0.0 {
+                    dynamics.gaps.push(GapLink {
+                        ends: sys.springs[i].between,
+                        gap: gap.max(0.0),
+                        k,
+                        sides: GapSides::Both,
+                    });
+                }
+            }
+        }
         Ok((dynamics, delay, rails))
     }
 
@@ -466,7 +552,7 @@ impl LumpedModel {
             let mut a = if delay == 0.0 {
                 a
             } else {
-                shifted(&a, delay / self.dt)
+                shift_by(&a, delay / self.dt)
             };
             if rails[o] > 0.0 {
                 let rail = 1.0 / rails[o];
@@ -488,28 +574,144 @@ impl LumpedModel {
     }
 }
 
-/// `y(k - shift)` for each sample `k`, linear between samples, the first value before the
-/// record and the last after it.
-fn shifted(y: &[f64], shift: f64) -> Vec<f64> {
-    let n = y.len();
-    (0..n)
-        .map(|k| {
-            let x = k as f64 - shift;
-            if x <= 0.0 {
-                y[0]
-            } else if x >= (n - 1) as f64 {
-                y[n - 1]
-            } else {
-                let i = x.floor() as usize;
-                let f = x - i as f64;
-                if f == 0.0 {
-                    y[i]
-                } else {
-                    y[i] + f * (y[i + 1] - y[i])
-                }
+/// The declared system at `point` (each spring's stiffness and damping ratio, in name
+/// order), without held quantities: what the nominal travel is read from.
+fn linear(system: &LumpedSystem, point: &[f64]) -> Result<Dynamics> {
+    let mass_of = |n: Node| match n {
+        Node::Base => None,
+        Node::Mass(i) => Some(system.masses[i].1),
+    };
+    let springs = system
+        .springs
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let (k, zeta) = (point[2 * i], point[2 * i + 1]);
+            let mu = match (mass_of(s.between[0]), mass_of(s.between[1])) {
+                (Some(a), Some(b)) => a * b / (a + b),
+                (Some(a), None) | (None, Some(a)) => a,
+                (None, None) => 0.0,
+            };
+            SpringLink {
+                ends: s.between,
+                k,
+                beta: 0.0,
+                c: 2.0 * zeta * (k * mu).sqrt(),
             }
         })
-        .collect()
+        .collect();
+    Ok(Dynamics {
+        masses: system.masses.iter().map(|m| m.1).collect(),
+        springs,
+        ..declared_elements(system)
+    })
+}
+
+/// The file's dashpots and gap contacts of `system`, as the integrator takes them (no mass,
+/// no spring).
+fn declared_elements(system: &LumpedSystem) -> Dynamics {
+    Dynamics {
+        masses: Vec::new(),
+        springs: Vec::new(),
+        dashpots: system
+            .dashpots
+            .iter()
+            .map(|d| (d.between, d.coefficient))
+            .collect(),
+        gaps: system
+            .gaps
+            .iter()
+            .map(|g| GapLink {
+                ends: g.between,
+                gap: g.gap,
+                k: g.stiffness,
+                sides: g.sides,
+            })
+            .collect(),
+    }
+}
+
+/// The largest stretch of each declared spring's ends (m) in the run of `dynamics` under
+/// `input` (m/s^2, step `dt`); `reach` the springs' `d_s`.
+fn travel_of(
+    dynamics: &Dynamics,
+    input: &[f64],
+    dt: f64,
+    reach: &[f64],
+    system: &LumpedSystem,
+) -> Result<Vec<f64>> {
+    let far = 2.0 * reach.iter().fold(0.0_f64, |m, r| m.max(*r));
+    let traj = dynamics.run(input, dt, far)?;
+    let at = |node: Node, k: usize| match node {
+        Node::Base => 0.0,
+        Node::Mass(i) => traj.z[i][k],
+    };
+    Ok(system
+        .springs
+        .iter()
+        .map(|s| {
+            (0..input.len()).fold(0.0_f64, |m, k| {
+                m.max((at(s.between[1], k) - at(s.between[0], k)).abs())
+            })
+        })
+        .collect())
+}
+
+/// The quasi-static stretch of each spring of `system` (m): `|z_a - z_b|` at its ends in
+/// the solution of `K z = M 1 peak` at the nominal stiffnesses (Gaussian elimination with
+/// partial pivoting; `K` is positive definite since every mass is tied to the base by
+/// springs, which the file reader checks).
+///
+/// # Errors
+/// [`ModelsError::Invalid`] if `K` is singular to working precision.
+fn static_stretch(system: &LumpedSystem, peak: f64) -> Result<Vec<f64>> {
+    let n = system.masses.len();
+    let mut k = vec![0.0; n * n];
+    for s in &system.springs {
+        let [a, b] = s.between;
+        for (x, y, w) in [(a, a, 1.0), (b, b, 1.0), (a, b, -1.0), (b, a, -1.0)] {
+            if let (Node::Mass(i), Node::Mass(j)) = (x, y) {
+                k[i * n + j] += w * s.stiffness;
+            }
+        }
+    }
+    let mut z: Vec<f64> = system.masses.iter().map(|m| m.1 * peak).collect();
+    for c in 0..n {
+        let pivot = (c..n)
+            .max_by(|&i, &j| k[i * n + c].abs().total_cmp(&k[j * n + c].abs()))
+            .unwrap_or(c);
+        if k[pivot * n + c] == 0.0 {
+            return Err(ModelsError::invalid(
+                "stiffness matrix",
+                format!("column {c}"),
+                "is singular: a mass is not held by springs",
+            ));
+        }
+        for j in 0..n {
+            k.swap(c * n + j, pivot * n + j);
+        }
+        z.swap(c, pivot);
+        for i in c + 1..n {
+            let f = k[i * n + c] / k[c * n + c];
+            for j in c..n {
+                k[i * n + j] -= f * k[c * n + j];
+            }
+            z[i] -= f * z[c];
+        }
+    }
+    for c in (0..n).rev() {
+        let tail: f64 = (c + 1..n).map(|j| k[c * n + j] * z[j]).sum();
+        z[c] = (z[c] - tail) / k[c * n + c];
+    }
+    let at = |node: Node| match node {
+        Node::Base => 0.0,
+        Node::Mass(i) => z[i],
+    };
+    Ok(system
+        .springs
+        .iter()
+        .map(|s| (at(s.between[1]) - at(s.between[0])).abs())
+        .collect())
 }
 
 impl Model for LumpedModel {

@@ -12,7 +12,9 @@
 //! **Scales.** The held quantities' ranges and held values (a rattle's gap, a rail, the
 //! cubic term's reach) are scaled by the largest peak base acceleration over every test of
 //! both sets, so that a freed quantity means the same physical thing on each test and its
-//! range covers the largest drive ([`LumpedModel::with_scale`]).
+//! range covers the largest drive; and the rattles' probe clearances, fractions of the
+//! travel each spring reaches in the nominal run, take that travel from the run under the
+//! strongest test's input on every test ([`LumpedModel::with_reference`]).
 //!
 //! **Which set runs** is a condition: [`REPEAT_SET`] `= 0` the calibration tests (the
 //! default), `= 1` the holdout tests; the loop's holdout runs at `repeat_set = 1`.
@@ -22,6 +24,7 @@ use impactcal_core::{
 };
 
 use crate::error::{ModelsError, Result};
+use crate::lumped::align::{delay_exact, input_shift};
 use crate::lumped::model::LumpedModel;
 use crate::lumped::system::LumpedSystem;
 
@@ -85,14 +88,19 @@ impl LumpedRepeats {
         let all = || calibration.iter().chain(holdout);
         same_window(&all().copied().collect::<Vec<_>>())?;
         let mut peak = 0.0_f64;
+        let mut reference = Vec::new();
         for (name, record) in all() {
             let m = LumpedModel::new(system.clone(), record).map_err(|e| in_test(name, e))?;
-            peak = m.input().iter().fold(peak, |p, a| p.max(a.abs()));
+            let own = m.input().iter().fold(0.0_f64, |p, a| p.max(a.abs()));
+            if own > peak {
+                peak = own;
+                reference = m.input().to_vec();
+            }
         }
         let build = |set: &[(&str, &Histories)]| -> Result<Vec<(String, LumpedModel)>> {
             set.iter()
                 .map(|(name, record)| {
-                    LumpedModel::with_scale(system.clone(), record, peak)
+                    LumpedModel::with_reference(system.clone(), record, peak, &reference)
                         .map(|m| (name.to_string(), m))
                         .map_err(|e| in_test(name, e))
                 })
@@ -310,15 +318,57 @@ pub struct ChannelScatter {
     pub upper: Vec<f64>,
 }
 
-/// The scatter between the repeats `tests` of each of `channels` (test labels), the tests
-/// sharing one window. It measures what a test of this article could be (the spread a
-/// repeat shows, with the measurement noise in it), beside what the model could be.
+/// The time (s) by which each of `tests` triggered later than the first, read from the
+/// channel `input` (the base acceleration, the same event in every test) by
+/// cross-correlation to a fraction of a sample ([`input_shift`], lags up to a quarter of
+/// the window): `y_k(t + shift_k)` matches `y_1(t)`. The first test's shift is 0.
 ///
 /// # Errors
 /// [`ModelsError::Record`] for fewer than two tests or tests of different windows (naming
-/// the test); a channel a test lacks (the core error, naming it); a non-finite sample
-/// (naming the test, the channel and the sample).
-pub fn scatter(tests: &[(&str, &Histories)], channels: &[String]) -> Result<Vec<ChannelScatter>> {
+/// the test), a test without the channel (naming it), or what [`input_shift`] refuses
+/// (naming the test).
+pub fn alignment(tests: &[(&str, &Histories)], input: &str) -> Result<Vec<f64>> {
+    if tests.len() < 2 {
+        return Err(ModelsError::record(
+            "alignment of repeated tests",
+            "needs at least two tests",
+        ));
+    }
+    same_window(tests)?;
+    fn read<'h>(name: &str, h: &'h Histories, input: &str) -> Result<&'h [f64]> {
+        h.channel_by_label(input).map_err(|e| {
+            ModelsError::record(format!("test `{name}`"), format!("input `{input}`: {e}"))
+        })
+    }
+    let first = read(tests[0].0, tests[0].1, input)?;
+    let max_lag = first.len() / 4;
+    let dt = tests[0].1.dt();
+    tests
+        .iter()
+        .map(|t| {
+            let y = read(t.0, t.1, input)?;
+            input_shift(first, y, max_lag)
+                .map(|s| s * dt)
+                .map_err(|e| in_test(t.0, e))
+        })
+        .collect()
+}
+
+/// The scatter between the repeats `tests` of each of `channels` (test labels), the tests
+/// sharing one window, each read `shifts[k]` seconds later than its own time base (the
+/// [`alignment`] on the input; zeros compare the samples as recorded). It measures what a
+/// test of this article could be (the spread a repeat shows, with the measurement noise in
+/// it), beside what the model could be.
+///
+/// # Errors
+/// [`ModelsError::Record`] for fewer than two tests, tests of different windows (naming the
+/// test), or a shift per test missing or not finite; a channel a test lacks (the core
+/// error, naming it); a non-finite sample (naming the test, the channel and the sample).
+pub fn scatter(
+    tests: &[(&str, &Histories)],
+    channels: &[String],
+    shifts: &[f64],
+) -> Result<Vec<ChannelScatter>> {
     let [(_, first), ..] = tests else {
         return Err(ModelsError::record(
             "scatter between repeats",
@@ -331,15 +381,27 @@ pub fn scatter(tests: &[(&str, &Histories)], channels: &[String]) -> Result<Vec<
             "needs at least two tests",
         ));
     }
+    if shifts.len() != tests.len() || shifts.iter().any(|s| !s.is_finite()) {
+        return Err(ModelsError::record(
+            "scatter between repeats",
+            format!(
+                "{} tests need as many finite shifts, got {:?}",
+                tests.len(),
+                shifts
+            ),
+        ));
+    }
     same_window(tests)?;
     let n = tests.len();
     let len = first.samples();
+    let dt = first.dt();
     channels
         .iter()
         .map(|channel| {
             let ys = tests
                 .iter()
-                .map(|(name, h)| {
+                .zip(shifts)
+                .map(|((name, h), shift)| {
                     let y = h.channel_by_label(channel)?;
                     if let Some(k) = y.iter().position(|v| !v.is_finite()) {
                         return Err(ModelsError::record(
@@ -347,9 +409,13 @@ pub fn scatter(tests: &[(&str, &Histories)], channels: &[String]) -> Result<Vec<
                             format!("sample {k} is {}", y[k]),
                         ));
                     }
-                    Ok(y)
+                    Ok(if *shift == 0.0 {
+                        y.to_vec()
+                    } else {
+                        delay_exact(y, -shift / dt)
+                    })
                 })
-                .collect::<Result<Vec<&[f64]>>>()?;
+                .collect::<Result<Vec<Vec<f64>>>>()?;
             let (mut var, mut power) = (0.0, 0.0);
             let mut lower = vec![f64::INFINITY; len];
             let mut upper = vec![f64::NEG_INFINITY; len];
